@@ -14,12 +14,14 @@ import math
 
 from ..model import ContactLaw, as_law
 from ..parameters import Parameters
+from ._batch import simulate_batch
 from ._events import Event
 from ._exact import SCIPY_METHODS, integrate_exact
 from ._rk4 import integrate_rk4
 from ._trajectory import STATUSES, Save, Trajectory
 
-__all__ = ["simulate", "Trajectory", "Event", "Save", "STATUSES", "INTEGRATORS", "SCIPY_METHODS"]
+__all__ = ["simulate", "simulate_batch", "Trajectory", "Event", "Save", "STATUSES", "INTEGRATORS",
+           "SCIPY_METHODS"]
 
 INTEGRATORS = ("exact", "rk4")
 
@@ -47,7 +49,8 @@ def simulate(params: Parameters, law: ContactLaw | str = "paper", t_end: float =
         Defaults to True for a summary, False otherwise.
     **options
         ``exact``: ``rtol`` (1e-10), ``atol`` (relative to the state scales), ``method``,
-        ``max_steps``, ``max_events``; ``rk4``: ``step`` (s), ``every``.
+        ``max_steps``, ``max_events``, ``initial`` (a state ``(x1, x2, x1dot, x2dot)`` to start
+        from instead of seed eq. 6); ``rk4``: ``step`` (s), ``every``.
     """
     law = as_law(law)
     if not (isinstance(t_end, (int, float)) and math.isfinite(t_end) and t_end > 0):

@@ -44,21 +44,34 @@ def target_reach(y, c: Coefficients):
     return np.where(c.Kb + root > 0, reach, np.abs(x2))
 
 
-def stick_is_permanent(y, c: Coefficients) -> bool:
-    """Whether a stick entered at ``y`` can never break (REFERENCE §3).
+def stick_orbit(y, c: Coefficients):
+    """Amplitude ``A`` of the stuck pair's orbit and the ``|x2|`` at which the stick breaks.
 
-    The stuck pair oscillates on the target springs with conserved energy; the largest
-    force it ever needs, at the turning point, is compared with the stick bound.
+    While stuck the pair oscillates on the target springs with conserved energy
+    ``M v^2/2 + Kb x2^2/2 + Km x2^4/4`` (``M = M1 + M2``); the force it needs,
+    ``F_req = M1/M S(x2)``, grows with ``|x2|`` and reaches the bound ``K |delta|^alpha``
+    at ``x_break`` (the real root of ``Km x^3 + Kb x = M/M1 * bound``). REFERENCE §3.
     """
-    if c.target != "plate":
-        return True
     M = c.M1 + c.M2
-    x2, v = y[X2], 0.5 * (y[V1] + y[V2])
+    x2, v = y[..., X2], y[..., V2]
     orbit_energy = 0.5 * M * v * v + (0.5 * c.Kb + 0.25 * c.Km * x2 * x2) * x2 * x2
-    amplitude = np.sqrt(4.0 * orbit_energy / (c.Kb + np.sqrt(c.Kb**2 + 4 * c.Km * orbit_energy)))
-    largest = c.M1 / M * (c.Kb + c.Km * amplitude**2) * amplitude
-    bound = c.K * _power(abs(y[X1] - y[X2]), c.alpha)
-    return bool(largest <= bound)
+    root = np.sqrt(c.Kb * c.Kb + 4.0 * c.Km * orbit_energy)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        amplitude = np.sqrt(4.0 * orbit_energy / (c.Kb + root))
+        force = M / c.M1 * c.K * _power(np.abs(y[..., X1] - x2), c.alpha)
+        # x^3 + 3p x = 2q with p = Kb/(3 Km), q = force/(2 Km): x = 2 sqrt(p) sinh(asinh(q/p^1.5)/3)
+        p = c.Kb / (3.0 * c.Km)
+        cubic = 2.0 * np.sqrt(p) * np.sinh(np.arcsinh(force / (2.0 * c.Km) / p**1.5) / 3.0)
+        x_break = np.where(c.Km > 0, cubic, force / c.Kb)
+    return amplitude, x_break
+
+
+def stick_margin(y, c: Coefficients) -> float:
+    """Relative margin ``(x_break - A) / x_break`` of a stick entered at ``y``; >= 0: it never breaks."""
+    if c.target != "plate":
+        return 1.0
+    amplitude, x_break = stick_orbit(y, c)
+    return float((x_break - amplitude) / x_break) if x_break > 0 else -1.0
 
 
 def event_values(y, c: Coefficients, law: ContactLaw, mode, energy_limit, f=None):
@@ -85,7 +98,7 @@ def event_values(y, c: Coefficients, law: ContactLaw, mode, energy_limit, f=None
         g[..., DELTADOT] = np.where(stuck, 1.0, deltadot)
         spring_rate = (c.Kb + 3 * c.Km * y[..., X2] ** 2) * y[..., V2] * c.M1 / (c.M1 + c.M2)
         g[..., FORCE_RATE] = np.where(stuck, spring_rate, mode * rate)
-        g[..., STICK_MARGIN] = np.where(stuck, c.K * hertz - np.abs(stick_force(y, c)), 1.0)
+        g[..., STICK_MARGIN] = np.where(stuck, _stick_break_distance(y, c), 1.0)
         return g
     g[..., DELTADOT] = deltadot
     if law.bilateral:
@@ -98,6 +111,39 @@ def event_values(y, c: Coefficients, law: ContactLaw, mode, energy_limit, f=None
     if c.target == "plate":
         g[..., REACH] = np.where(delta < 0, -(y[..., X1] + target_reach(y, c)), -1.0)
     return g
+
+
+def _stick_break_distance(y, c: Coefficients):
+    """Stick-break event function, monotone along each half-swing of the stuck pair, m.
+
+    ``x_break - |x2|`` swinging out and ``x_break - 2A + |x2|`` swinging back (continuous at the
+    turning point, where it equals ``x_break - A``). A plain ``bound - |F_req|`` grazes zero at
+    the turning point when the violation is small, and a step can jump over it; this one has
+    its sign at the turning point guaranteed negative whenever the orbit leaves the stick bound.
+    Held at +1 when the orbit never reaches ``x_break`` (``A <= x_break``).
+    """
+    if c.target != "plate":
+        return np.ones(np.shape(y[..., X2]))
+    amplitude, x_break = stick_orbit(y, c)
+    x2 = y[..., X2]
+    swing_out = x2 * y[..., V2] >= 0
+    distance = np.where(swing_out, x_break - np.abs(x2), x_break - 2 * amplitude + np.abs(x2))
+    return np.where(amplitude > x_break, distance, 1.0)
+
+
+def departure_sign(column: int, y, mode) -> float:
+    """The sign event ``column`` takes just after a run restarts on its zero at ``y``.
+
+    Integrators start the new phase with that sign (times a tiny number) in place of the zero,
+    so a return to zero within the first step is still seen as a crossing.
+    """
+    if column == DELTA:
+        sign = np.sign(y[V1] - y[V2])
+    elif column == DELTADOT:
+        sign = mode
+    else:
+        sign = 1.0
+    return float(sign) or 1.0
 
 
 def crossed(g_old, g_new):
@@ -172,7 +218,7 @@ def transition(column: int, t: float, y: np.ndarray, mode: int, c: Coefficients,
                 common = (c.M1 * y[V1] + c.M2 * y[V2]) / (c.M1 + c.M2)
                 y[V1] = y[V2] = 0.0 if c.target == "rigid" else common
                 kind, mode = "stick", 0
-                if stop_when_settled and stick_is_permanent(y, c):
+                if stop_when_settled and stick_margin(y, c) >= 0:
                     stop = "settled"
             else:
                 new = int(np.sign(required))
@@ -191,6 +237,13 @@ def transition(column: int, t: float, y: np.ndarray, mode: int, c: Coefficients,
     return Transition(Event(kind, t, y.copy(), force, mode), mode, y, restart or stop is not None, stop)
 
 
-def initial_mode(law: ContactLaw, v: float) -> int:
-    """Seed eq. 6 starts with ``deltadot = v > 0``: slipping forward."""
-    return 1 if v >= 0 else -1
+def initial_mode(law: ContactLaw, y, c: Coefficients) -> int:
+    """Mode of a run starting at ``y``: the sign of ``deltadot``, or stuck (``paper``) if the
+    relative velocity is zero and the stick bound holds (seed eq. 6 gives ``+1``)."""
+    deltadot = y[V1] - y[V2]
+    if deltadot != 0 or not law.is_filippov:
+        return 1 if deltadot >= 0 or not law.is_filippov else -1
+    required = float(stick_force(y, c))
+    if abs(required) <= c.K * abs(y[X1] - y[X2]) ** c.alpha:
+        return 0
+    return int(np.sign(required)) or 1

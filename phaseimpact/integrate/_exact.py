@@ -14,13 +14,14 @@ import numpy as np
 import scipy.integrate
 from scipy.optimize import brentq
 
-from ..model import ContactLaw, coefficients, energy, initial_state, rhs
+from ..model import ContactLaw, coefficients, contact_force, energy, initial_state, rhs
 from ..parameters import Parameters
 from ._events import (
     DELTA,
     RUNAWAY_ENERGY_FACTOR,
     Event,
     crossed,
+    departure_sign,
     event_values,
     initial_mode,
     transition,
@@ -29,41 +30,48 @@ from ._trajectory import Recorder, Save, Trajectory, state_scale
 
 SCIPY_METHODS = ("DOP853", "RK45", "Radau", "BDF", "LSODA")
 _EPS = np.finfo(float).eps
+_TINY = np.finfo(float).tiny
 
 
 def integrate_exact(params: Parameters, law: ContactLaw, t_end: float, *, save: Save,
                     stop_when_settled: bool, rtol: float = 1e-10, atol: float | None = None,
                     method: str = "DOP853", max_steps: int = 1_000_000,
-                    max_events: int = 10_000) -> Trajectory:
-    """Integrate from seed eq. 6 to ``t_end``; see :func:`phaseimpact.simulate`."""
+                    max_events: int = 10_000, initial=None, stop_on=()) -> Trajectory:
+    """Integrate from seed eq. 6 (or ``initial``) to ``t_end``; see :func:`phaseimpact.simulate`."""
     # Trial steps of a runaway may overflow; the solver rejects them and the energy event or
     # the finiteness check ends the run with a status, so the warnings carry no information.
     with np.errstate(over="ignore", invalid="ignore"):
         return _integrate(params, law, t_end, save, stop_when_settled, rtol, atol, method,
-                          max_steps, max_events)
+                          max_steps, max_events, initial, frozenset(stop_on))
 
 
 def _integrate(params, law, t_end, save, stop_when_settled, rtol, atol, method, max_steps,
-               max_events) -> Trajectory:
+               max_events, initial, stop_on) -> Trajectory:
     solver_class = getattr(scipy.integrate, method)
     c = coefficients(params, law)
     y = initial_state(params.v)
+    impact_energy = float(energy(y, c, law))
+    if initial is not None:
+        y[:4] = initial
     atol_vector = (rtol if atol is None else atol) * state_scale(params, c)
-    energy_limit = RUNAWAY_ENERGY_FACTOR * float(energy(y, c, law))
+    energy_limit = RUNAWAY_ENERGY_FACTOR * max(float(energy(y, c, law)), impact_energy)
     recorder = Recorder(c, law, save)
-    mode, t = initial_mode(law, params.v), 0.0
-    recorder.event(Event("contact", 0.0, y.copy(), 0.0, mode))
+    mode, t = initial_mode(law, y, c), 0.0
+    if y[0] == y[1] and y[2] > y[3]:
+        recorder.event(Event("contact", 0.0, y.copy(), float(contact_force(y, c, law, mode)), mode))
     if save.kind == "times":
         _sample_times(recorder, save.times, -np.inf, 0.0, lambda s: y, mode)
 
     nfev = nsteps = 0
     quiet = DELTA  # the event whose zero the run starts on
     status, message, settled = "success", f"reached t_end = {t_end:g} s", False
-    while t < t_end and status == "success" and not settled:
+    stopped = False
+    while t < t_end and status == "success" and not (settled or stopped):
         solver = solver_class(functools.partial(_phase_rhs, c=c, law=law, mode=mode), t, y, t_end,
                               rtol=rtol, atol=atol_vector)
         g_old = event_values(y, c, law, mode, energy_limit)
-        g_old[quiet] = 0.0
+        for col in {quiet, *np.flatnonzero(g_old == 0)}:
+            g_old[col] = departure_sign(col, y, mode) * _TINY
         while True:
             step_message = solver.step()
             nsteps += 1
@@ -84,11 +92,11 @@ def _integrate(params, law, t_end, save, stop_when_settled, rtol, atol, method, 
             restart = None
             if fired.size:
                 dense = solver.dense_output()
-                roots = sorted((_root(dense, col, t_old, t_new, c, law, mode, energy_limit), col)
+                roots = sorted((_root(dense, col, t_old, t_new, g_old[col], c, law, mode, energy_limit), col)
                                for col in fired)
                 for t_root, col in roots:
                     change = transition(col, t_root, dense(t_root), mode, c, law, stop_when_settled)
-                    if change.restart:
+                    if change.restart or change.event.kind in stop_on:
                         if save.kind == "times":
                             _sample_times(recorder, save.times, t_old, t_root, dense, mode)
                         recorder.event(change.event)
@@ -105,6 +113,9 @@ def _integrate(params, law, t_end, save, stop_when_settled, rtol, atol, method, 
                 elif change.stop == "settled":
                     settled = True
                     message = f"outcome settled at t = {t:.6g} s ({change.event.kind})"
+                elif change.event.kind in stop_on:
+                    stopped = True
+                    message = f"stopped at the first {change.event.kind} event, t = {t:.6g} s, as asked"
                 break
             recorder.extremes(y_new, mode)
             _samples(recorder, save, solver.dense_output() if save.kind == "times" else None,
@@ -123,15 +134,34 @@ def _phase_rhs(_t, y, c, law, mode):
     return rhs(y, c, law, mode)
 
 
-def _root(dense, col, t_old, t_new, c, law, mode, energy_limit) -> float:
-    """Time of the zero of event ``col`` in ``[t_old, t_new]`` on the dense output."""
+def _root(dense, col, t_old, t_new, g_start, c, law, mode, energy_limit) -> float:
+    """Time of the first zero of event ``col`` in ``[t_old, t_new]`` on the dense output.
+
+    A run that restarts on this event's zero (``g_start`` is then a signed tiny number) may
+    leave it and come back within one step, as a brief slip does near a grazing stick break;
+    the dense output is then sampled to find where the function has left zero, and the
+    return is bracketed from there.
+    """
     def g(s):
         return event_values(dense(s), c, law, mode, energy_limit)[col]
 
-    g_a, g_b = g(t_old), g(t_new)
-    if g_a == 0 or np.sign(g_a) == np.sign(g_b):
-        return t_new if g_b == 0 or np.sign(g_a) == np.sign(g_b) else t_old
-    return brentq(g, t_old, t_new, xtol=4 * _EPS * max(abs(t_new), 1e-300), rtol=4 * _EPS)
+    expected = np.sign(g_start)
+    a = t_old
+    if np.sign(g(t_old)) != expected:
+        grid = np.linspace(t_old, t_new, 33)[1:]
+        signs = np.sign([g(s) for s in grid])
+        away = np.flatnonzero(signs == expected)
+        if away.size == 0:
+            return t_old  # the excursion is below what the step resolves
+        back = np.flatnonzero(signs[away[0]:] != expected)
+        a = grid[away[0]]
+        if back.size:
+            t_new = grid[away[0] + back[0]]
+            a = grid[away[0] + back[0] - 1]
+    g_a, g_b = g(a), g(t_new)
+    if np.sign(g_a) == np.sign(g_b) or g_b == 0:
+        return t_new
+    return brentq(g, a, t_new, xtol=4 * _EPS * max(abs(t_new), 1e-300), rtol=4 * _EPS)
 
 
 def _samples(recorder: Recorder, save: Save, dense, t_old, t_new, y_new, mode) -> None:

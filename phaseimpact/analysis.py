@@ -1,0 +1,337 @@
+"""Phase-space analysis of trajectories: asymptotic points, outcomes, fixed points, portraits.
+
+Definitions follow REFERENCE §5. An *asymptotic point* of a trajectory, in a phase plane, is
+a point where the trajectory comes to rest in that plane for a dwell time that is not
+negligible. Two ways to find them:
+
+* ``method="events"`` (default for event-driven trajectories in the ``(delta, deltadot)``
+  plane): every stick phase of ``paper`` is a rest of the relative motion, at
+  ``(delta*, 0)``; two stick phases separated by a slip are distinct points however close.
+* ``method="distance"`` (trajectories without events, e.g. the seed's RK4, and the other
+  planes): runs of samples that stay within ``tol`` (relative to the plane's extent) for at
+  least ``min_dwell`` become candidates; candidates closer than ``tol`` merge. The tolerance
+  biases a critical value near a split; it is reported with the points.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.special import gamma
+
+from .integrate import Trajectory
+from .model import V1, V2, X1, X2, ContactLaw, as_law, coefficients, rhs, target_spring_force
+from .parameters import Parameters
+
+__all__ = [
+    "PLANES",
+    "OUTCOMES",
+    "AsymptoticPoints",
+    "Outcome",
+    "FixedPoint",
+    "EquilibriumSet",
+    "find_asymptotic_points",
+    "classify_outcome",
+    "fixed_points",
+    "plane_coordinates",
+    "hertz_contact_time",
+]
+
+PLANES = (("delta", "deltadot"), ("x1", "x1dot"), ("x2", "x2dot"))
+OUTCOMES = ("rest", "stick", "rebound", "bounded-oscillation", "runaway", "failed")
+_TAU = math.sqrt(math.pi) * gamma(7 / 5) / gamma(9 / 10)  # REFERENCE §4
+
+
+def hertz_contact_time(params: Parameters) -> float:
+    """Undamped Hertz contact time of the impact (REFERENCE §4), the system's fastest scale, s."""
+    m = params.reduced_mass
+    a = params.alpha
+    delta_max = ((a + 1) * m * params.v**2 / (2 * params.K)) ** (1 / (a + 1))
+    return 2 * _TAU * delta_max / params.v
+
+
+def plane_coordinates(y: np.ndarray, plane) -> tuple[np.ndarray, np.ndarray]:
+    """The two coordinates of states ``y`` (shape ``(..., 5)``) in ``plane``."""
+    plane = _check_plane(plane)
+    if plane[0] == "delta":
+        return y[..., X1] - y[..., X2], y[..., V1] - y[..., V2]
+    if plane[0] == "x1":
+        return y[..., X1], y[..., V1]
+    return y[..., X2], y[..., V2]
+
+
+def _check_plane(plane) -> tuple[str, str]:
+    plane = tuple(plane)
+    if plane not in PLANES:
+        allowed = ", ".join(f"({a}, {b})" for a, b in PLANES)
+        raise ValueError(f"plane = {plane!r} is out of range; allowed: {allowed}")
+    return plane
+
+
+@dataclass(frozen=True)
+class AsymptoticPoints:
+    """Distinct rest points of one trajectory in one plane.
+
+    Attributes
+    ----------
+    plane : tuple of str
+        Coordinate names.
+    points : ndarray, shape (k, 2)
+        Coordinates (SI units of the plane), in order of first arrival.
+    dwell : ndarray, shape (k,)
+        Time spent at each point, s (to ``t_end`` for the last one if the run ends there).
+    method : {"events", "distance"}
+        How they were found.
+    tol : float
+        Distance tolerance relative to the plane's extent (0 for ``events``).
+    min_dwell : float
+        Shortest dwell that counts, s.
+    """
+
+    plane: tuple
+    points: np.ndarray
+    dwell: np.ndarray
+    method: str
+    tol: float
+    min_dwell: float
+
+    def __len__(self) -> int:
+        return len(self.dwell)
+
+
+def find_asymptotic_points(trajectory: Trajectory, plane=("delta", "deltadot"), *,
+                           method: str | None = None, tol: float = 1e-3,
+                           min_dwell: float | None = None) -> AsymptoticPoints:
+    """Find the asymptotic points of ``trajectory`` in ``plane`` (REFERENCE §5).
+
+    Parameters
+    ----------
+    trajectory : Trajectory
+    plane : pair of str
+        ``("delta", "deltadot")`` (relative motion, the seed's Fig. 9-10), ``("x1", "x1dot")``
+        or ``("x2", "x2dot")``.
+    method : {"events", "distance"}, optional
+        Defaults to ``events`` for an event-driven trajectory in the relative plane, else
+        ``distance`` (which needs samples: ``save="steps"`` or a time grid).
+    tol : float
+        Distance tolerance for ``distance``, relative to the plane's extent (0 < tol < 1).
+    min_dwell : float, optional
+        Shortest dwell that counts, s; default 1% of the Hertz contact time.
+    """
+    plane = _check_plane(plane)
+    if not (math.isfinite(tol) and 0 < tol < 1):
+        raise ValueError(f"tol = {tol!r} is out of range; allowed: 0 < tol < 1")
+    if min_dwell is None:
+        min_dwell = 0.01 * hertz_contact_time(trajectory.params)
+    event_driven = not trajectory.integrator.startswith("rk4")
+    if method is None:
+        method = "events" if event_driven and plane == PLANES[0] else "distance"
+    if method == "events":
+        if not (event_driven and plane == PLANES[0]):
+            raise ValueError("method = 'events' needs an event-driven trajectory and the "
+                             "(delta, deltadot) plane; use method = 'distance'")
+        points, dwell = _stick_points(trajectory)
+        tol = 0.0
+    elif method == "distance":
+        if len(trajectory.t) < 2:
+            raise ValueError("method = 'distance' needs samples: simulate with save='steps' or a time grid")
+        points, dwell = _rest_runs(trajectory, plane, tol)
+    else:
+        raise ValueError(f"method = {method!r} is out of range; allowed: 'events', 'distance'")
+    keep = dwell >= min_dwell
+    return AsymptoticPoints(plane, points[keep].reshape(-1, 2), dwell[keep], method, tol, min_dwell)
+
+
+def _stick_points(trajectory: Trajectory):
+    """Stick phases of an event-driven run: ``(delta*, 0)`` and how long each lasted."""
+    points, dwell = [], []
+    start = None
+    for event in trajectory.events:
+        if event.kind == "stick":
+            start = event
+        elif event.kind == "slip" and start is not None:
+            points.append((start.delta, 0.0))
+            dwell.append(event.t - start.t)
+            start = None
+    if start is not None:
+        lasts_to = trajectory.t_end if (trajectory.settled or trajectory.ok) else trajectory.t_stop
+        points.append((start.delta, 0.0))
+        dwell.append(lasts_to - start.t)
+    return np.array(points, dtype=float).reshape(-1, 2), np.array(dwell, dtype=float)
+
+
+def _rest_runs(trajectory: Trajectory, plane, tol: float):
+    """Maximal runs of samples staying within ``tol`` of their first sample, then merged."""
+    a, b = plane_coordinates(trajectory.y, plane)
+    scale = np.array([np.ptp(a) or 1.0, np.ptp(b) or 1.0])
+    p = np.column_stack([a, b]) / scale
+    t = trajectory.t
+    candidates, dwell = [], []
+    start = 0
+    for i in range(1, len(t) + 1):
+        if i == len(t) or np.max(np.abs(p[i] - p[start])) > tol:
+            if i - start >= 2:
+                candidates.append(p[start:i].mean(axis=0))
+                dwell.append(t[i - 1] - t[start])
+            start = i
+    merged, merged_dwell = [], []
+    for point, d in zip(candidates, dwell, strict=False):
+        for k, other in enumerate(merged):
+            if np.max(np.abs(point - other)) <= tol:
+                merged_dwell[k] += d
+                break
+        else:
+            merged.append(point)
+            merged_dwell.append(d)
+    points = np.array(merged, dtype=float).reshape(-1, 2) * scale
+    return points, np.array(merged_dwell, dtype=float)
+
+
+@dataclass(frozen=True)
+class Outcome:
+    """The long-time outcome of one trajectory (REFERENCE §5).
+
+    ``kind`` is one of :data:`OUTCOMES`; ``n_stick`` the number of asymptotic (stick) points
+    in the relative plane; ``message`` a readable reason.
+    """
+
+    kind: str
+    n_stick: int
+    message: str
+
+
+def classify_outcome(trajectory: Trajectory, points: AsymptoticPoints | None = None) -> Outcome:
+    """Classify how ``trajectory`` ends: rest, stick, rebound, bounded oscillation, runaway."""
+    if points is None:
+        method = "events" if not trajectory.integrator.startswith("rk4") else "distance"
+        points = (find_asymptotic_points(trajectory, method=method)
+                  if method == "events" or len(trajectory.t) > 1 else None)
+    n = len(points) if points is not None else 0
+    if trajectory.status == "runaway":
+        return Outcome("runaway", n, trajectory.message)
+    if not trajectory.ok:
+        return Outcome("failed", n, f"{trajectory.status}: {trajectory.message}")
+    p, y = trajectory.params, trajectory.final_state
+    law = trajectory.law
+    delta, deltadot = y[X1] - y[X2], y[V1] - y[V2]
+    resting = (abs(y[V1]) + abs(y[V2]) <= 1e-9 * p.v
+               and (p.target != "plate" or abs(y[X2]) <= 1e-9 * max(abs(delta), 1e-12)))
+    if law.is_filippov and trajectory.final_mode == 0:
+        kind = "rest" if resting else "stick"
+        return Outcome(kind, n, f"stuck at delta = {delta:.6g} m ({n} stick point(s))")
+    if law.is_unilateral and delta <= 0 and (trajectory.settled or deltadot < 0):
+        return Outcome("rebound", n, f"projectile separated, receding at {deltadot:.6g} m/s relative")
+    if resting:
+        return Outcome("rest", n, "at rest")
+    return Outcome("bounded-oscillation", n, "still moving at t_end with bounded energy")
+
+
+@dataclass(frozen=True)
+class FixedPoint:
+    """An isolated equilibrium ``(x1, x2, x1dot, x2dot)`` with its Jacobian's eigenvalues."""
+
+    state: np.ndarray
+    eigenvalues: np.ndarray
+    stability: str  # "stable", "unstable", "neutral" (no eigenvalue with positive real part)
+
+
+@dataclass(frozen=True)
+class EquilibriumSet:
+    """A continuum of equilibria, reported as a set (not one arbitrary member).
+
+    ``description`` states the set; ``members`` samples it; ``eigenvalues`` of the dynamics
+    transverse to the set (at a sample member) and ``stability`` as for :class:`FixedPoint`.
+    """
+
+    description: str
+    members: np.ndarray
+    eigenvalues: np.ndarray
+    stability: str
+
+
+def _jacobian(y, c, law, mode, step=None):
+    """Central-difference Jacobian of the 4-d right-hand side (W dropped)."""
+    y = np.asarray(y, dtype=float)
+    J = np.empty((4, 4))
+    for j in range(4):
+        h = step[j] if step is not None else 1e-7 * max(abs(y[j]), 1.0)
+        e = np.zeros(5)
+        e[j] = h
+        J[:, j] = (rhs(y + e, c, law, mode)[:4] - rhs(y - e, c, law, mode)[:4]) / (2 * h)
+    return J
+
+
+def _stability(eigenvalues, rtol=1e-9) -> str:
+    scale = max(np.max(np.abs(eigenvalues)), 1e-300)
+    real = eigenvalues.real / scale
+    if np.any(real > rtol):
+        return "unstable"
+    if np.all(real < -rtol):
+        return "stable"
+    return "neutral"
+
+
+def fixed_points(params: Parameters, law: ContactLaw | str = "paper", *,
+                 guesses=None, tol: float = 1e-12) -> list:
+    """Equilibria of the model: isolated fixed points by Newton, and the sets of equilibria.
+
+    Newton's method runs on the right-hand side with its (central-difference) Jacobian from
+    each guess of ``(x1, x2)`` (velocities zero); sets are reported as sets: the separated
+    states of a unilateral law (``x2`` at a spring equilibrium, ``delta <= 0``), the stick set
+    of ``paper`` (``delta`` arbitrary, frozen), and the translations of a free target.
+    """
+    law = as_law(law)
+    c = coefficients(params, law)
+    scale = ((params.alpha + 1) * params.reduced_mass * params.v**2 / (2 * params.K)) ** (1 / (params.alpha + 1))
+    mode = 0 if law.is_filippov else 1
+    found: list = []
+    if params.target == "plate":
+        # Isolated in x2: roots of S(x2) = 0 refined by Newton on the right-hand side.
+        roots = []
+        starts = guesses if guesses is not None else [(0.0, 0.0), (scale, scale), (-scale, -scale)]
+        for x1, x2 in starts:
+            y = np.array([x1, x2, 0.0, 0.0, 0.0])
+            for _ in range(100):
+                f = rhs(y, c, law, mode)[:4]
+                J = _jacobian(y, c, law, mode, step=[1e-3 * scale] * 2 + [1e-3 * params.v] * 2)
+                try:
+                    dy = np.linalg.lstsq(J, -f, rcond=None)[0]
+                except np.linalg.LinAlgError:
+                    break
+                y[:4] += dy
+                if np.max(np.abs(dy[:2])) <= tol * scale:
+                    break
+            if np.all(np.abs(rhs(y, c, law, mode)[:4]) <= 1e-6 * (1 + abs(float(target_spring_force(scale, c))))):
+                if not any(abs(y[X2] - r) <= 1e-9 * scale for r in roots):
+                    roots.append(float(y[X2]))
+        for x2 in roots:
+            found.extend(_equilibria_at(x2, params, c, law, scale))
+    else:
+        found.extend(_equilibria_at(0.0, params, c, law, scale))
+    return found
+
+
+def _equilibria_at(x2, params, c, law, scale):
+    """The equilibria with the target at ``x2``: a point or a set, with eigenvalues."""
+    deltas = np.linspace(-2 * scale, 2 * scale, 5)
+    members = np.array([[x2 + d, x2, 0.0, 0.0] for d in deltas])
+    where = "at x2 = 0" if params.target != "free" else "with any x2 (free target)"
+    if law.is_filippov:
+        y = np.array([x2 + scale, x2, 0.0, 0.0, 0.0])
+        J = _jacobian(y, c, law, 0, step=[1e-3 * scale] * 2 + [1e-3 * params.v] * 2)
+        eig = np.linalg.eigvals(J)
+        return [EquilibriumSet(f"stick set: any frozen delta, both at rest, target {where}", members,
+                               eig, _stability(eig))]
+    if law.is_unilateral:
+        y = np.array([x2 - scale, x2, 0.0, 0.0, 0.0])
+        J = _jacobian(y, c, law, 1, step=[1e-3 * scale] * 2 + [1e-3 * params.v] * 2)
+        eig = np.linalg.eigvals(J)
+        separated = members[deltas <= 0]
+        return [EquilibriumSet(f"separated states: delta <= 0, both at rest, target {where}", separated,
+                               eig, _stability(eig))]
+    y = np.array([x2, x2, 0.0, 0.0, 0.0])
+    J = _jacobian(y, c, law, 1, step=[1e-3 * scale] * 2 + [1e-3 * params.v] * 2)
+    eig = np.linalg.eigvals(J)
+    return [FixedPoint(y[:4].copy(), eig, _stability(eig))]
