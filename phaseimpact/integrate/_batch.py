@@ -369,21 +369,22 @@ def _locate(t, y, f, h, t_new, y_new, f_new, g_old, g_new, cols, c, law, mode, e
 def _find_zero(evaluate, g_lo, g_hi, y_hi, tol, guess, slope, max_iter=60):
     """Zeros of ``evaluate(x, k) -> (g, y)`` for ``x`` in ``[0, 1]``, vectorised over pairs ``k``.
 
-    Secant iteration safeguarded by the bracket ``[lo, hi]`` (``g(0) = g_lo`` and ``g(1) = g_hi``
-    have opposite signs; ``hi`` stays on the side where the event has fired): it starts at
-    ``guess``, takes a Newton step with ``slope``, then secant steps on the last two iterates,
-    and falls back on regula falsi (bisection after ``max_iter // 2`` iterations) when a step
-    leaves the bracket. Trial points stay ``tol / 2`` inside the bracket, so the bracket closes
-    to ``tol`` even when the iterates approach the zero from one side.
+    Secant iteration safeguarded by the bracket ``[lo, hi]``, where ``g(0) = g_lo`` and
+    ``g(1) = g_hi`` have opposite signs and ``hi`` stays on the side where the event has fired.
+    It starts at ``guess``, takes a Newton step with ``slope``, then secant steps on the last
+    two iterates, and bisects when a step leaves the bracket. Trial points stay ``tol / 2``
+    inside the bracket, so it closes to ``tol`` even when the iterates approach the zero from
+    one side. An iterate with ``|g| <= |slope| tol`` is within ``tol`` of the zero and ends the
+    search too: near the zero ``g`` may be rounding noise whose sign means nothing.
 
-    Returns ``lo, hi`` and the ``y`` evaluated at ``hi``.
+    Returns ``lo``, the zero ``x`` (``hi`` or such an iterate) and the ``y`` evaluated there.
     """
     m = len(g_lo)
     lo, hi = np.zeros(m), np.ones(m)
     g_lo, g_hi, y_hi = np.array(g_lo, dtype=float), np.array(g_hi, dtype=float), y_hi.copy()
     sign = np.sign(g_lo)
     x_a, g_a, x_b, g_b = (np.zeros(m) for _ in range(4))  # the last two iterates
-    k = np.flatnonzero((hi - lo > tol) & (g_hi != 0))
+    k = np.flatnonzero(g_hi != 0)
     for it in range(max_iter):
         if k.size == 0:
             break
@@ -391,18 +392,14 @@ def _find_zero(evaluate, g_lo, g_hi, y_hi, tol, guess, slope, max_iter=60):
         if it == 0:
             x = guess[k]
         else:
-            step_slope = slope[k] if it == 1 else (g_b[k] - g_a[k]) / (x_b[k] - x_a[k])
-            x = x_b[k] - g_b[k] / step_slope
-            falsi = b - g_hi[k] * (b - a) / (g_hi[k] - g_lo[k])
-            if it >= max_iter // 2:
-                falsi = 0.5 * (a + b)
-            x = np.where((x > a + half) & (x < b - half), x, falsi)
+            x = x_b[k] - g_b[k] / (slope[k] if it == 1 else (g_b[k] - g_a[k]) / (x_b[k] - x_a[k]))
+            x = np.where((x > a + half) & (x < b - half), x, 0.5 * (a + b))
         x = np.where(np.isfinite(x), np.clip(x, a + half, b - half), 0.5 * (a + b))
         g, ys = evaluate(x, k)
         x_a[k], g_a[k], x_b[k], g_b[k] = x_b[k], g_b[k], x, g
-        fired = g * sign[k] <= 0
+        fired = (g * sign[k] <= 0) | (np.abs(g) <= np.abs(slope[k]) * tol[k])
         up, down = k[fired], k[~fired]
         hi[up], g_hi[up], y_hi[up] = x[fired], g[fired], ys[fired]
         lo[down], g_lo[down] = x[~fired], g[~fired]
-        k = k[(hi[k] - lo[k] > tol[k]) & (g_hi[k] != 0)]
+        k = k[(hi[k] - lo[k] > tol[k]) & ~(fired & (np.abs(g) <= np.abs(slope[k]) * tol[k]))]
     return lo, hi, y_hi
