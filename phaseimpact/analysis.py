@@ -22,7 +22,7 @@ import numpy as np
 from scipy.special import gamma
 
 from .integrate import Trajectory
-from .model import V1, V2, X1, X2, ContactLaw, as_law, coefficients, rhs, target_spring_force
+from .model import V1, V2, X1, X2, ContactLaw, as_law, coefficients, jacobian, rhs, target_spring_force
 from .parameters import Parameters
 
 __all__ = [
@@ -251,18 +251,6 @@ class EquilibriumSet:
     stability: str
 
 
-def _jacobian(y, c, law, mode, step=None):
-    """Central-difference Jacobian of the 4-d right-hand side (W dropped)."""
-    y = np.asarray(y, dtype=float)
-    J = np.empty((4, 4))
-    for j in range(4):
-        h = step[j] if step is not None else 1e-7 * max(abs(y[j]), 1.0)
-        e = np.zeros(5)
-        e[j] = h
-        J[:, j] = (rhs(y + e, c, law, mode)[:4] - rhs(y - e, c, law, mode)[:4]) / (2 * h)
-    return J
-
-
 def _stability(eigenvalues, rtol=1e-9) -> str:
     scale = max(np.max(np.abs(eigenvalues)), 1e-300)
     real = eigenvalues.real / scale
@@ -277,7 +265,7 @@ def fixed_points(params: Parameters, law: ContactLaw | str = "paper", *,
                  guesses=None, tol: float = 1e-12) -> list:
     """Equilibria of the model: isolated fixed points by Newton, and the sets of equilibria.
 
-    Newton's method runs on the right-hand side with its (central-difference) Jacobian from
+    Newton's method runs on the right-hand side with its exact Jacobian from
     each guess of ``(x1, x2)`` (velocities zero); sets are reported as sets: the separated
     states of a unilateral law (``x2`` at a spring equilibrium, ``delta <= 0``), the stick set
     of ``paper`` (``delta`` arbitrary, frozen), and the translations of a free target.
@@ -295,7 +283,7 @@ def fixed_points(params: Parameters, law: ContactLaw | str = "paper", *,
             y = np.array([x1, x2, 0.0, 0.0, 0.0])
             for _ in range(100):
                 f = rhs(y, c, law, mode)[:4]
-                J = _jacobian(y, c, law, mode, step=[1e-3 * scale] * 2 + [1e-3 * params.v] * 2)
+                J = jacobian(y, c, law, mode)
                 try:
                     dy = np.linalg.lstsq(J, -f, rcond=None)[0]
                 except np.linalg.LinAlgError:
@@ -320,18 +308,18 @@ def _equilibria_at(x2, params, c, law, scale):
     where = "at x2 = 0" if params.target != "free" else "with any x2 (free target)"
     if law.is_filippov:
         y = np.array([x2 + scale, x2, 0.0, 0.0, 0.0])
-        J = _jacobian(y, c, law, 0, step=[1e-3 * scale] * 2 + [1e-3 * params.v] * 2)
+        J = jacobian(y, c, law, 0)
         eig = np.linalg.eigvals(J)
         return [EquilibriumSet(f"stick set: any frozen delta, both at rest, target {where}", members,
                                eig, _stability(eig))]
     if law.is_unilateral:
         y = np.array([x2 - scale, x2, 0.0, 0.0, 0.0])
-        J = _jacobian(y, c, law, 1, step=[1e-3 * scale] * 2 + [1e-3 * params.v] * 2)
+        J = jacobian(y, c, law, 1)
         eig = np.linalg.eigvals(J)
         separated = members[deltas <= 0]
         return [EquilibriumSet(f"separated states: delta <= 0, both at rest, target {where}", separated,
                                eig, _stability(eig))]
     y = np.array([x2, x2, 0.0, 0.0, 0.0])
-    J = _jacobian(y, c, law, 1, step=[1e-3 * scale] * 2 + [1e-3 * params.v] * 2)
+    J = jacobian(y, c, law, 1)
     eig = np.linalg.eigvals(J)
     return [FixedPoint(y[:4].copy(), eig, _stability(eig))]

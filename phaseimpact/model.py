@@ -56,6 +56,7 @@ __all__ = [
     "stick_force",
     "target_spring_force",
     "rhs",
+    "jacobian",
     "energy",
     "initial_state",
     "hunt_crossley_restitution",
@@ -228,6 +229,42 @@ def rhs(y, c: Coefficients, law: ContactLaw, mode=None):
     return np.stack([y[..., V1], y[..., V2], a1, a2, P * deltadot], axis=-1)
 
 
+def jacobian(y, c: Coefficients, law: ContactLaw, mode=None) -> np.ndarray:
+    """Exact Jacobian of the mechanical right-hand side ``(x1, x2, x1dot, x2dot)``, shape (4, 4).
+
+    At ``delta = 0`` the Hertz stiffness ``alpha K |delta|^(alpha-1)`` is exactly zero (for
+    ``alpha > 1``), which a finite difference would blur.
+    """
+    y = np.asarray(y, dtype=float)
+    delta, deltadot = y[X1] - y[X2], y[V1] - y[V2]
+    ad = abs(delta)
+    spring_rate = c.Kb + 3.0 * c.Km * y[X2] ** 2
+    J = np.zeros((4, 4))
+    J[0, 2] = J[1, 3] = 1.0
+    if law.is_filippov and mode == 0:
+        M = c.M1 + c.M2
+        if c.target != "rigid":
+            J[2, 1] = J[3, 1] = -spring_rate / M
+        return J
+    stiffness = c.alpha * ad ** (c.alpha - 1) if ad > 0 else 0.0
+    if law.is_filippov:
+        sign = np.sign(deltadot) if mode is None else mode
+        P_delta = sign * (c.K + c.kappa * deltadot) * stiffness * np.sign(delta)
+        P_rate = sign * c.kappa * ad**c.alpha
+    elif law.bilateral:
+        P_delta, P_rate = c.K * stiffness, 0.0
+    elif delta > 0 and not (law.clamp and contact_force(y, c, law) <= 0):
+        P_delta, P_rate = (c.K + c.kappa * deltadot) * stiffness, c.kappa * ad**c.alpha
+    else:
+        P_delta = P_rate = 0.0
+    dP = np.array([P_delta, -P_delta, P_rate, -P_rate])
+    J[2] = -dP / c.M1
+    if c.target != "rigid":
+        J[3] = dP / c.M2
+        J[3, 1] -= spring_rate / c.M2
+    return J
+
+
 def contact_potential(delta, c: Coefficients, law: ContactLaw):
     """Hertz potential ``K |delta|^(alpha+1) / (alpha+1)`` (only ``delta > 0`` if unilateral), J."""
     d = np.maximum(delta, 0.0) if law.is_unilateral else np.abs(delta)
@@ -255,15 +292,22 @@ def damping_factor(name: str, e: float) -> float:
     return RESTITUTION_LAWS[name](e)
 
 
+#: Taylor coefficients of e(a) at a = 0 (from the implicit equation of REFERENCE §4).
+_RESTITUTION_SERIES = (1.0, -2 / 3, 4 / 9, -44 / 135, 104 / 405, -40 / 189, 7648 / 42525, -2848 / 18225)
+_SERIES_BELOW = 0.02  # the series' truncation error there is ~1e-15; W0's rounding error is ~eps/a^2
+
+
 def hunt_crossley_restitution(a):
     """Exact restitution of Hunt-Crossley contact, ``a = kappa v0 / K`` (REFERENCE §4).
 
-    ``e = (1 + W0(-(1+a) exp(-(1+a)))) / a``; ``e -> 1`` as ``a -> 0``.
+    ``e = (1 + W0(-(1+a) exp(-(1+a)))) / a``. Next to ``a = 0`` the argument of ``W0`` sits on
+    its branch point and rounding costs ``eps/a^2``; there the Taylor series is used instead.
     """
     a = np.asarray(a, dtype=float)
-    safe = np.where(a > 0, a, 1.0)
+    safe = np.where(a >= _SERIES_BELOW, a, 1.0)
     w = lambertw(-(1 + safe) * np.exp(-(1 + safe)), 0).real
-    return np.where(a > 0, (1 + w) / safe, 1.0)
+    series = np.polynomial.polynomial.polyval(a, _RESTITUTION_SERIES)
+    return np.where(a >= _SERIES_BELOW, (1 + w) / safe, series)
 
 
 def kappa_for_restitution(e: float, params: Parameters) -> float:

@@ -62,8 +62,8 @@ def simulate(params: Parameters, law: ContactLaw | str = "paper", t_end: float =
             raise ValueError(f"method = {method!r} is out of range; "
                              f"allowed: one of {', '.join(SCIPY_METHODS)}")
         rtol = options.get("rtol", 1e-10)
-        if not (isinstance(rtol, (int, float)) and 1e-14 <= rtol < 1):
-            raise ValueError(f"rtol = {rtol!r} is out of range; allowed: 1e-14 <= rtol < 1")
+        if not (isinstance(rtol, (int, float)) and 1e-13 <= rtol < 1):
+            raise ValueError(f"rtol = {rtol!r} is out of range; allowed: 1e-13 <= rtol < 1")
         settle = (save.kind == "summary") if stop_when_settled is None else stop_when_settled
         return integrate_exact(params, law, float(t_end), save=save, stop_when_settled=settle, **options)
     if integrator == "rk4":

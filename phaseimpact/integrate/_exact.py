@@ -69,7 +69,7 @@ def _integrate(params, law, t_end, save, stop_when_settled, rtol, atol, method, 
     while t < t_end and status == "success" and not (settled or stopped):
         solver = solver_class(functools.partial(_phase_rhs, c=c, law=law, mode=mode), t, y, t_end,
                               rtol=rtol, atol=atol_vector)
-        g_old = event_values(y, c, law, mode, energy_limit)
+        g_old, y_old = event_values(y, c, law, mode, energy_limit), y.copy()
         for col in {quiet, *np.flatnonzero(g_old == 0)}:
             g_old[col] = departure_sign(col, y, mode) * _TINY
         while True:
@@ -95,7 +95,14 @@ def _integrate(params, law, t_end, save, stop_when_settled, rtol, atol, method, 
                 roots = sorted((_root(dense, col, t_old, t_new, g_old[col], c, law, mode, energy_limit), col)
                                for col in fired)
                 for t_root, col in roots:
-                    change = transition(col, t_root, dense(t_root), mode, c, law, stop_when_settled)
+                    y_root = dense(t_root)
+                    if col == DELTA:
+                        # |delta|^alpha is only C^1 at delta = 0: the step's stages beyond the root
+                        # spoil its interpolant there, so integrate up to the root afresh.
+                        y_root, extra = _integrate_to(solver_class, c, law, mode, t_old, y_old, t_root,
+                                                      rtol, atol_vector)
+                        nfev += extra
+                    change = transition(col, t_root, y_root, mode, c, law, stop_when_settled)
                     if change.restart or change.event.kind in stop_on:
                         if save.kind == "times":
                             _sample_times(recorder, save.times, t_old, t_root, dense, mode)
@@ -120,7 +127,7 @@ def _integrate(params, law, t_end, save, stop_when_settled, rtol, atol, method, 
             recorder.extremes(y_new, mode)
             _samples(recorder, save, solver.dense_output() if save.kind == "times" else None,
                      t_old, t_new, y_new, mode)
-            g_old = g_new
+            g_old, y_old = g_new, y_new.copy()
             if solver.status == "finished":
                 t, y = t_new, y_new.copy()
                 break
@@ -128,6 +135,17 @@ def _integrate(params, law, t_end, save, stop_when_settled, rtol, atol, method, 
     return recorder.finish(params=params, t_end=t_end, t_stop=t, y=y, mode=mode, settled=settled,
                            status=status, message=message, nfev=nfev, nsteps=nsteps,
                            integrator=f"exact[{method}, rtol={rtol:g}]")
+
+
+def _integrate_to(solver_class, c, law, mode, t0, y0, t1, rtol, atol):
+    """State at ``t1`` integrated from ``(t0, y0)`` with the phase's right-hand side."""
+    if t1 <= t0:
+        return np.array(y0, dtype=float), 0
+    solver = solver_class(functools.partial(_phase_rhs, c=c, law=law, mode=mode), t0, y0, t1,
+                          rtol=rtol, atol=atol)
+    while solver.status == "running":
+        solver.step()
+    return (solver.y.copy() if solver.status == "finished" else np.array(y0, dtype=float)), solver.nfev
 
 
 def _phase_rhs(_t, y, c, law, mode):
