@@ -67,8 +67,17 @@ class PointResult:
 
 def evaluate_point(params: Parameters, law: ContactLaw, t_end: float, *, rtol: float = 1e-10,
                    min_dwell: float | None = None) -> PointResult:
-    """Integrate one point (exact, summary only, stopping once settled) and summarise it."""
-    trajectory = simulate(params, law, t_end, rtol=rtol)
+    """Integrate one point (exact, summary only, stopping once settled) and summarise it.
+
+    Numerical trouble is a status of the point (``runaway``, ``step-size-collapse``...), and an
+    unexpected error in one point is recorded as status ``error`` with outcome ``failed``, so
+    a long sweep always carries on.
+    """
+    try:
+        trajectory = simulate(params, law, t_end, rtol=rtol)
+    except (ArithmeticError, RuntimeError, ValueError) as error:
+        return PointResult(params.kappa, 0, np.empty((0, 2)), np.empty(0), "failed", "error",
+                           f"{type(error).__name__}: {error}", np.nan, np.nan, None, np.nan)
     points = find_asymptotic_points(trajectory, min_dwell=min_dwell)
     outcome = classify_outcome(trajectory, points)
     q = impact_quantities(trajectory)

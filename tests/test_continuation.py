@@ -171,3 +171,23 @@ def test_fixed_points_are_sets_where_they_should_be():
     omega = math.sqrt(p.Kb / p.M2)
     assert np.any(np.isclose(np.abs(origin.eigenvalues.imag), omega, rtol=1e-4))
     assert origin.stability == "neutral"
+
+
+def test_phase_portrait_family_from_states_and_speeds():
+    """A family from given states (a grid in the relative plane) and from impact speeds, in one
+    call; every member starts where asked and carries its events."""
+    from phaseimpact.analysis import plane_coordinates
+    from phaseimpact.continuation import phase_portrait
+
+    p = seed_parameters(kappa=1e9)
+    states = [(d, 0.0, v, 0.0) for d in (0.0, 1e-5) for v in (0.5, 1.0)]
+    family = phase_portrait(p, PAPER, states=states, t_end=0.001, n_jobs=2)
+    assert len(family) == 4
+    for state, tr in zip(states, family, strict=True):
+        assert np.array_equal(tr.y[0, :4], state)
+        delta, deltadot = plane_coordinates(tr.y, ("delta", "deltadot"))
+        assert delta[0] == state[0] and deltadot[0] == state[2]
+        assert tr.events_of("stick")  # each one sticks in the relative plane
+    by_speed = phase_portrait(p, PAPER, speeds=[0.5, 1.0, 2.0], t_end=0.001)
+    first_stick = [tr.events_of("stick")[0].delta for tr in by_speed]
+    assert first_stick == sorted(first_stick)  # faster impacts stick deeper

@@ -59,6 +59,8 @@ def _integrate(params, law, t_end, save, stop_when_settled, rtol, atol, method, 
     mode, t = initial_mode(law, y, c), 0.0
     if y[0] == y[1] and y[2] > y[3]:
         recorder.event(Event("contact", 0.0, y.copy(), float(contact_force(y, c, law, mode)), mode))
+    elif save.kind == "steps":
+        recorder.sample(0.0, y, mode)
     if save.kind == "times":
         _sample_times(recorder, save.times, -np.inf, 0.0, lambda s: y, mode)
 
