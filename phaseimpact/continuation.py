@@ -24,7 +24,7 @@ from scipy.optimize import brentq
 from tqdm.auto import tqdm
 
 from .analysis import classify_outcome, find_asymptotic_points
-from .integrate import simulate
+from .integrate import simulate, simulate_batch
 from .integrate._events import stick_margin
 from .model import ContactLaw, as_law, coefficients
 from .parameters import Parameters
@@ -45,7 +45,7 @@ __all__ = [
 ]
 
 BACKENDS = ("loky", "dask")
-CHUNK = 16  # points per task; fixed so that chunking never depends on n_jobs
+CHUNK = 32  # points per task, advanced as one batch; fixed, whatever n_jobs
 
 
 @dataclass(frozen=True)
@@ -76,22 +76,40 @@ def evaluate_point(params: Parameters, law: ContactLaw, t_end: float, *, rtol: f
     try:
         trajectory = simulate(params, law, t_end, rtol=rtol)
     except (ArithmeticError, RuntimeError, ValueError) as error:
-        return PointResult(params.kappa, 0, np.empty((0, 2)), np.empty(0), "failed", "error",
-                           f"{type(error).__name__}: {error}", np.nan, np.nan, None, np.nan)
+        return _failed_point(params.kappa, error)
+    return summarise_point(trajectory, min_dwell)
+
+
+def summarise_point(trajectory, min_dwell: float | None = None) -> PointResult:
+    """What a sweep keeps of one trajectory."""
     points = find_asymptotic_points(trajectory, min_dwell=min_dwell)
     outcome = classify_outcome(trajectory, points)
     q = impact_quantities(trajectory)
     return PointResult(
-        kappa=params.kappa, n_asymptotic=len(points), points=points.points, dwell=points.dwell,
+        kappa=trajectory.params.kappa, n_asymptotic=len(points), points=points.points, dwell=points.dwell,
         outcome=outcome.kind, status=trajectory.status, message=trajectory.message,
         max_force=q.max_force, max_indentation=q.max_indentation, restitution=q.restitution,
         dissipated_energy=q.dissipated_energy,
     )
 
 
+def _failed_point(kappa, error) -> PointResult:
+    return PointResult(kappa, 0, np.empty((0, 2)), np.empty(0), "failed", "error",
+                       f"{type(error).__name__}: {error}", np.nan, np.nan, None, np.nan)
+
+
 def _evaluate_chunk(params, law, kappas, t_end, rtol, min_dwell):
-    return [evaluate_point(params.replace(kappa=float(k)), law, t_end, rtol=rtol, min_dwell=min_dwell)
-            for k in kappas]
+    """One task of a sweep: the chunk's points advanced together by :func:`simulate_batch`.
+
+    A member's result does not depend on the batch it runs in, so chunking (and therefore
+    ``n_jobs``) cannot change any number.
+    """
+    members = [params.replace(kappa=float(k)) for k in kappas]
+    try:
+        trajectories = simulate_batch(members, law, t_end, rtol=rtol)
+    except (ArithmeticError, RuntimeError, ValueError):
+        return [evaluate_point(p, law, t_end, rtol=rtol, min_dwell=min_dwell) for p in members]
+    return [summarise_point(tr, min_dwell) for tr in trajectories]
 
 
 @dataclass
@@ -217,7 +235,8 @@ def sweep(params: Parameters, law: ContactLaw | str, kappas, *, t_end: float = 0
     """
     law = as_law(law)
     kappas = _check_kappas(kappas)
-    settings = {"rtol": rtol, "min_dwell": -1.0 if min_dwell is None else min_dwell, "integrator": "exact"}
+    settings = {"rtol": rtol, "min_dwell": -1.0 if min_dwell is None else min_dwell,
+                "integrator": "batch[DOP853]"}
     if previous is not None:
         if previous.kappa.shape != kappas.shape or not np.array_equal(previous.kappa, kappas):
             raise ValueError("resume: the archive's kappa values differ from the requested sweep")

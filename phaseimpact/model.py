@@ -275,7 +275,8 @@ def energy(y, c: Coefficients, law: ContactLaw):
     """Mechanical energy (REFERENCE §4): kinetic + target springs + Hertz potential, J."""
     x2 = y[..., X2]
     kinetic = 0.5 * c.M1 * y[..., V1] ** 2 + 0.5 * c.M2 * y[..., V2] ** 2
-    springs = 0.5 * c.Kb * x2**2 + 0.25 * c.Km * x2**4
+    x2sq = x2 * x2  # products, not pow: elementwise results must not depend on the array shape
+    springs = (0.5 * c.Kb + 0.25 * c.Km * x2sq) * x2sq
     return kinetic + springs + contact_potential(y[..., X1] - x2, c, law)
 
 

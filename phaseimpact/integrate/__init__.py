@@ -1,11 +1,11 @@
 """Trajectory generators: one entry point, :func:`simulate`, over swappable integrators.
 
-========== ==============================================================================
-``exact``  event-driven; scipy's ``DOP853`` (or ``method=``) between events; stick and slip
-           of ``paper`` resolved exactly
-``rk4``    the seed's classic fixed-step RK4 on the plain right-hand side (``step=``)
-``batch``  many parameter sets at once (see :func:`simulate_batch`), summary outputs only
-========== ==============================================================================
+==================  ======================================================================
+``exact``           event-driven; scipy's ``DOP853`` (or ``method=``) between events; stick and slip
+                    of ``paper`` resolved exactly
+``rk4``             the seed's classic fixed-step RK4 on the plain right-hand side (``step=``)
+``simulate_batch``  many parameter sets at once (vectorised DOP853, same events), summary only
+==================  ======================================================================
 """
 
 from __future__ import annotations

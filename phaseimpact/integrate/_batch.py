@@ -14,8 +14,9 @@ of the step control are taken with square roots, which are correctly rounded.
 
 Event zeros are located on the step itself: a first estimate of the crossing time from cubic
 Hermite interpolation of the step, refined by re-taking the Runge-Kutta step from its start with
-shortened sizes (Illinois iteration on the step fraction) until the bracket is a few ulps of
-``t`` wide; the state at the zero is thus an 8th-order step, not an interpolant.
+shortened sizes (a secant iteration on the step fraction, safeguarded by a bracket) until the
+bracket is a few ulps of ``t`` wide or the event function is down to rounding noise; the state
+at the zero is thus an 8th-order step, not an interpolant.
 """
 
 from __future__ import annotations
@@ -37,7 +38,16 @@ from ..model import (
     stack_coefficients,
 )
 from ..parameters import Parameters
-from ._events import DELTA, RUNAWAY_ENERGY_FACTOR, Event, crossed, event_values, initial_mode, transition
+from ._events import (
+    DELTA,
+    RUNAWAY_ENERGY_FACTOR,
+    Event,
+    crossed,
+    departure_sign,
+    event_values,
+    initial_mode,
+    transition,
+)
 from ._trajectory import Recorder, Save, Trajectory, state_scale
 
 __all__ = ["simulate_batch"]
@@ -46,6 +56,7 @@ SAFETY = 0.9  # as scipy's RungeKutta
 MIN_FACTOR = 0.2
 MAX_FACTOR = 10.0
 _EPS = np.finfo(float).eps
+_TINY = np.finfo(float).tiny
 _N_STAGES = scipy.integrate.DOP853.n_stages
 _STAGE_EVALS = _N_STAGES  # n_stages - 1 inner stages and f at the new point
 
@@ -186,7 +197,8 @@ def _initial_step(t, y, f, t_end, c, law, mode, rtol, atol):
 class _Active:
     """Arrays of the members still running; row ``r`` belongs to member ``ids[r]``."""
 
-    _ROWS = ("ids", "t", "y", "f", "mode", "g_old", "h_abs", "rejected", "atol", "energy_limit")
+    _ROWS = ("ids", "t", "y", "f", "mode", "g_old", "h_abs", "rejected", "overflowed", "atol",
+             "energy_limit")
 
     def __init__(self, **arrays):
         self.__dict__.update(arrays)
@@ -211,6 +223,7 @@ def _integrate(params_list, law, t_end, rtol, atol, settle, max_steps, max_event
     step_rtol = max(rtol, 100 * _EPS)  # scipy raises smaller ones to this
     b = _Active(ids=np.arange(n), t=np.zeros(n), y=y0, f=np.empty((n, 5)), mode=modes,
                 g_old=np.empty((n, 6)), h_abs=np.empty(n), rejected=np.zeros(n, dtype=bool),
+                overflowed=np.zeros(n, dtype=bool),
                 atol=np.array([(rtol if atol is None else atol) * state_scale(p, ci)
                                for p, ci in zip(params_list, cs, strict=True)]),
                 energy_limit=RUNAWAY_ENERGY_FACTOR * energy(y0, c, law), c=c)
@@ -224,7 +237,11 @@ def _integrate(params_list, law, t_end, rtol, atol, settle, max_steps, max_event
         cr, y, mode = _take(b.c, rows), b.y[rows], b.mode[rows]
         b.f[rows] = f = rhs(y, cr, law, mode)
         g = event_values(y, cr, law, mode, b.energy_limit[rows], f=f)
-        g[np.arange(len(rows)), quiet] = 0.0  # the run starts on this zero: do not fire on it
+        # The run starts on this zero (and maybe others): give them the sign they depart with,
+        # so that only a return to zero fires, as in the exact integrator.
+        for j, q in enumerate(quiet):
+            for col in {q, *np.flatnonzero(g[j] == 0)}:
+                g[j, col] = departure_sign(col, y[j], mode[j]) * _TINY
         b.g_old[rows] = g
         b.h_abs[rows] = _initial_step(b.t[rows], y, f, t_end, cr, law, mode, step_rtol, b.atol[rows])
         b.rejected[rows] = False
@@ -253,8 +270,10 @@ def _integrate(params_list, law, t_end, rtol, atol, settle, max_steps, max_event
         nfev[b.ids] += _STAGE_EVALS
         error = _error_norm(K, h, b.atol + np.maximum(np.abs(b.y), np.abs(y_new)) * step_rtol)
         # Unlike scipy, never accept a non-finite state: an overflow makes the scale infinite and
-        # can zero the error estimate, while a shorter step would meet the runaway event.
-        accepted = (error < 1) & ~collapsed & np.isfinite(y_new).all(axis=1)
+        # can zero the error estimate, while a shorter step would meet the runaway event. A state
+        # that is non-finite down to the shortest step ends the member as "non-finite".
+        finite = np.isfinite(y_new).all(axis=1)
+        accepted = (error < 1) & ~collapsed & finite
         shrink = SAFETY / _root8(error)  # SAFETY * error ** (-1/8); nan -> MIN_FACTOR below
         grow = np.where(error == 0, MAX_FACTOR, np.minimum(MAX_FACTOR, shrink))
         grow = np.where(b.rejected, np.minimum(1.0, grow), grow)
@@ -262,14 +281,14 @@ def _integrate(params_list, law, t_end, rtol, atol, settle, max_steps, max_event
         b.rejected = ~accepted
         nsteps[b.ids[accepted | collapsed]] += 1
         for r in np.flatnonzero(collapsed):
-            finish(r, "step-size-collapse",
-                   f"t = {b.t[r]:.6g} s: Required step size is less than spacing between numbers.")
+            if b.overflowed[r]:  # the last trial step, of the shortest size, was not finite
+                finish(r, "non-finite", f"the state became non-finite at t = {b.t[r]:.6g} s")
+            else:
+                finish(r, "step-size-collapse",
+                       f"t = {b.t[r]:.6g} s: Required step size is less than spacing between numbers.")
+        b.overflowed = ~finite
 
         rows = np.flatnonzero(accepted)
-        finite = np.isfinite(y_new[rows]).all(axis=1)
-        for r in rows[~finite]:
-            finish(r, "non-finite", f"the state became non-finite at t = {t_new[r]:.6g} s")
-        rows = rows[finite]
         over = (nsteps[b.ids[rows]] >= max_steps) | (n_events[b.ids[rows]] >= max_events)
         for r in rows[over]:
             i = b.ids[r]
@@ -345,7 +364,7 @@ def _locate(t, y, f, h, t_new, y_new, f_new, g_old, g_new, cols, c, law, mode, e
         s, hk, d = x[:, None], h[k][:, None], y_new[k] - y[k]
         ys = y[k] + s * (hk * f[k] + s * ((3 * d - hk * (2 * f[k] + f_new[k]))
                                           + s * (hk * (f[k] + f_new[k]) - 2 * d)))
-        evals[k] += 1
+        np.add.at(evals, k, 1)
         g = event_values(ys, _take(c, k), law, mode[k], energy_limit[k])
         return g[np.arange(len(k)), cols[k]], ys
 
@@ -357,33 +376,52 @@ def _locate(t, y, f, h, t_new, y_new, f_new, g_old, g_new, cols, c, law, mode, e
         return g[np.arange(len(k)), cols[k]], ys
 
     every = np.arange(m)
-    _, guess, _ = _find_zero(on_interpolant, g_old, g_new, y_new, np.full(m, 1e-10),
-                             g_old / (g_old - g_new), g_new - g_old)
-    d = 1e-6  # central difference of the interpolant: its slope is a good Newton slope for the step
+    lo, hi, g_lo, g_hi = np.zeros(m), np.ones(m), g_old.copy(), g_new.copy()
+    # A run restarted on this zero (g_old a signed tiny number) may leave it and come back within
+    # the step, as in a grazing contact: bracket the return from a sample where g has left zero.
+    back = np.flatnonzero(np.sign(on_interpolant(lo, every)[0]) != np.sign(g_old))
+    grid = np.linspace(0, 1, 33)[1:]
+    signs = np.sign(on_interpolant(np.tile(grid, back.size), np.repeat(back, grid.size))[0])
+    away = signs.reshape(back.size, grid.size) == np.sign(g_old[back])[:, None]
+    first = np.argmax(away, axis=1)
+    returned = np.argmax(~away & (np.arange(grid.size) > first[:, None]), axis=1)  # > first: found
+    lo[back] = np.where(returned > first, grid[returned - 1], grid[first])
+    hi[back] = np.where(returned > first, grid[returned], 1.0)
+    g_lo[back], g_hi[back] = on_interpolant(lo[back], back)[0], on_interpolant(hi[back], back)[0]
+    stays = back[~away.any(axis=1)]  # the excursion is below what the step resolves: zero at 0
+    g_hi[stays] = 0.0
+
+    _, guess, _ = _find_zero(on_interpolant, lo, hi, g_lo, g_hi, y_new, np.full(m, 1e-10),
+                             lo + g_lo / (g_lo - g_hi) * (hi - lo), (g_hi - g_lo) / (hi - lo))
+    d = 1e-6  # the interpolant's slope is a good Newton slope for the step
     slope = (on_interpolant(guess + d, every)[0] - on_interpolant(guess - d, every)[0]) / (2 * d)
     tol = 4 * _EPS * np.maximum(np.abs(t_new) / np.abs(h), 1.0)
-    _, x, y_root = _find_zero(on_step, g_old, g_new, y_new, tol, guess, slope)
+    _, x, y_root = _find_zero(on_step, lo, hi, g_lo, g_hi, y_new, tol, guess, slope)
+    x[stays], y_root[stays] = 0.0, y[stays]
     return np.where(x == 1, t_new, t + x * h), y_root, evals
 
 
-def _find_zero(evaluate, g_lo, g_hi, y_hi, tol, guess, slope, max_iter=60):
-    """Zeros of ``evaluate(x, k) -> (g, y)`` for ``x`` in ``[0, 1]``, vectorised over pairs ``k``.
+def _find_zero(evaluate, lo, hi, g_lo, g_hi, y_hi, tol, guess, slope, max_iter=60):
+    """Zeros of ``evaluate(x, k) -> (g, y)`` in brackets ``[lo, hi]``, vectorised over pairs ``k``.
 
-    Secant iteration safeguarded by the bracket ``[lo, hi]``, where ``g(0) = g_lo`` and
-    ``g(1) = g_hi`` have opposite signs and ``hi`` stays on the side where the event has fired.
-    It starts at ``guess``, takes a Newton step with ``slope``, then secant steps on the last
-    two iterates, and bisects when a step leaves the bracket. Trial points stay ``tol / 2``
-    inside the bracket, so it closes to ``tol`` even when the iterates approach the zero from
-    one side. An iterate with ``|g| <= |slope| tol`` is within ``tol`` of the zero and ends the
-    search too: near the zero ``g`` may be rounding noise whose sign means nothing.
+    ``g_lo`` and ``g_hi`` have opposite signs (``hi`` stays on the side where the event has
+    fired; ``g_hi = 0`` means ``hi`` is the zero). ``y_hi`` is the ``y`` at ``hi = 1``.
+    Secant iteration safeguarded by the bracket: it starts at ``guess``, takes a Newton step
+    with ``slope``, then secant steps on the last two iterates, and bisects when a step leaves
+    the bracket. Trial points stay ``tol / 2`` inside the bracket, so it closes to ``tol`` even
+    when the iterates approach the zero from one side. It also ends when ``g`` is within
+    rounding: ``|g| <= |slope| tol``, or the smallest ``|g|`` has not halved in two iterations
+    while ``hi`` is that close to zero too (rounding noise, whose sign means nothing, has been
+    reached from both sides).
 
-    Returns ``lo``, the zero ``x`` (``hi`` or such an iterate) and the ``y`` evaluated there.
+    Returns ``lo``, ``hi`` and the ``y`` evaluated at ``hi``.
     """
     m = len(g_lo)
-    lo, hi = np.zeros(m), np.ones(m)
-    g_lo, g_hi, y_hi = np.array(g_lo, dtype=float), np.array(g_hi, dtype=float), y_hi.copy()
+    lo, hi, g_hi, y_hi = lo.copy(), hi.copy(), np.array(g_hi, dtype=float), y_hi.copy()
+    known = hi == 1  # where y_hi is the y at hi
     sign = np.sign(g_lo)
     x_a, g_a, x_b, g_b = (np.zeros(m) for _ in range(4))  # the last two iterates
+    smallest, stale = np.full(m, np.inf), np.zeros(m, dtype=int)
     k = np.flatnonzero(g_hi != 0)
     for it in range(max_iter):
         if k.size == 0:
@@ -397,9 +435,16 @@ def _find_zero(evaluate, g_lo, g_hi, y_hi, tol, guess, slope, max_iter=60):
         x = np.where(np.isfinite(x), np.clip(x, a + half, b - half), 0.5 * (a + b))
         g, ys = evaluate(x, k)
         x_a[k], g_a[k], x_b[k], g_b[k] = x_b[k], g_b[k], x, g
-        fired = (g * sign[k] <= 0) | (np.abs(g) <= np.abs(slope[k]) * tol[k])
+        zero = np.abs(g) <= np.abs(slope[k]) * tol[k]
+        fired = (g * sign[k] <= 0) | zero
         up, down = k[fired], k[~fired]
-        hi[up], g_hi[up], y_hi[up] = x[fired], g[fired], ys[fired]
-        lo[down], g_lo[down] = x[~fired], g[~fired]
-        k = k[(hi[k] - lo[k] > tol[k]) & ~(fired & (np.abs(g) <= np.abs(slope[k]) * tol[k]))]
+        hi[up], g_hi[up], y_hi[up], known[up] = x[fired], g[fired], ys[fired], True
+        lo[down] = x[~fired]
+        stale[k] = np.where(np.abs(g) <= 0.5 * smallest[k], 0, stale[k] + 1)
+        smallest[k] = np.minimum(smallest[k], np.abs(g))
+        noise = (stale[k] >= 2) & (np.abs(g_hi[k]) <= 4 * smallest[k])
+        k = k[(hi[k] - lo[k] > tol[k]) & ~zero & ~noise]
+    k = np.flatnonzero(~known)
+    if k.size:
+        y_hi[k] = evaluate(hi[k], k)[1]
     return lo, hi, y_hi

@@ -18,6 +18,8 @@ from ..model import ContactLaw, coefficients, contact_force, energy, initial_sta
 from ..parameters import Parameters
 from ._events import (
     DELTA,
+    DELTADOT,
+    FORCE_RATE,
     RUNAWAY_ENERGY_FACTOR,
     Event,
     crossed,
@@ -71,22 +73,22 @@ def _integrate(params, law, t_end, save, stop_when_settled, rtol, atol, method, 
     while t < t_end and status == "success" and not (settled or stopped):
         solver = solver_class(functools.partial(_phase_rhs, c=c, law=law, mode=mode), t, y, t_end,
                               rtol=rtol, atol=atol_vector)
-        g_old, y_old = event_values(y, c, law, mode, energy_limit), y.copy()
+        g_old, y_old, t_accepted = event_values(y, c, law, mode, energy_limit), y.copy(), t
         for col in {quiet, *np.flatnonzero(g_old == 0)}:
             g_old[col] = departure_sign(col, y, mode) * _TINY
         while True:
             step_message = solver.step()
             nsteps += 1
+            failure = None
             if solver.status == "failed":
-                status, message = "step-size-collapse", f"t = {solver.t:.6g} s: {step_message}"
-                break
-            if not np.all(np.isfinite(solver.y)):
-                status, message = "non-finite", f"the state became non-finite at t = {solver.t:.6g} s"
-                break
-            if nsteps >= max_steps or len(recorder.events) >= max_events:
-                status = "too-many-steps"
-                message = (f"stopped at t = {solver.t:.6g} s after {nsteps} steps and "
-                           f"{len(recorder.events)} events (limits {max_steps}, {max_events})")
+                failure = "step-size-collapse", f"t = {solver.t:.6g} s: {step_message}"
+            elif not np.all(np.isfinite(solver.y)):
+                failure = "non-finite", f"the state became non-finite at t = {solver.t:.6g} s"
+            elif nsteps >= max_steps or len(recorder.events) >= max_events:
+                failure = "too-many-steps", (f"stopped at t = {solver.t:.6g} s after {nsteps} steps and "
+                                             f"{len(recorder.events)} events (limits {max_steps}, {max_events})")
+            if failure is not None:
+                (status, message), t, y = failure, t_accepted, y_old.copy()  # the last good state
                 break
             t_old, t_new, y_new = solver.t_old, solver.t, solver.y
             g_new = event_values(y_new, c, law, mode, energy_limit)
@@ -98,9 +100,10 @@ def _integrate(params, law, t_end, save, stop_when_settled, rtol, atol, method, 
                                for col in fired)
                 for t_root, col in roots:
                     y_root = dense(t_root)
-                    if col == DELTA:
-                        # |delta|^alpha is only C^1 at delta = 0: the step's stages beyond the root
-                        # spoil its interpolant there, so integrate up to the root afresh.
+                    if col != FORCE_RATE and (col != DELTADOT or law.is_filippov):
+                        # The run restarts here: take the state from a fresh integration up to the
+                        # root, not the interpolant (|delta|^alpha is only C^1 at delta = 0, and the
+                        # step's stages beyond the root spoil the interpolant there).
                         y_root, extra = _integrate_to(solver_class, c, law, mode, t_old, y_old, t_root,
                                                       rtol, atol_vector)
                         nfev += extra
@@ -129,7 +132,7 @@ def _integrate(params, law, t_end, save, stop_when_settled, rtol, atol, method, 
             recorder.extremes(y_new, mode)
             _samples(recorder, save, solver.dense_output() if save.kind == "times" else None,
                      t_old, t_new, y_new, mode)
-            g_old, y_old = g_new, y_new.copy()
+            g_old, y_old, t_accepted = g_new, y_new.copy(), t_new
             if solver.status == "finished":
                 t, y = t_new, y_new.copy()
                 break
