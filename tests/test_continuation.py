@@ -191,3 +191,14 @@ def test_phase_portrait_family_from_states_and_speeds():
     by_speed = phase_portrait(p, PAPER, speeds=[0.5, 1.0, 2.0], t_end=0.001)
     first_stick = [tr.events_of("stick")[0].delta for tr in by_speed]
     assert first_stick == sorted(first_stick)  # faster impacts stick deeper
+
+
+def test_count_up_to_two_equals_the_full_count():
+    """The early-stopping count (stop at the second stick once it has lasted min_dwell) agrees with
+    the full run's count, capped at two, on both sides of kappa_c and far from it."""
+    from phaseimpact.continuation import count_up_to
+
+    p = seed_parameters()
+    for kappa in [1e9, 1e11, 1.4994e12, 1.49943e12, 1.5e12, 3e12, 1e13]:
+        full = evaluate_point(p.replace(kappa=kappa), PAPER, 0.01).n_asymptotic
+        assert count_up_to(p.replace(kappa=kappa), PAPER, 0.01, 2) == min(full, 2), kappa

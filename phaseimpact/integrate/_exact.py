@@ -44,7 +44,7 @@ def integrate_exact(params: Parameters, law: ContactLaw, t_end: float, *, save: 
     # the finiteness check ends the run with a status, so the warnings carry no information.
     with np.errstate(over="ignore", invalid="ignore"):
         return _integrate(params, law, t_end, save, stop_when_settled, rtol, atol, method,
-                          max_steps, max_events, initial, frozenset(stop_on))
+                          max_steps, max_events, initial, _stop_counts(stop_on))
 
 
 def _integrate(params, law, t_end, save, stop_when_settled, rtol, atol, method, max_steps,
@@ -108,15 +108,17 @@ def _integrate(params, law, t_end, save, stop_when_settled, rtol, atol, method, 
                                                       rtol, atol_vector)
                         nfev += extra
                     change = transition(col, t_root, y_root, mode, c, law, stop_when_settled)
-                    if change.restart or change.event.kind in stop_on:
+                    kind = change.event.kind
+                    stop_here = kind in stop_on and len(recorder.events_of(kind)) + 1 >= stop_on[kind]
+                    if change.restart or stop_here:
                         if save.kind == "times":
                             _sample_times(recorder, save.times, t_old, t_root, dense, mode)
                         recorder.event(change.event)
-                        restart = (t_root, change, col)
+                        restart = (t_root, change, col, stop_here)
                         break
                     recorder.event(change.event)
             if restart is not None:
-                t, change, quiet = restart
+                t, change, quiet, stop_here = restart
                 y, mode = change.state, change.mode
                 if change.stop == "runaway":
                     status = "runaway"
@@ -125,9 +127,10 @@ def _integrate(params, law, t_end, save, stop_when_settled, rtol, atol, method, 
                 elif change.stop == "settled":
                     settled = True
                     message = f"outcome settled at t = {t:.6g} s ({change.event.kind})"
-                elif change.event.kind in stop_on:
+                elif stop_here:
                     stopped = True
-                    message = f"stopped at the first {change.event.kind} event, t = {t:.6g} s, as asked"
+                    kind = change.event.kind
+                    message = f"stopped at {kind} event {stop_on[kind]}, t = {t:.6g} s, as asked"
                 break
             recorder.extremes(y_new, mode)
             _samples(recorder, save, solver.dense_output() if save.kind == "times" else None,
@@ -140,6 +143,15 @@ def _integrate(params, law, t_end, save, stop_when_settled, rtol, atol, method, 
     return recorder.finish(params=params, t_end=t_end, t_stop=t, y=y, mode=mode, settled=settled,
                            status=status, message=message, nfev=nfev, nsteps=nsteps,
                            integrator=f"exact[{method}, rtol={rtol:g}]")
+
+
+def _stop_counts(stop_on) -> dict:
+    """``stop_on`` as ``{kind: n}``: stop at the n-th event of that kind (a bare kind means n = 1)."""
+    counts = dict(stop_on) if isinstance(stop_on, dict) else {kind: 1 for kind in stop_on}
+    for kind, n in counts.items():
+        if not (isinstance(n, int) and n >= 1):
+            raise ValueError(f"stop_on[{kind!r}] = {n!r} is out of range; allowed: an integer >= 1")
+    return counts
 
 
 def _integrate_to(solver_class, c, law, mode, t0, y0, t1, rtol, atol):

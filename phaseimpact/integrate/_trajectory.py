@@ -160,6 +160,9 @@ class Recorder:
         self.y.append(np.array(y, dtype=float))
         self.mode.append(mode)
 
+    def events_of(self, kind: str) -> list:
+        return [e for e in self.events if e.kind == kind]
+
     def event(self, event: Event) -> None:
         self.events.append(event)
         self.extremes(event.state, event.mode)
