@@ -1,8 +1,8 @@
 """Trajectory generators: one entry point, :func:`simulate`, over swappable integrators.
 
 ==================  ======================================================================
-``exact``           event-driven; scipy's ``DOP853`` (or ``method=``) between events; stick and slip
-                    of ``paper`` resolved exactly
+``exact``           event-driven; scipy's ``DOP853`` between events (LSODA for stiff damping, or
+                    ``method=``); stick and slip of ``paper`` resolved exactly
 ``rk4``             the seed's classic fixed-step RK4 on the plain right-hand side (``step=``)
 ``simulate_batch``  many parameter sets at once (vectorised DOP853, same events), summary only
 ==================  ======================================================================
@@ -57,10 +57,10 @@ def simulate(params: Parameters, law: ContactLaw | str = "paper", t_end: float =
         raise ValueError(f"t_end = {t_end!r} is out of range; allowed: a finite number > 0")
     save = Save.parse(save)
     if integrator == "exact":
-        method = options.get("method", "DOP853")
-        if method not in SCIPY_METHODS:
+        method = options.get("method", "auto")
+        if method not in ("auto", *SCIPY_METHODS):
             raise ValueError(f"method = {method!r} is out of range; "
-                             f"allowed: one of {', '.join(SCIPY_METHODS)}")
+                             f"allowed: auto or one of {', '.join(SCIPY_METHODS)}")
         rtol = options.get("rtol", 1e-10)
         if not (isinstance(rtol, (int, float)) and 1e-13 <= rtol < 1):
             raise ValueError(f"rtol = {rtol!r} is out of range; allowed: 1e-13 <= rtol < 1")
