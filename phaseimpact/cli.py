@@ -165,28 +165,27 @@ def cmd_critical_curve(args) -> None:
         print(f"wrote {args.out}")
 
 
-def _positive(name):
+def _number(name, *, positive=True):
+    """argparse type: a finite number > 0 (or >= 0), the error naming ``name`` and the range."""
+    allowed = "a finite number > 0" if positive else "a finite number >= 0"
+
     def parse(text):
         try:
             value = float(text)
         except ValueError:
-            value = text
-        if not (isinstance(value, float) and math.isfinite(value) and value > 0):
-            raise argparse.ArgumentTypeError(f"{name} = {text!r} is out of range; allowed: a finite number > 0")
+            value = math.nan
+        if not (math.isfinite(value) and (value > 0 if positive else value >= 0)):
+            raise argparse.ArgumentTypeError(f"{name} = {text!r} is out of range; allowed: {allowed}")
         return value
     return parse
+
+
+def _positive(name):
+    return _number(name)
 
 
 def _nonnegative(name):
-    def parse(text):
-        try:
-            value = float(text)
-        except ValueError:
-            value = text
-        if not (isinstance(value, float) and math.isfinite(value) and value >= 0):
-            raise argparse.ArgumentTypeError(f"{name} = {text!r} is out of range; allowed: a finite number >= 0")
-        return value
-    return parse
+    return _number(name, positive=False)
 
 
 def _count(name, low=1):
