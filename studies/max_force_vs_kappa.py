@@ -1,0 +1,81 @@
+"""Maximum impact force and restitution against the damping, for each reading of the model.
+
+Claims checked: seed conclusion 6 (excessive damping raises the maximum impact force; an optimum
+damping minimises it) and how well each restitution-based damping law delivers the coefficient of
+restitution it is built from. Left: max force against kappa for eq. 8 as printed ("paper") and
+Hunt-Crossley on the seed's plate at 1 m/s; the minimum of each curve is the optimum damping.
+Middle: restitution of Hunt-Crossley against kappa on the free target, with the exact Lambert-W
+formula (REFERENCE §4). Right: restitution measured on the free target against the e requested,
+for the Hunt-Crossley approximation, Lankarani-Nikravesh, Flores, Gonthier and the exact inverse.
+"""
+
+from pathlib import Path
+
+import numpy as np
+
+from phaseimpact import ContactLaw, seed_parameters, simulate
+from phaseimpact.continuation import sweep
+from phaseimpact.model import hunt_crossley_restitution
+from phaseimpact.plotting import figure, save, save_h5, style
+from phaseimpact.quantities import impact_quantities
+
+FIGURES = Path(__file__).resolve().parents[1] / "figures"
+NAME = "max_force_vs_kappa"
+RESTITUTION_LAWS = ("hunt-crossley-approx", "lankarani-nikravesh", "flores", "gonthier", "hunt-crossley")
+
+
+def main(quick=False, jobs=1):
+    p = seed_parameters(v=1.0)
+    kappas = np.geomspace(1e8, 1e13, 25 if quick else 80)
+    data = {"kappa": (kappas, "N s/m^2.5")}
+    with style():
+        fig, axes = figure(1, 3, width=11, height=3.4)
+        ax = axes[0, 0]
+        for law, color in (("paper", "C0"), ("hunt-crossley", "C1")):
+            result = sweep(p, law, kappas, n_jobs=jobs)
+            # A runaway's largest force is wherever the run was stopped: not an impact force.
+            force = np.where(result.outcome == "runaway", np.nan, result.max_force)
+            best = int(np.nanargmin(force))
+            ax.loglog(kappas, force, color=color, label=f"{law}: min at κ = {kappas[best]:.3g}")
+            ax.plot(kappas[best], result.max_force[best], "o", color=color, mfc="none")
+            data[f"{law}/max_force"] = (result.max_force, "N")
+        ax.set_xlabel("damping κ (N s/m$^{2.5}$)")
+        ax.set_ylabel("maximum contact force (N)")
+        ax.set_title("plate, v = 1 m/s: optimum damping (runaways omitted)")
+        ax.legend(loc="upper left")
+
+        ax = axes[0, 1]
+        free = p.replace(target="free")
+        result = sweep(free, "hunt-crossley", kappas, n_jobs=jobs)
+        a = kappas * free.v / free.K
+        ax.semilogx(kappas, result.restitution, "o", ms=3, color="C1", label="measured (sweep)")
+        ax.semilogx(kappas, hunt_crossley_restitution(a), "k-", lw=0.8, label="Lambert-W formula")
+        ax.set_xlabel("damping κ (N s/m$^{2.5}$)")
+        ax.set_ylabel("coefficient of restitution e")
+        ax.set_title("Hunt-Crossley, free target")
+        ax.legend(loc="lower left")
+        data["hunt-crossley/free/restitution"] = (result.restitution, "1")
+
+        ax = axes[0, 2]
+        requested = np.linspace(0.1, 0.95, 8 if quick else 18)
+        for name, color in zip(RESTITUTION_LAWS, ("C2", "C3", "C4", "C5", "k"), strict=True):
+            measured = [impact_quantities(simulate(free, ContactLaw(name, restitution=float(e)), 0.01)).restitution
+                        for e in requested]
+            label = "exact inverse (hunt-crossley)" if name == "hunt-crossley" else name
+            ax.plot(requested, measured, "o-" if name != "hunt-crossley" else "-", ms=3, color=color, label=label)
+            data[f"restitution_laws/{name}"] = (np.array(measured, dtype=float), "1")
+        ax.plot([0, 1], [0, 1], ":", color="grey", lw=0.8)
+        ax.set_xlabel("requested restitution e")
+        ax.set_ylabel("measured restitution")
+        ax.set_title("restitution laws, free target, v = 1 m/s")
+        ax.legend(loc="upper left")
+        data["restitution_laws/requested"] = (requested, "1")
+        out = save(fig, FIGURES / f"{NAME}.png")
+    save_h5(FIGURES / "data" / f"{NAME}.h5", data, {"v": 1.0, "claim": __doc__.strip()})
+    return out
+
+
+if __name__ == "__main__":
+    from _cli import run
+
+    run(main, __doc__)
