@@ -33,12 +33,12 @@ import dataclasses
 import datetime
 import json
 import os
-import tempfile
 
 import h5py
 import numpy as np
 
 from . import __version__
+from ._atomic import atomic_path
 from .continuation import CriticalCurve, CriticalDamping, SweepResult
 from .model import ContactLaw
 from .parameters import Parameters
@@ -53,32 +53,19 @@ _SWEEP_FLOATS = {"max_force": "N", "max_indentation": "m", "restitution": "1", "
 def save(result: SweepResult | CriticalCurve, path, *, law: ContactLaw | None = None,
          params: Parameters | None = None, settings: dict | None = None) -> None:
     """Write ``result`` to ``path`` atomically (temporary file, then rename)."""
-    path = os.fspath(path)
-    folder = os.path.dirname(os.path.abspath(path))
-    fd, tmp = tempfile.mkstemp(prefix=".phaseimpact-", suffix=".h5.tmp", dir=folder)
-    os.close(fd)
-    try:
-        with h5py.File(tmp, "w") as f:
-            if isinstance(result, SweepResult):
-                _write_header(f, "sweep", result.law, result.params, result.t_end, result.settings)
-                _write_sweep(f.create_group("sweep"), result)
-                if result.critical is not None:
-                    _write_critical(f.create_group("critical"), result.critical)
-            elif isinstance(result, CriticalCurve):
-                if law is None or params is None:
-                    raise ValueError("saving a critical curve needs law= and params=")
-                _write_header(f, "critical-curve", law, params, (settings or {}).get("t_end", np.nan),
-                              settings or {})
-                _write_curve(f.create_group("curve"), result)
-            else:
-                raise TypeError(f"cannot archive a {type(result).__name__}")
-        with open(tmp, "rb+") as handle:
-            os.fsync(handle.fileno())
-        os.replace(tmp, path)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.remove(tmp)
-        raise
+    with atomic_path(path) as tmp, h5py.File(tmp, "w") as f:
+        if isinstance(result, SweepResult):
+            _write_header(f, "sweep", result.law, result.params, result.t_end, result.settings)
+            _write_sweep(f.create_group("sweep"), result)
+            if result.critical is not None:
+                _write_critical(f.create_group("critical"), result.critical)
+        elif isinstance(result, CriticalCurve):
+            if law is None or params is None:
+                raise ValueError("saving a critical curve needs law= and params=")
+            _write_header(f, "critical-curve", law, params, (settings or {}).get("t_end", np.nan), settings or {})
+            _write_curve(f.create_group("curve"), result)
+        else:
+            raise TypeError(f"cannot archive a {type(result).__name__}")
 
 
 def _write_header(f, kind, law, params, t_end, settings):

@@ -8,13 +8,14 @@ from __future__ import annotations
 
 import contextlib
 import os
-import tempfile
 
 import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
+
+from ._atomic import atomic_path  # noqa: E402
 
 __all__ = ["STYLE", "style", "figure", "plot_displacements", "plot_force", "plot_phase", "plot_hysteresis",
            "mark_points", "save", "save_h5", "UM", "MS"]
@@ -119,26 +120,13 @@ def save_h5(path, datasets: dict, attrs: dict | None = None):
     """
     import h5py
 
-    path = os.fspath(path)
-    folder = os.path.dirname(path) or "."
-    os.makedirs(folder, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(suffix=".h5.tmp", dir=folder)
-    os.close(fd)
-    try:
-        with h5py.File(tmp, "w") as f:
-            for key, value in (attrs or {}).items():
-                f.attrs[key] = value
-            for name, (data, units) in datasets.items():
-                arr = np.asarray(data)
-                if arr.dtype == object:
-                    arr = arr.astype("S")
-                elif arr.dtype.kind == "U":
-                    arr = arr.astype("S")
-                ds = f.create_dataset(name, data=arr, compression="gzip" if arr.size > 64 else None)
-                ds.attrs["units"] = units
-        os.replace(tmp, path)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.remove(tmp)
-        raise
+    with atomic_path(path) as tmp, h5py.File(tmp, "w") as f:
+        for key, value in (attrs or {}).items():
+            f.attrs[key] = value
+        for name, (data, units) in datasets.items():
+            arr = np.asarray(data)
+            if arr.dtype == object or arr.dtype.kind == "U":
+                arr = arr.astype("S")
+            ds = f.create_dataset(name, data=arr, compression="gzip" if arr.size > 64 else None)
+            ds.attrs["units"] = units
     return path

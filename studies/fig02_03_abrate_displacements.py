@@ -5,14 +5,12 @@ unilateral law the projectile separates after one contact, with the bilateral la
 relative motion keeps oscillating for the whole 10 ms.
 """
 
-import argparse
-import time
 from pathlib import Path
 
 import numpy as np
 
 from phaseimpact import ContactLaw, seed_parameters, simulate
-from phaseimpact.plotting import MS, figure, plot_displacements, save, save_h5, style
+from phaseimpact.plotting import MS, UM, figure, plot_displacements, save, save_h5, style
 
 ROOT = Path(__file__).resolve().parents[1] / "figures"
 NAME = "fig02_03_abrate_displacements"
@@ -32,6 +30,10 @@ def main(quick=False, jobs=1):
                 ax = axes[row, col]
                 plot_displacements(ax, tr)
                 ax.set_xlim(0, window * MS)
+                shown = tr.t <= window  # scale the axis to what the window shows
+                values = np.concatenate([tr.x1[shown], tr.x2[shown], tr.delta[shown]]) * UM
+                pad = 0.05 * np.ptp(values)
+                ax.set_ylim(values.min() - pad, values.max() + pad)
                 ax.set_title(f"Abrate, {name} contact, v = 1 m/s, {window * MS:g} ms")
             data[f"{name}/x1"] = (tr.x1, "m")
             data[f"{name}/x2"] = (tr.x2, "m")
@@ -43,9 +45,6 @@ def main(quick=False, jobs=1):
 
 
 if __name__ == "__main__":
-    ap = argparse.ArgumentParser(description=__doc__)
-    ap.add_argument("--quick", action="store_true")
-    ap.add_argument("--jobs", type=int, default=1)
-    a = ap.parse_args()
-    t0 = time.time()
-    print(main(a.quick, a.jobs), f"{time.time() - t0:.1f} s")
+    from _cli import run
+
+    run(main, __doc__)

@@ -4,8 +4,6 @@ Claim supported: without damping the loading and unloading branches coincide wit
 P = K delta^1.5: no hysteresis, no dissipated energy.
 """
 
-import argparse
-import time
 from pathlib import Path
 
 import numpy as np
@@ -39,9 +37,6 @@ def main(quick=False, jobs=1):
 
 
 if __name__ == "__main__":
-    ap = argparse.ArgumentParser(description=__doc__)
-    ap.add_argument("--quick", action="store_true")
-    ap.add_argument("--jobs", type=int, default=1)
-    a = ap.parse_args()
-    t0 = time.time()
-    print(main(a.quick, a.jobs), f"{time.time() - t0:.1f} s")
+    from _cli import run
+
+    run(main, __doc__)

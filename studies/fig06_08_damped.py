@@ -5,8 +5,6 @@ loop closes at the origin and the projectile rebounds; with the printed eq. 8 ("
 motion sticks at the first maximum compression, so the loop does not return to the origin.
 """
 
-import argparse
-import time
 from pathlib import Path
 
 import numpy as np
@@ -54,9 +52,6 @@ def main(quick=False, jobs=1):
 
 
 if __name__ == "__main__":
-    ap = argparse.ArgumentParser(description=__doc__)
-    ap.add_argument("--quick", action="store_true")
-    ap.add_argument("--jobs", type=int, default=1)
-    a = ap.parse_args()
-    t0 = time.time()
-    print(main(a.quick, a.jobs), f"{time.time() - t0:.1f} s")
+    from _cli import run
+
+    run(main, __doc__)
