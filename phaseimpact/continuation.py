@@ -14,6 +14,7 @@ integration tolerance.
 
 from __future__ import annotations
 
+import contextlib
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -241,6 +242,9 @@ def sweep(params: Parameters, law: ContactLaw | str, kappas, *, t_end: float = 0
     if previous is not None:
         if previous.kappa.shape != kappas.shape or not np.array_equal(previous.kappa, kappas):
             raise ValueError("resume: the archive's kappa values differ from the requested sweep")
+        if previous.t_end != t_end or previous.settings.get("rtol") != rtol:
+            raise ValueError(f"resume: the archive was computed with t_end = {previous.t_end!r}, "
+                             f"rtol = {previous.settings.get('rtol')!r}; asked: t_end = {t_end!r}, rtol = {rtol!r}")
         result = previous
     else:
         result = SweepResult(kappas, params, law, t_end, settings)
@@ -252,7 +256,7 @@ def sweep(params: Parameters, law: ContactLaw | str, kappas, *, t_end: float = 0
     tasks = (joblib.delayed(_evaluate_chunk)(params, law, kappas[idx], t_end, rtol, min_dwell) for idx in chunks)
     bar = tqdm(total=len(todo), desc=f"sweep {law.name}", unit="pt", disable=not progress)
     try:
-        context = joblib.parallel_config(backend="dask") if client is not None else _nullcontext()
+        context = joblib.parallel_config(backend="dask") if client is not None else contextlib.nullcontext()
         with context:
             for idx, points in zip(chunks, parallel(tasks), strict=False):
                 for i, point in zip(idx, points, strict=False):
@@ -265,14 +269,6 @@ def sweep(params: Parameters, law: ContactLaw | str, kappas, *, t_end: float = 0
         if client is not None:
             client.close()
     return result
-
-
-class _nullcontext:
-    def __enter__(self):
-        return self
-
-    def __exit__(self, *exc):
-        return False
 
 
 @dataclass(frozen=True)
