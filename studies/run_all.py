@@ -17,6 +17,7 @@ STUDIES = (
     "bifurcation",
     "critical_curve",
     "max_force_vs_kappa",
+    "rk4_critical",
     "claims",
 )
 
