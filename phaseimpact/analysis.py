@@ -46,10 +46,7 @@ _TAU = math.sqrt(math.pi) * gamma(7 / 5) / gamma(9 / 10)  # REFERENCE §4
 
 def hertz_contact_time(params: Parameters) -> float:
     """Undamped Hertz contact time of the impact (REFERENCE §4), the system's fastest scale, s."""
-    m = params.reduced_mass
-    a = params.alpha
-    delta_max = ((a + 1) * m * params.v**2 / (2 * params.K)) ** (1 / (a + 1))
-    return 2 * _TAU * delta_max / params.v
+    return 2 * _TAU * params.hertz_indentation / params.v
 
 
 def plane_coordinates(y: np.ndarray, plane) -> tuple[np.ndarray, np.ndarray]:
@@ -272,7 +269,7 @@ def fixed_points(params: Parameters, law: ContactLaw | str = "paper", *,
     """
     law = as_law(law)
     c = coefficients(params, law)
-    scale = ((params.alpha + 1) * params.reduced_mass * params.v**2 / (2 * params.K)) ** (1 / (params.alpha + 1))
+    scale = params.hertz_indentation
     mode = 0 if law.is_filippov else 1
     found: list = []
     if params.target == "plate":
@@ -305,7 +302,7 @@ def _equilibria_at(x2, params, c, law, scale):
     """The equilibria with the target at ``x2``: a point or a set, with eigenvalues."""
     deltas = np.linspace(-2 * scale, 2 * scale, 5)
     members = np.array([[x2 + d, x2, 0.0, 0.0] for d in deltas])
-    where = "at x2 = 0" if params.target != "free" else "with any x2 (free target)"
+    where = f"at x2 = {x2:g} m" if params.target != "free" else "with any x2 (free target)"
     if law.is_filippov:
         y = np.array([x2 + scale, x2, 0.0, 0.0, 0.0])
         J = jacobian(y, c, law, 0)

@@ -170,6 +170,13 @@ class Parameters:
             return self.M1
         return self.M1 * self.M2 / (self.M1 + self.M2)
 
+    @property
+    def hertz_indentation(self) -> float:
+        """Largest indentation of the undamped impact of the reduced mass, m (REFERENCE §4):
+        ``((alpha+1) m v^2 / (2K))^(1/(alpha+1))``, ``(5 m v^2/(4K))^(2/5)`` for Hertz."""
+        a = self.alpha
+        return ((a + 1) * self.reduced_mass * self.v**2 / (2 * self.K)) ** (1 / (a + 1))
+
     def as_dict(self) -> dict:
         return dataclasses.asdict(self)
 

@@ -6,7 +6,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..model import V1, V2, X1, X2, Coefficients, ContactLaw, contact_force, energy
+from ..model import V1, V2, X1, X2, Coefficients, ContactLaw, contact_force
 from ..parameters import Parameters
 from ._events import Event
 
@@ -194,11 +194,6 @@ def state_scale(params: Parameters, c: Coefficients) -> np.ndarray:
     Positions scale with the Hertz indentation on a rigid wall (REFERENCE §4), velocities with
     the impact speed and the work with the initial energy.
     """
-    mass = params.reduced_mass
-    indentation = ((params.alpha + 1) * mass * params.v**2 / (2 * params.K)) ** (1 / (params.alpha + 1))
+    indentation = params.hertz_indentation
     work = 0.5 * params.M1 * params.v**2
     return np.array([indentation, indentation, params.v, params.v, work])
-
-
-def initial_energy(y0, c: Coefficients, law: ContactLaw) -> float:
-    return float(energy(y0, c, law))
