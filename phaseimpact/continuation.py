@@ -1,8 +1,8 @@
 """Continuation over the damping ``kappa``: sweeps, the critical damping and ``kappa_c(v)``.
 
-This is the only layer that knows about joblib. A sweep is split into fixed chunks of points
-(independent of the number of jobs) and every point is integrated on its own, so results are
-identical for any ``n_jobs`` and backend. ``backend="dask"`` runs the same chunks on a
+This is the only layer that knows about joblib. A sweep is split into chunks of points, each
+advanced by the batched integrator, whose result for a point is bit-identical whatever batch it
+runs in: results are identical for any ``n_jobs``, chunking and backend. ``backend="dask"`` runs the same chunks on a
 ``dask.distributed`` cluster through joblib's Dask backend.
 
 The critical damping (REFERENCE §5) is the smallest ``kappa`` at which the number of
@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import contextlib
 import math
+import os
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
@@ -47,7 +48,9 @@ __all__ = [
 ]
 
 BACKENDS = ("loky", "dask")
-CHUNK = 32  # points per task, advanced as one batch; fixed, whatever n_jobs
+#: Points per task (advanced as one batch): about four tasks per worker, within these bounds.
+#: A member's result is bit-identical whatever batch it runs in, so chunking changes no number.
+CHUNK_MIN, CHUNK_MAX = 16, 256
 
 
 @dataclass(frozen=True)
@@ -249,7 +252,9 @@ def sweep(params: Parameters, law: ContactLaw | str, kappas, *, t_end: float = 0
     else:
         result = SweepResult(kappas, params, law, t_end, settings)
     todo = np.flatnonzero(~result.done)
-    chunks = [todo[i:i + CHUNK] for i in range(0, len(todo), CHUNK)]
+    workers = (os.cpu_count() or 1) if n_jobs == -1 or backend == "dask" else n_jobs
+    chunk = int(np.clip(math.ceil(len(todo) / (4 * workers)), CHUNK_MIN, CHUNK_MAX))
+    chunks = [todo[i:i + chunk] for i in range(0, len(todo), chunk)]
     if not chunks:
         return result
     parallel, client = _parallel(n_jobs, backend, scheduler)
@@ -296,6 +301,8 @@ def locate_transition(count: Callable[[float], int], lo: float, hi: float, *, rt
     evaluations = 0
     if indicator is not None:
         def g(s):
+            nonlocal evaluations
+            evaluations += 1
             return indicator(math.exp(s) if log else s)
 
         a, b = (math.log(lo), math.log(hi)) if log else (lo, hi)

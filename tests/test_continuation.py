@@ -202,3 +202,16 @@ def test_count_up_to_two_equals_the_full_count():
     for kappa in [1e9, 1e11, 1.4994e12, 1.49943e12, 1.5e12, 3e12, 1e13]:
         full = evaluate_point(p.replace(kappa=kappa), PAPER, 0.01).n_asymptotic
         assert count_up_to(p.replace(kappa=kappa), PAPER, 0.01, 2) == min(full, 2), kappa
+
+
+def test_sweep_numbers_do_not_depend_on_chunking():
+    """Chunks follow n_jobs; a point's numbers must not: a 40-point sweep (chunks of 16) equals
+    each point integrated alone, bit for bit."""
+    from phaseimpact import simulate_batch
+
+    p = seed_parameters()
+    kappas = np.geomspace(1e10, 1e13, 40)
+    result = sweep(p, PAPER, kappas, n_jobs=1)
+    for i in (0, 17, 39):
+        (alone,) = simulate_batch([p.replace(kappa=float(kappas[i]))], PAPER, 0.01)
+        assert result.max_force[i] == alone.max_force
