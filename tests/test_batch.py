@@ -19,10 +19,6 @@ CASES = {
 }
 
 
-def _kinds(trajectory, drop_peaks):
-    return [e.kind for e in trajectory.events if not (drop_peaks and e.kind == "force-peak")]
-
-
 def _same_events(a, b):
     """Event kinds agree in order, force peaks aside (a flat maximum that coincides with the deepest
     indentation, as for Hertz, may be located just before or just after it); force peaks are paired
