@@ -6,7 +6,7 @@ STAMP := $(VENV)/.installed
 QUICK ?=
 JOBS ?= 2
 
-.PHONY: test reproduce lint benchmarks stress clean
+.PHONY: test reproduce lint benchmarks stress peers clean
 
 $(BIN)/python:
 	$(PYTHON) -m venv $(VENV)
@@ -31,6 +31,9 @@ benchmarks: $(STAMP)
 
 stress: $(STAMP)
 	$(BIN)/python benchmarks/stress.py $(if $(QUICK),--quick)
+
+peers: $(STAMP)  # heyoka comparison, in its own .venv-peers (downloads ~100 MB)
+	$(BIN)/python benchmarks/peers.py
 
 clean:
 	rm -rf $(VENV) .pytest_cache build *.egg-info

@@ -29,9 +29,7 @@ heyoka is a comparison only, never a dependency: the script installs it (with nu
 phaseimpact in editable mode) into its own venv ``.venv-peers`` at the project root and re-runs
 itself there. If that fails, it writes a "not available" section and exits 0.
 
-Before timing, it waits (every 20 s, at most 30 min) until ``/tmp/bench_full.log`` holds a line
-starting with ``rc=`` -- another benchmark run on this 2-core machine; a missing file means no
-such run. Output: a printed table and ``benchmarks/results/peers.md``.
+Output: a printed table and ``benchmarks/results/peers.md``.
 
 Run: ``python benchmarks/peers.py [--quick]``.
 """
@@ -51,7 +49,6 @@ HERE = Path(__file__).resolve().parent
 ROOT = HERE.parent
 VENV = ROOT / ".venv-peers"
 VENV_PYTHON = VENV / "bin" / "python"
-BUSY_LOG = Path("/tmp/bench_full.log")
 LAW = "hunt-crossley"
 T_END = 2e-4
 TAU0 = 1e-6  # heyoka's start, in units of L / v0
@@ -91,20 +88,6 @@ def bootstrap(argv) -> int:
                 return _not_available(f"`{' '.join(step)}` failed ({rc})")
     env = {**os.environ, "PHASEIMPACT_PEERS": "1"}
     return subprocess.call([str(VENV_PYTHON), __file__, *argv], env=env)
-
-
-def wait_for_quiet_machine(path: Path = BUSY_LOG, poll: float = 20.0, limit: float = 1800.0) -> str:
-    """Wait until ``path`` has a line starting with ``rc=`` (the other run ended); say what happened."""
-    start = time.monotonic()
-    while True:
-        if not path.exists():
-            return f"{path} absent: no other benchmark run to wait for"
-        if any(line.startswith("rc=") for line in path.read_text(errors="replace").splitlines()):
-            return f"waited {time.monotonic() - start:.0f} s for the other benchmark run ({path}) to end"
-        if time.monotonic() - start > limit:
-            return f"gave up waiting after {limit:.0f} s: {path} has no `rc=` line, timings may be disturbed"
-        print(f"  machine busy ({path} has no rc= line yet); waiting {poll:.0f} s", flush=True)
-        time.sleep(poll)
 
 
 # --------------------------------------------------------------------------------------------
@@ -290,8 +273,7 @@ def main(argv=None) -> int:
               table(["pair", "t_sep", "max force", "state"], ref_rows), ""]
     emit("\n".join(lines))
 
-    note = "quick run: no waiting" if args.quick else wait_for_quiet_machine()
-    emit(f"({note})\n")
+    note = "run alone on the machine (other jobs disturb the timings)"
 
     rows, runs = [], []  # runs: (solver, setting, seconds, max error)
     for r in rtols:

@@ -21,7 +21,8 @@ from _common import FIGURES, RESULTS, emit, machine  # noqa: E402
 SCRIPTS = ("work_precision", "critical", "throughput", "scene_savings", "stress")
 #: Extra arguments per script run (the throughput benchmark runs once per law).
 RUNS = {"throughput": (["--law", "paper"], ["--law", "hunt-crossley"])}
-SECTIONS = ("work_precision", "critical", "throughput_paper", "throughput_hunt-crossley", "scene_savings", "stress")
+SECTIONS = ("work_precision", "critical", "throughput_paper", "throughput_hunt-crossley", "scene_savings", "stress",
+            "peers")
 
 
 def collect() -> None:
