@@ -225,8 +225,11 @@ def rhs(y, c: Coefficients, law: ContactLaw, mode=None):
         stuck = mode == 0
         a1 = np.where(stuck, common, a1)
         a2 = np.where(stuck, common, a2)
-    deltadot = y[..., V1] - y[..., V2]
-    return np.stack([y[..., V1], y[..., V2], a1, a2, P * deltadot], axis=-1)
+    out = np.empty(np.broadcast_shapes(np.shape(y), np.shape(P) + (5,)))  # cheaper than np.stack
+    out[..., X1], out[..., X2] = y[..., V1], y[..., V2]
+    out[..., V1], out[..., V2] = a1, a2
+    out[..., WORK] = P * (y[..., V1] - y[..., V2])
+    return out
 
 
 def jacobian(y, c: Coefficients, law: ContactLaw, mode=None) -> np.ndarray:
