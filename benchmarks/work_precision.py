@@ -192,7 +192,6 @@ def plot(curves) -> None:
         for (lw, name), pts in curves.items():
             if lw != law:
                 continue
-            pts = sorted(pts)
             color, style = styles.get(name, ("gray", "x-"))
             ax.loglog([p[1 + k] if p[1 + k] > floor else floor for p in pts], [p[0] for p in pts], style,
                       color=color, label=name, ms=4)
