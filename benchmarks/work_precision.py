@@ -15,12 +15,13 @@ import argparse
 import math
 import sys
 import time
+from pathlib import Path
 
 import numpy as np
 from scipy.integrate import solve_ivp
 
-sys.path.insert(0, str(__import__("pathlib").Path(__file__).resolve().parent))
-from _common import FIGURES, emit, machine, save_section, table, timed  # noqa: E402
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from _common import FIGURES, RESULTS, emit, machine, save_section, table, timed  # noqa: E402
 
 import phaseimpact.integrate as integrate  # noqa: E402
 from phaseimpact.integrate import simulate  # noqa: E402
@@ -102,7 +103,11 @@ def errors(res, ref, scale):
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__)
     ap.add_argument("--quick", action="store_true", help="fewer tolerances, one repeat")
+    ap.add_argument("--plot-only", action="store_true", help="redraw the figure from results/work_precision.md")
     args = ap.parse_args(argv)
+    if args.plot_only:
+        plot(curves_from_table(RESULTS / "work_precision.md"))
+        return 0
     rtols = RTOLS[::2] if args.quick else RTOLS
     repeats = 1 if args.quick else 3
     emit(f"# Work-precision (seed case, kappa = {KAPPA:g}, v = 1 m/s, t_end = {T_END:g} s)\n")
@@ -171,9 +176,26 @@ def _record(rows, curves, law, name, setting, wall, tr, res, ref, scale):
     nfev = res.get("nfev", getattr(tr, "nfev", ""))
     status = res.get("status", getattr(tr, "status", ""))
     rows.append((law, name, setting, wall, nfev, e[0], e[1], e[2] if law == "paper" else "", status))
-    curves.setdefault((law, name), []).append((wall, *e))
+    if status == "success":  # a failed run's numbers are not a point of the trade-off
+        curves.setdefault((law, name), []).append((wall, *e))
     emit(f"{law:14s} {name:18s} {setting:14s} {wall:9.4f} s  force {e[0]:.2e}  state {e[1]:.2e}  "
          f"stick {e[2]:.2e}  {status}")
+
+
+def curves_from_table(path) -> dict:
+    """The plotted points, read back from a results table (``--plot-only``)."""
+    curves = {}
+    for line in Path(path).read_text().splitlines():
+        cells = [c.strip() for c in line.strip().strip("|").split("|")]
+        if len(cells) != 9 or cells[-1] != "success":
+            continue
+        law, name, _, wall, _, force, state, stick, _ = cells
+        try:
+            point = (float(wall), float(force), float(state), float(stick) if stick else float("nan"))
+        except ValueError:
+            continue
+        curves.setdefault((law, name), []).append(point)
+    return curves
 
 
 def plot(curves) -> None:
