@@ -8,7 +8,8 @@ The seed's formulas are used as printed except where REFERENCE §2 corrects them
 * eq. 5b (``Km``) is kept as printed, with ``(1 - nu)`` in the denominator offered as
   ``membrane="shivakumar"``.
 
-All quantities are SI: m, kg, Pa, N/m^alpha, N s/m^(1+alpha).
+All quantities are SI: m, kg, Pa, N/m^alpha, N s/m^(1+alpha). Every numeric field accepts any
+real number type (Python or NumPy; ``bool`` is not a number) and is stored as a plain ``float``.
 """
 
 from __future__ import annotations
@@ -16,6 +17,7 @@ from __future__ import annotations
 import dataclasses
 import math
 import numbers
+from collections.abc import Mapping
 from dataclasses import dataclass
 
 __all__ = [
@@ -24,13 +26,21 @@ __all__ = [
     "Parameters",
     "TARGETS",
     "MEMBRANE_FORMULAS",
+    "GEOMETRY_NAMES",
+    "MATERIAL_NAMES",
+    "OVERRIDE_NAMES",
     "derive_parameters",
+    "parameters_with",
     "seed_parameters",
+    "dotted_overrides",
     "STEEL",
 ]
 
 TARGETS = ("plate", "rigid", "free")
 MEMBRANE_FORMULAS = ("printed", "shivakumar")
+BODIES = ("projectile", "plate")
+MATERIAL_FIELDS = ("E", "nu", "rho", "yield_strength")
+GEOMETRY_NAMES = ("a", "h", "R1", "R2")
 
 
 def require(name: str, value, allowed: str, ok: bool) -> None:
@@ -48,11 +58,56 @@ def require_nonnegative(name: str, value) -> None:
 
 
 def require_choice(name: str, value, choices) -> None:
-    require(name, value, "one of " + ", ".join(map(str, choices)), value in choices)
+    require(name, value, "one of " + ", ".join(map(str, choices)), isinstance(value, str) and value in choices)
+
+
+def is_number(value) -> bool:
+    """True for any real number type (int, float, NumPy scalars), False for ``bool``."""
+    return isinstance(value, numbers.Real) and not isinstance(value, bool)
 
 
 def _is_finite(value) -> bool:
-    return isinstance(value, numbers.Real) and not isinstance(value, bool) and math.isfinite(value)
+    return is_number(value) and math.isfinite(value)
+
+
+def _store_floats(obj, names) -> None:
+    # Frozen dataclasses: normalise NumPy and integer inputs to plain floats after validation,
+    # so that results, JSON output and equality never depend on the caller's number type.
+    for name in names:
+        value = getattr(obj, name)
+        if value is not None:
+            object.__setattr__(obj, name, float(value))
+
+
+def validate_material(values: Mapping, prefix: str = "") -> None:
+    """Check the fields of a :class:`Material` given as a mapping.
+
+    Parameters
+    ----------
+    values : Mapping
+        ``E``, ``nu``, ``rho`` and optionally ``yield_strength``.
+    prefix : str
+        Prepended to the field names in error messages (``"plate."``, ``"projectile_"``).
+
+    Raises
+    ------
+    ValueError
+        Naming the (prefixed) field, its value and the allowed range.
+    """
+    require_positive(prefix + "E", values["E"])
+    nu = values["nu"]
+    require(prefix + "nu", nu, "0 <= nu < 0.5", _is_finite(nu) and 0 <= nu < 0.5)
+    require_positive(prefix + "rho", values["rho"])
+    strength = values.get("yield_strength")
+    if strength is not None:
+        require(prefix + "yield_strength", strength, "a finite number > 0, or absent",
+                _is_finite(strength) and strength > 0)
+
+
+def validate_geometry(values: Mapping, prefix: str = "") -> None:
+    """Check the fields of a :class:`Geometry` (all > 0, m); messages name ``prefix + field``."""
+    for name in GEOMETRY_NAMES:
+        require_positive(prefix + name, values[name])
 
 
 @dataclass(frozen=True)
@@ -67,19 +122,22 @@ class Material:
         Poisson's ratio, dimensionless (0 <= nu < 0.5).
     rho : float
         Density, kg/m^3 (> 0).
+    yield_strength : float or None
+        Yield (or, for brittle and polymeric materials, compressive) strength, Pa (> 0), if known.
+        It drives the validity check of elastic Hertz contact (first yield at ``p0 ≈ 1.6 Y``).
     """
 
     E: float
     nu: float
     rho: float
+    yield_strength: float | None = None
 
     def __post_init__(self):
-        require_positive("E", self.E)
-        require("nu", self.nu, "0 <= nu < 0.5", _is_finite(self.nu) and 0 <= self.nu < 0.5)
-        require_positive("rho", self.rho)
+        validate_material(dataclasses.asdict(self))
+        _store_floats(self, MATERIAL_FIELDS)
 
 
-#: Steel, as REFERENCE §2 fixes it for the seed (the seed gives only E).
+#: Steel, as REFERENCE §2 fixes it for the seed (the seed gives only E; no yield strength).
 STEEL = Material(E=2.1e11, nu=0.3, rho=7850.0)
 
 
@@ -105,8 +163,13 @@ class Geometry:
     R2: float = 2e3
 
     def __post_init__(self):
-        for name in ("a", "h", "R1", "R2"):
-            require_positive(name, getattr(self, name))
+        validate_geometry(dataclasses.asdict(self))
+        _store_floats(self, GEOMETRY_NAMES)
+
+    @property
+    def effective_radius(self) -> float:
+        """``R = R1 R2 / (R1 + R2)``, m (REFERENCE §2)."""
+        return self.R1 * self.R2 / (self.R1 + self.R2)
 
 
 @dataclass(frozen=True)
@@ -133,6 +196,10 @@ class Parameters:
         Impact speed of the projectile, m/s (initial condition eq. 6).
     target : str
         ``"plate"`` (eq. 1), ``"rigid"`` (target held fixed) or ``"free"`` (no springs).
+    R : float or None
+        Effective contact radius ``R1 R2/(R1+R2)``, m, filled by :func:`derive_parameters`; not
+        used by the equations of motion, only by contact radius and pressure (Hertz). ``None``
+        when the parameters are given directly without it.
     """
 
     M1: float
@@ -144,6 +211,7 @@ class Parameters:
     kappa: float = 0.0
     v: float = 1.0
     target: str = "plate"
+    R: float | None = None
 
     def __post_init__(self):
         for name in ("M1", "M2", "K", "alpha", "v"):
@@ -151,9 +219,13 @@ class Parameters:
         for name in ("Kb", "Km", "kappa"):
             require_nonnegative(name, getattr(self, name))
         require_choice("target", self.target, TARGETS)
+        if self.R is not None:
+            require("R", self.R, "a finite number > 0, or None", _is_finite(self.R) and self.R > 0)
+        _store_floats(self, ("M1", "M2", "K", "Kb", "Km", "alpha", "kappa", "v", "R"))
 
     def replace(self, **changes) -> Parameters:
-        """A copy with ``changes`` applied (and validated)."""
+        """A copy with ``changes`` applied (and validated); unknown names raise ``ValueError``."""
+        _reject_unknown(changes, PARAMETER_NAMES)
         return dataclasses.replace(self, **changes)
 
     @property
@@ -181,6 +253,20 @@ class Parameters:
         return dataclasses.asdict(self)
 
 
+PARAMETER_NAMES = tuple(f.name for f in dataclasses.fields(Parameters))
+#: Material names accepted by :func:`seed_parameters`: ``projectile_E``, ..., ``plate_yield_strength``.
+MATERIAL_NAMES = tuple(f"{body}_{field}" for body in BODIES for field in MATERIAL_FIELDS)
+#: Every name :func:`seed_parameters` and :func:`parameters_with` accept as an override.
+OVERRIDE_NAMES = GEOMETRY_NAMES + MATERIAL_NAMES + PARAMETER_NAMES + ("membrane",)
+
+
+def _reject_unknown(names, allowed) -> None:
+    unknown = [name for name in names if name not in allowed]
+    if unknown:
+        label = "parameter" if len(unknown) == 1 else "parameters"
+        raise ValueError(f"unknown {label} {', '.join(map(repr, unknown))}; allowed: {', '.join(allowed)}")
+
+
 def derive_parameters(
     projectile: Material = STEEL,
     plate: Material = STEEL,
@@ -192,7 +278,7 @@ def derive_parameters(
     v: float = 1.0,
     target: str = "plate",
 ) -> Parameters:
-    """Derive ``M1, M2, K, Kb, Km`` from materials and geometry (seed eq. 3-5, REFERENCE §2).
+    """Derive ``M1, M2, K, Kb, Km`` (and ``R``) from materials and geometry (seed eq. 3-5, REFERENCE §2).
 
     Parameters
     ----------
@@ -210,20 +296,107 @@ def derive_parameters(
     M1 = projectile.rho * 4.0 / 3.0 * math.pi * g.R1**3
     M2 = 0.25 * plate.rho * math.pi * g.a**2 * g.h  # a quarter of the plate takes part
     eta = (1 - projectile.nu**2) / projectile.E + (1 - nu**2) / E  # eq. 4
-    R = g.R1 * g.R2 / (g.R1 + g.R2)
+    R = g.effective_radius
     K = 4.0 * math.sqrt(R) / (3.0 * eta)  # eq. 3 with eta restored
     Kb = 4.0 * math.pi * E * g.h**3 / (3.0 * (1 - nu**2) * g.a**2)  # eq. 5a with h^3
     km_denominator = (1 - nu**2) if membrane == "printed" else (1 - nu)
     Km = (353 - 191 * nu) * math.pi * E * g.h / (648 * km_denominator * g.a**2)  # eq. 5b
-    return Parameters(M1=M1, M2=M2, K=K, Kb=Kb, Km=Km, alpha=alpha, kappa=kappa, v=v, target=target)
+    return Parameters(M1=M1, M2=M2, K=K, Kb=Kb, Km=Km, alpha=alpha, kappa=kappa, v=v, target=target, R=R)
+
+
+def _replace_material(material: Material, prefix: str, changes: Mapping) -> Material:
+    values = {**dataclasses.asdict(material), **changes}
+    validate_material(values, prefix)  # so that the message names e.g. "plate_E", not "E"
+    return Material(**values)
+
+
+def parameters_with(
+    projectile: Material = STEEL,
+    plate: Material = STEEL,
+    geometry: Geometry = Geometry(),
+    *,
+    v: float = 1.0,
+    **overrides,
+) -> Parameters:
+    """Derive :class:`Parameters` from materials and geometry, with named overrides.
+
+    Parameters
+    ----------
+    projectile, plate : Material
+        Base materials.
+    geometry : Geometry
+        Base geometry.
+    v : float
+        Impact speed, m/s.
+    **overrides
+        Any of :data:`OVERRIDE_NAMES`: geometry ``a, h, R1, R2`` (m); materials
+        ``projectile_E, projectile_nu, projectile_rho, plate_E, plate_nu, plate_rho`` (Pa, -, kg/m^3)
+        and ``*_yield_strength`` (Pa); ``membrane``; any :class:`Parameters` field (``kappa``,
+        ``target``, ``alpha``, or a derived value such as ``M1``, which then wins over the
+        derivation).
+
+    Raises
+    ------
+    ValueError
+        For an unknown name (the message lists the allowed ones) or a value out of range.
+    """
+    _reject_unknown(overrides, OVERRIDE_NAMES)
+    overrides = dict(overrides)
+    geometry_changes = {name: overrides.pop(name) for name in GEOMETRY_NAMES if name in overrides}
+    if geometry_changes:
+        validate_geometry({**dataclasses.asdict(geometry), **geometry_changes})
+        geometry = Geometry(**{**dataclasses.asdict(geometry), **geometry_changes})
+    materials = {"projectile": projectile, "plate": plate}
+    for body in BODIES:
+        changes = {field: overrides.pop(f"{body}_{field}") for field in MATERIAL_FIELDS
+                   if f"{body}_{field}" in overrides}
+        if changes:
+            materials[body] = _replace_material(materials[body], f"{body}_", changes)
+    passed = {name: overrides.pop(name) for name in ("alpha", "kappa", "target", "membrane") if name in overrides}
+    if "v" in overrides:
+        v = overrides.pop("v")
+    params = derive_parameters(materials["projectile"], materials["plate"], geometry, v=v, **passed)
+    return params.replace(**overrides) if overrides else params
 
 
 def seed_parameters(v: float = 1.0, **overrides) -> Parameters:
-    """The seed's case (eq. 7, steel, REFERENCE §2) at impact speed ``v`` (m/s).
+    """The seed's case (eq. 7, steel, REFERENCE §2) at impact speed ``v`` (m/s), with overrides.
 
-    ``overrides`` may name any :class:`Parameters` field (``kappa=1e9``, ``target="rigid"``)
-    or ``membrane="shivakumar"``.
+    ``overrides`` may name geometry (``a, h, R1, R2``, m), materials (``projectile_E``,
+    ``plate_nu``, ... see :data:`MATERIAL_NAMES`), ``membrane="shivakumar"`` or any
+    :class:`Parameters` field (``kappa=1e9``, ``target="rigid"``, ``M1=...``); see
+    :func:`parameters_with`. Dotted names (``"plate.E"``) go through :func:`dotted_overrides`.
+
+    Examples
+    --------
+    >>> seed_parameters(13.0, R1=0.005, plate_E=7e10).v
+    13.0
+
+    Raises
+    ------
+    ValueError
+        For an unknown name (the message lists the allowed names) or a value out of range.
     """
-    membrane = overrides.pop("membrane", "printed")
-    params = derive_parameters(membrane=membrane, v=v)
-    return params.replace(**overrides) if overrides else params
+    return parameters_with(STEEL, STEEL, Geometry(), v=v, **overrides)
+
+
+def dotted_overrides(settings: Mapping) -> dict:
+    """Translate dotted names (``"plate.E"``, ``"projectile.nu"``) to keyword names (``plate_E``).
+
+    Undotted names pass unchanged; ``seed_parameters(**dotted_overrides({"plate.E": 7e10}))``.
+
+    Raises
+    ------
+    ValueError
+        For a dotted name whose body or field is unknown.
+    """
+    out = {}
+    for name, value in settings.items():
+        if "." in name:
+            body, _, field = name.partition(".")
+            if body not in BODIES or field not in MATERIAL_FIELDS:
+                allowed = [f"{b}.{f}" for b in BODIES for f in MATERIAL_FIELDS]
+                raise ValueError(f"unknown parameter {name!r}; allowed dotted names: {', '.join(allowed)}")
+            name = f"{body}_{field}"
+        out[name] = value
+    return out

@@ -9,12 +9,13 @@ from __future__ import annotations
 import dataclasses
 import math
 
+import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from phaseimpact import Geometry, Material, Parameters, derive_parameters, seed_parameters
-from phaseimpact.parameters import STEEL
+from phaseimpact.parameters import STEEL, dotted_overrides
 
 # ---------------------------------------------------------------------------------------------
 # Seed values (REFERENCE §2 table, "seed value (check)" column)
@@ -221,3 +222,110 @@ def test_replacing_derived_parameters_revalidates(m1, m2, g, name, bad):
     p = derive_parameters(m1, m2, g)
     with pytest.raises(ValueError, match=f"{name} ="):
         dataclasses.replace(p, **{name: bad})
+
+
+# ---------------------------------------------------------------------------------------------
+# Issue 12: every quantity settable by name; any real number type; yield strength; R
+# ---------------------------------------------------------------------------------------------
+
+def test_seed_parameters_accepts_geometry_and_material_names():
+    """seed_parameters(v, R1=..., plate_E=...) equals derive_parameters with the changed inputs."""
+    p = seed_parameters(13.0, a=0.2, h=0.002, R1=0.005, R2=1.0, projectile_E=7e10, projectile_nu=0.33,
+                        projectile_rho=2700.0, plate_E=3.4e9, plate_nu=0.35, plate_rho=1200.0, kappa=1e9)
+    expected = derive_parameters(Material(E=7e10, nu=0.33, rho=2700.0), Material(E=3.4e9, nu=0.35, rho=1200.0),
+                                 Geometry(a=0.2, h=0.002, R1=0.005, R2=1.0), v=13.0, kappa=1e9)
+    assert p == expected
+    for name, value in _reference_formulas(Material(E=7e10, nu=0.33, rho=2700.0),
+                                           Material(E=3.4e9, nu=0.35, rho=1200.0),
+                                           Geometry(a=0.2, h=0.002, R1=0.005, R2=1.0)).items():
+        assert getattr(p, name) == pytest.approx(value, rel=1e-12), name
+
+
+def test_explicit_parameter_fields_win_over_the_derivation():
+    p = seed_parameters(R1=0.005, M1=1.0, target="rigid", alpha=1.4)
+    assert (p.M1, p.target, p.alpha) == (1.0, "rigid", 1.4)
+    assert p.K == seed_parameters(R1=0.005).K
+
+
+@pytest.mark.parametrize("name", ["G", "radius", "plate_G", "plate.E", "r1"])
+def test_unknown_names_raise_value_error_listing_the_allowed(name):
+    """Issue 12: seed_parameters(v, R1=...) used to raise a bare TypeError; unknown names must
+    raise ValueError naming the parameter and listing the allowed names."""
+    with pytest.raises(ValueError) as info:
+        seed_parameters(**{name: 1.0})
+    message = str(info.value)
+    assert repr(name) in message
+    for allowed in ("R1", "plate_E", "projectile_nu", "kappa", "target", "membrane"):
+        assert allowed in message
+
+
+def test_parameters_replace_rejects_unknown_names_with_value_error():
+    with pytest.raises(ValueError, match="unknown parameter 'R1'"):
+        seed_parameters().replace(R1=0.01)
+
+
+@pytest.mark.parametrize(("name", "bad", "shown"), [
+    ("plate_E", -1.0, "plate_E = -1.0"), ("projectile_nu", 0.5, "projectile_nu = 0.5"),
+    ("plate_rho", 0.0, "plate_rho = 0.0"), ("R1", "abc", "R1 = 'abc'"), ("a", float("nan"), "a = nan"),
+    ("plate_yield_strength", -5.0, "plate_yield_strength = -5.0"),
+])
+def test_bad_override_values_name_the_override(name, bad, shown):
+    with pytest.raises(ValueError) as info:
+        seed_parameters(**{name: bad})
+    assert shown in str(info.value) and "allowed" in str(info.value)
+
+
+def test_dotted_overrides():
+    assert dotted_overrides({"plate.E": 1e9, "projectile.rho": 2650, "R1": 0.01}) == {
+        "plate_E": 1e9, "projectile_rho": 2650, "R1": 0.01}
+    assert seed_parameters(**dotted_overrides({"plate.E": 1e9})) == seed_parameters(plate_E=1e9)
+    with pytest.raises(ValueError, match="'plate.G'"):
+        dotted_overrides({"plate.G": 1.0})
+
+
+NUMPY_VALUES = [np.float32(0.25), np.float64(0.25), np.int64(1), np.int32(2), 3, 0.5]
+
+
+@pytest.mark.parametrize("value", NUMPY_VALUES, ids=lambda v: type(v).__name__)
+def test_any_real_number_type_is_accepted_and_stored_as_float(value):
+    """NumPy scalars and ints are numbers; the dataclasses store plain Python floats."""
+    nu = float(value) if float(value) < 0.5 else 0.3
+    m = Material(E=value * 1e9, nu=np.float32(nu) if isinstance(value, np.floating) else nu, rho=value * 1000,
+                 yield_strength=value * 1e6)
+    g = Geometry(a=value, h=value, R1=value, R2=value)
+    p = Parameters(M1=value, M2=value, K=value, Kb=value, Km=value, alpha=value, kappa=value, v=value, R=value)
+    for obj in (m, g, p):
+        for f in dataclasses.fields(obj):
+            stored = getattr(obj, f.name)
+            assert stored is None or isinstance(stored, str) or type(stored) is float, (obj, f.name)
+    assert p.v == float(value) and g.R1 == float(value)
+    q = seed_parameters(np.float32(2.0), R1=np.float64(0.01), plate_nu=np.float32(0.25), kappa=np.int64(10))
+    assert type(q.v) is float and q.v == 2.0 and type(q.kappa) is float
+
+
+@pytest.mark.parametrize(("cls", "base", "name"), [(Material, MATERIAL, "E"), (Material, MATERIAL, "nu"),
+                                                   (Geometry, GEOMETRY, "R1"), (Parameters, PARAMETERS, "v"),
+                                                   (Parameters, PARAMETERS, "kappa")])
+@pytest.mark.parametrize("bad", [True, False, np.bool_(True), "1.0", None, [1.0]])
+def test_bools_strings_and_none_are_not_numbers(cls, base, name, bad):
+    with pytest.raises(ValueError, match=f"{name} ="):
+        cls(**{**base, name: bad})
+
+
+def test_yield_strength_is_optional_and_positive():
+    assert STEEL.yield_strength is None
+    assert Material(**MATERIAL, yield_strength=2.5e8).yield_strength == 2.5e8
+    for bad in (0.0, -1.0, NAN, INF, True):
+        with pytest.raises(ValueError, match="yield_strength =.*> 0"):
+            Material(**MATERIAL, yield_strength=bad)
+
+
+def test_effective_radius_is_filled_and_optional():
+    """REFERENCE §2: R = R1 R2/(R1+R2); derived parameters carry it, direct Parameters may omit it."""
+    g = Geometry()
+    assert seed_parameters().R == pytest.approx(g.R1 * g.R2 / (g.R1 + g.R2), rel=1e-15)
+    assert seed_parameters(R1=0.01, R2=0.01).R == pytest.approx(0.005, rel=1e-15)
+    assert Parameters(**PARAMETERS).R is None
+    for bad in (0.0, -1.0, NAN):
+        with pytest.raises(ValueError, match="R ="):
+            Parameters(**PARAMETERS, R=bad)

@@ -1,0 +1,630 @@
+"""Impact cases: materials, geometry and impact settings in one object, read from TOML (issue 12).
+
+A case file has this schema (SI units; ``[projectile]`` and ``[plate]`` take the same keys)::
+
+    name = "5 mm steel ball on the seed plate"   # optional (default: the file name)
+    description = "..."                          # optional, one line
+    source = "..."                               # optional, free text: where the numbers come from
+    [projectile]   # E (Pa), nu (0 <= nu < 0.5), rho (kg/m^3); optional yield_strength (Pa)
+    E = 2.1e11
+    nu = 0.3
+    rho = 7850.0
+    [plate]        # same keys; yield_strength drives the validity check
+    E = 2.1e11
+    nu = 0.3
+    rho = 7850.0
+    [geometry]     # a, h, R1, R2 (m)
+    a = 0.1
+    h = 0.005
+    R1 = 0.005
+    R2 = 2000.0
+    [impact]       # v (m/s); optional kappa (N s/m^2.5, default 0), target (plate|rigid|free,
+    v = 13.0       # default plate), law (default paper), contact (printed|unilateral, default
+                   # printed), restitution (0 < e <= 1, default none)
+
+Unknown keys, missing keys, wrong types and values out of range raise ``ValueError`` naming the
+dotted key, its value and the allowed range. Named cases ship in ``phaseimpact/cases/``
+(:func:`list_cases`); :func:`load_case` takes a name or a path.
+
+Hertz scales and validity (REFERENCE §4; Johnson 1985, *Contact Mechanics*, §4.2, §11.4) are
+pure functions of :class:`~phaseimpact.parameters.Parameters` and the materials:
+:func:`hertz_scales`, :func:`validity`, :func:`hertz_contact`, :func:`validity_for_force`.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import math
+import sys
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from importlib import resources
+from pathlib import Path
+
+from scipy.special import gamma
+
+if sys.version_info >= (3, 11):
+    import tomllib
+else:  # pragma: no cover - Python 3.10
+    import tomli as tomllib
+
+from .parameters import (
+    STEEL,
+    TARGETS,
+    Geometry,
+    Material,
+    Parameters,
+    dotted_overrides,
+    is_number,
+    parameters_with,
+    require,
+    require_choice,
+    require_nonnegative,
+    require_positive,
+    validate_geometry,
+    validate_material,
+)
+
+__all__ = [
+    "Case",
+    "SETTABLE",
+    "CONTACTS",
+    "FIRST_YIELD_FACTOR",
+    "CONTACT_RATIO_LIMIT",
+    "apply_settings",
+    "parse_setting",
+    "case_from_dict",
+    "load_case",
+    "list_cases",
+    "seed_case",
+    "hertz_scales",
+    "hertz_contact",
+    "validity",
+    "validity_for_force",
+]
+
+#: Every name ``--set NAME=VALUE`` accepts: ``{name: (unit, description)}`` (SI units).
+SETTABLE = {
+    "projectile.E": ("Pa", "Young's modulus of the projectile"),
+    "projectile.nu": ("-", "Poisson's ratio of the projectile (0 <= nu < 0.5)"),
+    "projectile.rho": ("kg/m^3", "density of the projectile"),
+    "plate.E": ("Pa", "Young's modulus of the plate (target)"),
+    "plate.nu": ("-", "Poisson's ratio of the plate (0 <= nu < 0.5)"),
+    "plate.rho": ("kg/m^3", "density of the plate"),
+    "plate.yield_strength": ("Pa", "yield (or compressive) strength of the plate; drives the validity check"),
+    "a": ("m", "radius of the clamped circular plate"),
+    "h": ("m", "plate thickness"),
+    "R1": ("m", "radius of the spherical projectile"),
+    "R2": ("m", "radius of curvature of the target surface"),
+    "v": ("m/s", "impact speed"),
+}
+
+CONTACTS = ("printed", "unilateral")
+#: First yield under a Hertz contact at ``p0 = 1.60 Y`` (von Mises, nu = 0.3; Johnson 1985, §4.2 and §11.4).
+FIRST_YIELD_FACTOR = 1.60
+#: Hertz theory assumes a contact radius small against the radius: ``a0 / R`` above this is out of range
+#: (assumed limit; Johnson 1985, §4.1 requires ``a << R``).
+CONTACT_RATIO_LIMIT = 0.3
+
+_MATERIAL_KEYS = {"E": "Pa", "nu": "-", "rho": "kg/m^3", "yield_strength": "Pa"}
+_MATERIAL_REQUIRED = ("E", "nu", "rho")
+_GEOMETRY_KEYS = ("a", "h", "R1", "R2")
+_IMPACT_DEFAULTS = {"kappa": 0.0, "target": "plate", "law": "paper", "contact": "printed", "restitution": None}
+_IMPACT_KEYS = ("v", *_IMPACT_DEFAULTS)
+_TOP_KEYS = ("name", "description", "source", "projectile", "plate", "geometry", "impact")
+_TABLES = ("projectile", "plate", "geometry", "impact")
+_CASES_PACKAGE = "phaseimpact.cases"
+
+
+def _laws() -> tuple:
+    # Imported late: the engine (model) is not needed to describe a case, and importing it here
+    # would tie case files to the engine's import time.
+    from .model import LAWS
+
+    return tuple(LAWS)
+
+
+# ---------------------------------------------------------------------------------------------
+# Validation helpers (messages name the dotted key, its value and the allowed range)
+# ---------------------------------------------------------------------------------------------
+
+def _wrong_type(key: str, value, allowed: str) -> ValueError:
+    return ValueError(f"{key} = {value!r} has the wrong type ({type(value).__name__}); allowed: {allowed}")
+
+
+def _number(key: str, value, allowed: str = "a finite number"):
+    if not is_number(value):
+        raise _wrong_type(key, value, allowed)
+    return float(value)
+
+
+def _string(key: str, value, allowed: str = "a string") -> str:
+    if not isinstance(value, str):
+        raise _wrong_type(key, value, allowed)
+    return value
+
+
+def _check_keys(table: Mapping, allowed, where: str) -> None:
+    for key in table:
+        if key not in allowed:
+            dotted = f"{where}.{key}" if where else key
+            raise ValueError(f"unknown key {dotted!r}; allowed in {'[' + where + ']' if where else 'the top level'}: "
+                             + ", ".join(allowed))
+
+
+def _missing(key: str, allowed: str) -> ValueError:
+    return ValueError(f"missing key {key!r}; allowed: {allowed}")
+
+
+def _material_from(table, body: str) -> Material:
+    if not isinstance(table, Mapping):
+        raise _wrong_type(body, table, "a table with keys " + ", ".join(_MATERIAL_KEYS))
+    _check_keys(table, tuple(_MATERIAL_KEYS), body)
+    for key in _MATERIAL_REQUIRED:
+        if key not in table:
+            raise _missing(f"{body}.{key}", f"a number in {_MATERIAL_KEYS[key]}")
+    values = {key: _number(f"{body}.{key}", value) for key, value in table.items()}
+    validate_material(values, f"{body}.")
+    return Material(**values)
+
+
+def _geometry_from(table) -> Geometry:
+    if not isinstance(table, Mapping):
+        raise _wrong_type("geometry", table, "a table with keys a, h, R1, R2")
+    _check_keys(table, _GEOMETRY_KEYS, "geometry")
+    for key in _GEOMETRY_KEYS:
+        if key not in table:
+            raise _missing(f"geometry.{key}", "a finite number > 0 (m)")
+    values = {key: _number(f"geometry.{key}", value) for key, value in table.items()}
+    validate_geometry(values, "geometry.")
+    return Geometry(**values)
+
+
+def _impact_from(table) -> dict:
+    """Validate an ``[impact]`` table and fill the defaults of its optional keys."""
+    if not isinstance(table, Mapping):
+        raise _wrong_type("impact", table, "a table with keys " + ", ".join(_IMPACT_KEYS))
+    _check_keys(table, _IMPACT_KEYS, "impact")
+    if "v" not in table:
+        raise _missing("impact.v", "a finite number > 0 (m/s)")
+    out = {**_IMPACT_DEFAULTS, **table}
+    out["v"] = _number("impact.v", out["v"], "a finite number > 0 (m/s)")
+    require_positive("impact.v", out["v"])
+    out["kappa"] = _number("impact.kappa", out["kappa"], "a finite number >= 0 (N s/m^2.5)")
+    require_nonnegative("impact.kappa", out["kappa"])
+    for key, choices in (("target", TARGETS), ("law", _laws()), ("contact", CONTACTS)):
+        _string(f"impact.{key}", out[key], "one of " + ", ".join(choices))
+        require_choice(f"impact.{key}", out[key], choices)
+    if out["restitution"] is not None:
+        e = _number("impact.restitution", out["restitution"], "a number with 0 < e <= 1")
+        require("impact.restitution", e, "0 < e <= 1", math.isfinite(e) and 0 < e <= 1)
+        out["restitution"] = e
+    return {key: out[key] for key in _IMPACT_KEYS}
+
+
+# ---------------------------------------------------------------------------------------------
+# The case
+# ---------------------------------------------------------------------------------------------
+
+@dataclass(frozen=True, kw_only=True)
+class Case:
+    """A complete impact case: who hits what, how fast (the TOML schema in this module's docstring).
+
+    Attributes
+    ----------
+    name : str
+        Short name (for shipped cases, the name :func:`load_case` takes).
+    description : str
+        One line saying what the case is.
+    source : str
+        Where the numbers come from; assumed values are marked as assumed.
+    projectile, plate : Material
+        Materials of the spherical projectile and of the target plate.
+    geometry : Geometry
+        ``a, h, R1, R2`` (m).
+    impact : dict
+        ``v`` (m/s), ``kappa`` (N s/m^2.5), ``target``, ``law``, ``contact`` and ``restitution``
+        (``None`` when not given); defaults are filled in for the optional keys. Not hashable.
+    """
+
+    name: str
+    description: str = ""
+    source: str = ""
+    projectile: Material
+    plate: Material
+    geometry: Geometry
+    impact: dict = field(default_factory=lambda: {"v": 1.0})
+
+    def __post_init__(self):
+        for key in ("name", "description", "source"):
+            _string(key, getattr(self, key))
+        require("name", self.name, "a non-empty string", bool(self.name.strip()))
+        for key, cls in (("projectile", Material), ("plate", Material), ("geometry", Geometry)):
+            if not isinstance(getattr(self, key), cls):
+                raise _wrong_type(key, getattr(self, key), f"a {cls.__name__}")
+        object.__setattr__(self, "impact", _impact_from(self.impact))
+
+    def parameters(self, **overrides) -> Parameters:
+        """The model parameters of this case (via :func:`~phaseimpact.parameters.derive_parameters`).
+
+        Parameters
+        ----------
+        **overrides
+            ``v``, ``kappa``, ``target``, any name :func:`~phaseimpact.parameters.parameters_with`
+            accepts (``R1``, ``plate_E``, ``membrane``, ...), or a dotted material name passed as
+            ``**{"plate.E": 1e9}``. They win over the case's values.
+        """
+        overrides = dotted_overrides(overrides)
+        v = overrides.pop("v", self.impact["v"])
+        settings = {"kappa": self.impact["kappa"], "target": self.impact["target"], **overrides}
+        return parameters_with(self.projectile, self.plate, self.geometry, v=v, **settings)
+
+    def with_settings(self, settings) -> Case:
+        """A copy with ``--set`` settings applied; see :func:`apply_settings`."""
+        return apply_settings(self, settings)
+
+    def as_dict(self) -> dict:
+        """The case as plain JSON- and TOML-able data in the file schema (``None`` values left out)."""
+        def material(m: Material) -> dict:
+            return {k: v for k, v in dataclasses.asdict(m).items() if v is not None}
+
+        return {
+            "name": self.name,
+            "description": self.description,
+            "source": self.source,
+            "projectile": material(self.projectile),
+            "plate": material(self.plate),
+            "geometry": dataclasses.asdict(self.geometry),
+            "impact": {k: v for k, v in self.impact.items() if v is not None},
+        }
+
+    def to_toml(self) -> str:
+        """The case as TOML text that :func:`load_case` reads back to an equal case."""
+        data = self.as_dict()
+        lines = [f"{key} = {_toml_value(data[key])}" for key in ("name", "description", "source")]
+        for table in _TABLES:
+            lines += ["", f"[{table}]"] + [f"{k} = {_toml_value(v)}" for k, v in data[table].items()]
+        return "\n".join(lines) + "\n"
+
+    def save(self, path) -> Path:
+        """Write :meth:`to_toml` to ``path`` (UTF-8) and return the path."""
+        path = Path(path)
+        path.write_text(self.to_toml(), encoding="utf-8")
+        return path
+
+
+def _toml_value(value) -> str:
+    if isinstance(value, str):
+        # A JSON string is a valid TOML basic string, except that TOML also wants DEL escaped.
+        return json.dumps(value, ensure_ascii=False).replace("\x7f", "\\u007f")
+    return repr(float(value))
+
+
+def case_from_dict(data, origin: str = "<dict>") -> Case:
+    """Build a :class:`Case` from data in the file schema (parsed TOML, or JSON from an archive).
+
+    Parameters
+    ----------
+    data : Mapping
+        Top-level keys ``name``, ``description``, ``source`` (optional) and the tables
+        ``projectile``, ``plate``, ``geometry``, ``impact``.
+    origin : str
+        File name or label, put in front of error messages. Also the default ``name``
+        (its stem, for a path).
+
+    Raises
+    ------
+    ValueError
+        ``"<origin>: ..."`` naming the dotted key, its value and the allowed range.
+    """
+    try:
+        if not isinstance(data, Mapping):
+            raise _wrong_type("case", data, "a table")
+        _check_keys(data, _TOP_KEYS, "")
+        for table in _TABLES:
+            if table not in data:
+                raise ValueError(f"missing table [{table}]")
+        text = {key: _string(key, data[key]) for key in ("name", "description", "source") if key in data}
+        return Case(
+            name=text.get("name", Path(origin).stem if origin != "<dict>" else "case"),
+            description=text.get("description", ""),
+            source=text.get("source", ""),
+            projectile=_material_from(data["projectile"], "projectile"),
+            plate=_material_from(data["plate"], "plate"),
+            geometry=_geometry_from(data["geometry"]),
+            impact=_impact_from(data["impact"]),
+        )
+    except ValueError as exc:
+        raise ValueError(f"{origin}: {exc}") from None
+
+
+def _read_toml(text: str, origin: str) -> Case:
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise ValueError(f"{origin}: TOML syntax error: {exc}") from None
+    return case_from_dict(data, origin)
+
+
+def _shipped() -> dict:
+    """``{name: resource}`` for every ``*.toml`` file shipped in ``phaseimpact/cases``."""
+    folder = resources.files(_CASES_PACKAGE)
+    return {Path(item.name).stem: item for item in folder.iterdir() if item.name.endswith(".toml")}
+
+
+def load_case(name_or_path) -> Case:
+    """Load a shipped case by name (``"seed"``, ``"sand-gelcoat"``, ...) or a case file (``*.toml``).
+
+    A string without a ``.toml`` suffix and without a path separator is taken as a shipped name.
+
+    Raises
+    ------
+    ValueError
+        Unknown name (the message lists the shipped ones), missing file, TOML syntax error (with
+        the file name and the parser's message), or any schema error (see :func:`case_from_dict`).
+    """
+    text = str(name_or_path)
+    is_name = isinstance(name_or_path, str) and not text.endswith(".toml") and "/" not in text and "\\" not in text
+    if is_name:
+        shipped = _shipped()
+        if text not in shipped:
+            raise ValueError(f"unknown case {text!r}; shipped cases: {', '.join(sorted(shipped))} "
+                             "(or give a path to a .toml file)")
+        return _read_toml(shipped[text].read_text(encoding="utf-8"), f"{text}.toml")
+    path = Path(name_or_path)
+    try:
+        content = path.read_text(encoding="utf-8")
+    except OSError as exc:
+        raise ValueError(f"{path}: cannot read the case file ({exc.strerror or exc})") from None
+    except UnicodeDecodeError as exc:
+        raise ValueError(f"{path}: not UTF-8 text ({exc.reason})") from None
+    return _read_toml(content, str(path))
+
+
+def list_cases() -> list[dict]:
+    """The shipped cases, ``[{"name", "description", "source"}, ...]``, the seed first."""
+    cases = [load_case(name) for name in _shipped()]
+    cases.sort(key=lambda c: (c.name != "seed", c.name))
+    return [{"name": c.name, "description": c.description, "source": c.source} for c in cases]
+
+
+def seed_case() -> Case:
+    """The seed's case (eq. 7, steel as REFERENCE §2 fixes it) at 1 m/s, built without a file."""
+    return Case(
+        name="seed",
+        description="The seed paper's case (eq. 7): 2 cm steel ball on a 10 cm steel plate, 5 mm thick, at 1 m/s",
+        source=_SEED_SOURCE,
+        projectile=STEEL,
+        plate=STEEL,
+        geometry=Geometry(),
+        impact={"v": 1.0},
+    )
+
+
+_SEED_SOURCE = ("Seed paper eq. 7 (a = 0.1 m, h = 0.005 m, R1 = 0.02 m, R2 = 2e3 m, E1 = E2 = 2.1e11 Pa); "
+                "nu = 0.3 and rho = 7850 kg/m^3 are not in the seed: steel as fixed by REFERENCE §2; "
+                "v = 1 m/s is REFERENCE §1's default (the seed gives no speed)")
+
+
+# ---------------------------------------------------------------------------------------------
+# --set NAME=VALUE
+# ---------------------------------------------------------------------------------------------
+
+def _settable_list() -> str:
+    return ", ".join(f"{name} ({unit})" for name, (unit, _) in SETTABLE.items())
+
+
+def parse_setting(text: str) -> tuple[str, float]:
+    """Parse one ``NAME=VALUE`` (``--set``) into ``(name, value)``; the range is checked later.
+
+    Raises
+    ------
+    ValueError
+        Without ``=``, for a name not in :data:`SETTABLE` (the message lists them), or a value that
+        is not a number.
+    """
+    if not isinstance(text, str) or "=" not in text:
+        raise ValueError(f"a setting is NAME=VALUE, got {text!r}; names: {_settable_list()}")
+    name, _, raw = text.partition("=")
+    return name.strip(), _setting_value(name.strip(), raw)
+
+
+def _setting_value(name: str, raw) -> float:
+    if name not in SETTABLE:
+        raise ValueError(f"unknown setting {name!r}; allowed: {_settable_list()}")
+    unit = SETTABLE[name][0]
+    if is_number(raw):
+        return float(raw)
+    try:
+        return float(str(raw).strip())
+    except ValueError:
+        raise ValueError(f"{name} = {raw!r} is not a number; allowed: a number in {unit}") from None
+
+
+def apply_settings(case: Case, settings) -> Case:
+    """Apply ``--set`` settings to a case and return the new, validated case.
+
+    Parameters
+    ----------
+    case : Case
+        The base case.
+    settings : iterable of str, or Mapping
+        ``["plate.E=1e9", "R1=0.001", ...]``, or ``{"plate.E": 1e9, ...}`` (values numbers or
+        strings). Names are the keys of :data:`SETTABLE` (SI units). Later settings win.
+
+    Raises
+    ------
+    ValueError
+        Naming the setting, its value and the allowed range.
+    """
+    if isinstance(settings, Mapping):
+        pairs = [(str(name).strip(), _setting_value(str(name).strip(), raw)) for name, raw in settings.items()]
+    elif isinstance(settings, str):
+        pairs = [parse_setting(settings)]
+    else:
+        pairs = [parse_setting(text) for text in settings]
+    values = {
+        "projectile": dataclasses.asdict(case.projectile),
+        "plate": dataclasses.asdict(case.plate),
+        "geometry": dataclasses.asdict(case.geometry),
+        "impact": dict(case.impact),
+    }
+    for name, value in pairs:
+        if "." in name:
+            body, _, key = name.partition(".")
+            values[body][key] = value
+        elif name == "v":
+            values["impact"]["v"] = value
+        else:
+            values["geometry"][name] = value
+    for body in ("projectile", "plate"):
+        validate_material(values[body], f"{body}.")
+    validate_geometry(values["geometry"])
+    require_positive("v", values["impact"]["v"])
+    return dataclasses.replace(
+        case,
+        projectile=Material(**values["projectile"]),
+        plate=Material(**values["plate"]),
+        geometry=Geometry(**values["geometry"]),
+        impact=values["impact"],
+    )
+
+
+# ---------------------------------------------------------------------------------------------
+# Hertz scales and validity (REFERENCE §4; Johnson 1985)
+# ---------------------------------------------------------------------------------------------
+
+def _tau(alpha: float) -> float:
+    """``tau`` of the contact time ``T = 2 tau delta_max / v`` for ``P = K delta^alpha``.
+
+    From energy conservation, ``t(delta_max) = delta_max/v * int_0^1 (1 - x^p)^(-1/2) dx`` with
+    ``p = alpha + 1``, i.e. ``sqrt(pi) Gamma(1 + 1/p) / Gamma(1/p + 1/2)``; for Hertz (``p = 5/2``)
+    ``sqrt(pi) Gamma(7/5) / Gamma(9/10) = 1.4716376...`` (REFERENCE §4).
+    """
+    p = alpha + 1.0
+    return math.sqrt(math.pi) * float(gamma(1.0 + 1.0 / p)) / float(gamma(1.0 / p + 0.5))
+
+
+def hertz_scales(params: Parameters, plate_material: Material | None = None) -> dict:
+    """Closed-form scales of the undamped impact of the reduced mass (REFERENCE §4, Johnson §11.4).
+
+    Parameters
+    ----------
+    params : Parameters
+        Uses ``M1, M2, K, Kb, alpha, v, target`` and the effective radius ``R`` (m).
+    plate_material : Material, optional
+        If it gives a ``yield_strength``, the result also holds ``first_yield_pressure``
+        (``1.6 Y``, Pa) and ``pressure_to_first_yield`` (``p0 / 1.6 Y``).
+
+    Returns
+    -------
+    dict
+        ``contact_time`` (s): ``T = 2 tau delta_max / v``, ``3.218065... (m^2/(K^2 v))^(1/5)`` for
+        Hertz; ``plate_period`` (s): ``2 pi sqrt(M2/Kb)`` (inf for a rigid or free target);
+        ``indentation`` (m): ``delta_max = (5 m v^2/(4K))^(2/5)``; ``peak_force`` (N):
+        ``K delta_max^alpha``; ``contact_radius`` (m): ``a0 = sqrt(R delta_max)``;
+        ``peak_pressure`` (Pa): ``p0 = 3 F / (2 pi a0^2)``. ``m`` is the reduced mass
+        (``M1`` for a rigid target). The last two are ``None`` when ``params.R`` is ``None``;
+        for ``alpha != 3/2`` they are Hertz estimates only.
+    """
+    delta = params.hertz_indentation
+    force = params.K * delta**params.alpha
+    out = {
+        "contact_time": 2.0 * _tau(params.alpha) * delta / params.v,
+        "plate_period": params.target_period,
+        "indentation": delta,
+        "peak_force": force,
+        "contact_radius": None,
+        "peak_pressure": None,
+    }
+    if params.R is not None:
+        out.update(hertz_contact(force, params))
+        if plate_material is not None and plate_material.yield_strength is not None:
+            limit = FIRST_YIELD_FACTOR * plate_material.yield_strength
+            out["first_yield_pressure"] = limit
+            out["pressure_to_first_yield"] = out["peak_pressure"] / limit
+    return out
+
+
+def hertz_contact(force: float, params: Parameters) -> dict:
+    """Hertz contact radius and peak pressure for a normal force (Johnson 1985, eq. 4.22-4.24).
+
+    Parameters
+    ----------
+    force : float
+        Normal contact force ``F``, N (>= 0), e.g. a simulation's peak force.
+    params : Parameters
+        ``K`` and ``R`` (m); the contact modulus is ``E* = 3 K / (4 sqrt(R))`` (inverting
+        ``K = 4/3 E* sqrt(R)``), so overrides of ``K`` are honoured.
+
+    Returns
+    -------
+    dict
+        ``contact_radius`` ``a = (3 F R / (4 E*))^(1/3)`` (m) and ``peak_pressure``
+        ``p0 = 3 F / (2 pi a^2)`` (Pa); both 0 for ``F = 0``.
+    """
+    if params.R is None:
+        raise ValueError("R = None: the contact radius needs the effective radius R (derive the parameters "
+                         "from materials and geometry, or give Parameters(R=...))")
+    require_nonnegative("force", force)
+    if force == 0:
+        return {"contact_radius": 0.0, "peak_pressure": 0.0}
+    e_star = 3.0 * params.K / (4.0 * math.sqrt(params.R))
+    a = (3.0 * force * params.R / (4.0 * e_star)) ** (1.0 / 3.0)
+    return {"contact_radius": a, "peak_pressure": 3.0 * force / (2.0 * math.pi * a * a)}
+
+
+def _reasons(pressure: float, radius: float, params: Parameters, plate_material, projectile_material) -> str:
+    reasons = []
+    for role, material in (("target", plate_material), ("projectile", projectile_material)):
+        if material is not None and material.yield_strength is not None:
+            strength = material.yield_strength
+            if pressure > FIRST_YIELD_FACTOR * strength:
+                reasons.append(
+                    f"peak pressure {pressure:.3g} Pa exceeds 1.6 x yield strength {strength:.3g} Pa of the {role} "
+                    "(first yield at p0 ≈ 1.6 Y, Johnson 1985): elastic Hertz contact is out of its range")
+    ratio = radius / params.R
+    if ratio > CONTACT_RATIO_LIMIT:
+        reasons.append(f"contact radius {radius:.3g} m is {ratio:.2g} x the effective radius R = {params.R:.3g} m "
+                       f"(> {CONTACT_RATIO_LIMIT:g}): Hertz theory needs a << R")
+    return "; ".join(reasons) if reasons else "ok"
+
+
+def validity(params: Parameters, plate_material: Material | None,
+             projectile_material: Material | None = None) -> str:
+    """Whether elastic Hertz contact holds at the closed-form peak of :func:`hertz_scales`.
+
+    Parameters
+    ----------
+    params : Parameters
+        With the effective radius ``R``.
+    plate_material : Material or None
+        Its ``yield_strength`` ``Y`` (Pa), if given, is checked: ``p0 <= 1.6 Y``.
+    projectile_material : Material, optional
+        The same check for the projectile (a hailstone crushes before the plate yields).
+
+    Returns
+    -------
+    str
+        ``"ok"``, or the reasons (joined by ``"; "``): peak pressure beyond first yield, or a
+        contact radius beyond ``CONTACT_RATIO_LIMIT * R``. Without any yield strength only the
+        geometric check applies.
+    """
+    scales = hertz_scales(params)
+    if scales["peak_pressure"] is None:
+        raise ValueError("R = None: validity needs the effective radius R")
+    return _reasons(scales["peak_pressure"], scales["contact_radius"], params, plate_material, projectile_material)
+
+
+def validity_for_force(force: float, params: Parameters, plate_material: Material | None,
+                       projectile_material: Material | None = None) -> str:
+    """Like :func:`validity`, for an actual peak force ``force`` (N), e.g. from a simulation.
+
+    The pressure is Hertz's ``p0 = 3 F / (2 pi a^2)`` with ``a = (3 F R / (4 E*))^(1/3)``
+    (:func:`hertz_contact`).
+    """
+    contact = hertz_contact(force, params)
+    return _reasons(contact["peak_pressure"], contact["contact_radius"], params, plate_material,
+                    projectile_material)
+

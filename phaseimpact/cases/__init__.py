@@ -1,0 +1,1 @@
+"""Named impact cases shipped with phaseimpact, one TOML file each (see :mod:`phaseimpact.case`)."""

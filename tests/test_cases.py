@@ -1,0 +1,380 @@
+"""Cases, case files, --set settings, Hertz scales and validity (issue 12; REFERENCE §2, §4).
+
+Expected values come from REFERENCE §2 and §4 (printed digits), from the closed forms of Hertz
+impact re-derived here or checked against a numerical integration of ``m delta'' = -K delta^1.5``,
+and from the issue's own estimates for sand on a gelcoat (contact about 0.3 µs, peak pressure
+near 1 GPa, about ten times the gelcoat's compressive strength).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+from scipy.integrate import solve_ivp
+
+from phaseimpact import seed_parameters
+from phaseimpact.case import (
+    CONTACT_RATIO_LIMIT,
+    FIRST_YIELD_FACTOR,
+    SETTABLE,
+    Case,
+    apply_settings,
+    case_from_dict,
+    hertz_contact,
+    hertz_scales,
+    list_cases,
+    load_case,
+    parse_setting,
+    seed_case,
+    validity,
+    validity_for_force,
+)
+from phaseimpact.parameters import STEEL, Geometry, Material, Parameters
+
+CASES_DIR = Path(__file__).resolve().parents[1] / "phaseimpact" / "cases"
+SHIPPED = sorted(p.stem for p in CASES_DIR.glob("*.toml"))
+
+# ---------------------------------------------------------------------------------------------
+# Shipped cases
+# ---------------------------------------------------------------------------------------------
+
+
+def test_the_issue_s_cases_are_shipped():
+    """Issue 12 §3: the seed, sand/dust on gelcoat, LEP coating and laminate, and hail."""
+    assert {"seed", "sand-gelcoat", "sand-lep", "sand-laminate", "hail-laminate"} <= set(SHIPPED)
+    listed = list_cases()
+    assert [c["name"] for c in listed][0] == "seed"
+    assert sorted(c["name"] for c in listed) == SHIPPED
+    assert all(set(c) == {"name", "description", "source"} for c in listed)
+
+
+@pytest.mark.parametrize("name", SHIPPED)
+def test_every_shipped_case_loads_with_sources_and_finite_parameters(name):
+    case = load_case(name)
+    assert case.name == name  # the name in the file is the name load_case takes
+    assert case.description and len(case.source) > 40  # every case cites where its numbers come from
+    p = case.parameters()
+    for key in ("M1", "M2", "K", "Kb", "Km", "v", "R"):
+        value = getattr(p, key)
+        assert math.isfinite(value) and value > 0, key
+    scales = hertz_scales(p, case.plate)
+    assert all(math.isfinite(scales[k]) and scales[k] > 0 for k in
+               ("contact_time", "indentation", "peak_force", "contact_radius", "peak_pressure"))
+    assert isinstance(validity(p, case.plate, case.projectile), str)
+
+
+@pytest.mark.parametrize("name", [n for n in SHIPPED if n != "seed"])
+def test_assumed_values_are_marked_in_the_source(name):
+    """Issue 12 §3: 'mark assumed values' (in the source text as well as in comments)."""
+    assert "assumed" in load_case(name).source.lower()
+
+
+def test_seed_case_is_reference_section_2():
+    """REFERENCE §2: the seed file, the programmatic seed case and seed_parameters() agree."""
+    case = load_case("seed")
+    assert case == seed_case()
+    assert case.parameters() == seed_parameters()
+    p = case.parameters()
+    assert f"{p.M1:.6f}" == "0.263056" and f"{p.K:.5e}" == "2.17570e+10"
+    assert case.impact == {"v": 1.0, "kappa": 0.0, "target": "plate", "law": "paper", "contact": "printed",
+                           "restitution": None}
+
+
+def test_case_parameters_overrides():
+    """Case.parameters(**overrides): v, kappa, target, geometry and dotted material names win."""
+    case = load_case("seed")
+    p = case.parameters(v=5.0, kappa=1e9, target="rigid", R1=0.01, **{"plate.E": 7e10})
+    q = seed_parameters(5.0, kappa=1e9, target="rigid", R1=0.01, plate_E=7e10)
+    assert p == q
+    assert p.M1 == pytest.approx(case.parameters().M1 / 8, rel=1e-14)  # M1 ∝ R1^3
+    with pytest.raises(ValueError, match="unknown parameter 'G'"):
+        case.parameters(G=1.0)
+
+
+# ---------------------------------------------------------------------------------------------
+# TOML round trip and bad files
+# ---------------------------------------------------------------------------------------------
+
+def _custom_case() -> Case:
+    return Case(name="custom \"quoted\" ünïcode", description="tab\there", source="line1\nline2 \\ backslash",
+                projectile=Material(E=np.float32(7e10), nu=np.int64(0), rho=2700),
+                plate=Material(E=3e9, nu=0.35, rho=1200.0, yield_strength=8e7),
+                geometry=Geometry(a=0.2, h=0.002, R1=1e-4, R2=0.5),
+                impact={"v": 42, "kappa": 1e6, "target": "free", "law": "hunt-crossley", "contact": "unilateral",
+                        "restitution": 0.5})
+
+
+@pytest.mark.parametrize("case", [load_case(n) for n in SHIPPED] + [_custom_case()], ids=SHIPPED + ["custom"])
+def test_toml_round_trip(case, tmp_path):
+    """as_dict -> TOML -> load_case gives an equal case; as_dict is plain JSON."""
+    path = case.save(tmp_path / "case.toml")
+    assert load_case(path) == case
+    assert load_case(str(path)) == case
+    data = json.loads(json.dumps(case.as_dict()))
+    assert case_from_dict(data) == case
+
+
+def test_numbers_are_stored_as_plain_floats():
+    case = _custom_case()
+    assert type(case.projectile.E) is float and type(case.projectile.nu) is float
+    assert type(case.impact["v"]) is float and case.impact["v"] == 42.0
+
+
+def test_defaults_of_optional_keys_and_name_from_the_file(tmp_path):
+    path = tmp_path / "my-case.toml"
+    path.write_text(_seed_text().replace('name = "seed"\n', ""), encoding="utf-8")
+    case = load_case(path)
+    assert case.name == "my-case"
+    assert case.impact["kappa"] == 0.0 and case.impact["contact"] == "printed" and case.impact["restitution"] is None
+
+
+def _seed_text() -> str:
+    return (CASES_DIR / "seed.toml").read_text(encoding="utf-8")
+
+
+def _replace_line(text: str, table: str, key: str, new: str | None) -> str:
+    """Replace (or, with ``new=None``, delete) line ``key = ...`` inside ``[table]``."""
+    lines, current = text.splitlines(), ""
+    for i, line in enumerate(lines):
+        if line.startswith("["):
+            current = line.split("]")[0][1:]
+        elif current == table and line.split("=")[0].strip() == key:
+            lines[i:i + 1] = [] if new is None else [new]
+            return "\n".join(lines) + "\n"
+    raise AssertionError(f"{table}.{key} not in the seed file")
+
+
+def _drop_table(text: str, table: str) -> str:
+    out, skip = [], False
+    for line in text.splitlines():
+        if line.startswith("["):
+            skip = line.startswith(f"[{table}]")
+        if not skip:
+            out.append(line)
+    return "\n".join(out) + "\n"
+
+
+BAD_FILES = {
+    "unknown key": (lambda t: t.replace("[plate]", "[plate]\nG = 8e10", 1), ["'plate.G'", "E, nu, rho"]),
+    "unknown top-level key": (lambda t: "speed = 3.0\n" + t, ["'speed'"]),
+    "unknown table": (lambda t: t + "\n[damping]\nkappa = 1.0\n", ["'damping'"]),
+    "missing [plate]": (lambda t: _drop_table(t, "plate"), ["[plate]"]),
+    "missing plate.E": (lambda t: _replace_line(t, "plate", "E", None), ["'plate.E'"]),
+    "missing geometry.h": (lambda t: _replace_line(t, "geometry", "h", None), ["'geometry.h'", "> 0"]),
+    "missing impact.v": (lambda t: _replace_line(t, "impact", "v", None), ["'impact.v'"]),
+    "nu = 0.7": (lambda t: _replace_line(t, "plate", "nu", "nu = 0.7"), ["plate.nu = 0.7", "0 <= nu < 0.5"]),
+    "E = -1": (lambda t: _replace_line(t, "projectile", "E", "E = -1"), ["projectile.E = -1", "> 0"]),
+    "E a string": (lambda t: _replace_line(t, "plate", "E", 'E = "2e11"'), ["plate.E = '2e11'", "wrong type"]),
+    "E a boolean": (lambda t: _replace_line(t, "plate", "E", "E = true"), ["plate.E = True", "wrong type"]),
+    "R1 = 0": (lambda t: _replace_line(t, "geometry", "R1", "R1 = 0.0"), ["geometry.R1 = 0.0", "> 0"]),
+    "yield_strength = 0": (lambda t: t.replace("[plate]", "[plate]\nyield_strength = 0.0", 1),
+                           ["plate.yield_strength = 0.0", "> 0"]),
+    "v = nan": (lambda t: _replace_line(t, "impact", "v", "v = nan"), ["impact.v = nan", "> 0"]),
+    "target": (lambda t: t + 'target = "wall"\n', ["impact.target = 'wall'", "plate, rigid, free"]),
+    "contact": (lambda t: t + 'contact = "both"\n', ["impact.contact = 'both'", "printed, unilateral"]),
+    "law": (lambda t: t + 'law = "newton"\n', ["impact.law = 'newton'", "paper"]),
+    "restitution": (lambda t: t + "restitution = 1.5\n", ["impact.restitution = 1.5", "0 < e <= 1"]),
+    "kappa < 0": (lambda t: t + "kappa = -1.0\n", ["impact.kappa = -1.0", ">= 0"]),
+    "name not a string": (lambda t: t.replace('name = "seed"', "name = 3"), ["name = 3", "wrong type"]),
+    "table not a table": (lambda t: "geometry = 1.0\n" + _drop_table(t, "geometry"), ["geometry = 1.0"]),
+    "syntax error": (lambda t: t.replace("E = 2.1e11", "E = 2.1e11 Pa", 1), ["TOML syntax error", "line"]),
+}
+
+
+@pytest.mark.parametrize("label", list(BAD_FILES))
+def test_bad_case_file_raises_naming_file_key_value_and_range(label, tmp_path):
+    edit, expected = BAD_FILES[label]
+    path = tmp_path / "bad.toml"
+    path.write_text(edit(_seed_text()), encoding="utf-8")
+    with pytest.raises(ValueError) as info:
+        load_case(path)
+    message = str(info.value)
+    assert message.startswith(str(path) + ":")
+    for part in expected:
+        assert part in message, (part, message)
+
+
+def test_unknown_name_and_missing_file():
+    with pytest.raises(ValueError, match="unknown case 'granite'.*sand-gelcoat"):
+        load_case("granite")
+    with pytest.raises(ValueError, match="nowhere.toml: cannot read"):
+        load_case("nowhere.toml")
+
+
+# ---------------------------------------------------------------------------------------------
+# --set NAME=VALUE
+# ---------------------------------------------------------------------------------------------
+
+def test_settable_names_are_the_issue_s_list_with_units():
+    """Issue 12 §1 (+ plate.yield_strength and v): every name with an SI unit for --help."""
+    assert list(SETTABLE) == ["projectile.E", "projectile.nu", "projectile.rho", "plate.E", "plate.nu", "plate.rho",
+                              "plate.yield_strength", "a", "h", "R1", "R2", "v"]
+    assert SETTABLE["plate.E"][0] == "Pa" and SETTABLE["R1"][0] == "m" and SETTABLE["v"][0] == "m/s"
+
+
+def test_settings_apply_and_leave_the_rest():
+    case = seed_case()
+    new = case.with_settings(["plate.E=1e9", "R1 = 0.001", "v=13", "plate.yield_strength=2.5e8", "R1=0.002"])
+    assert new.plate.E == 1e9 and new.plate.yield_strength == 2.5e8 and new.plate.nu == case.plate.nu
+    assert new.geometry.R1 == 0.002  # the later setting wins
+    assert new.impact["v"] == 13.0 and new.impact["law"] == case.impact["law"]
+    assert (new.projectile, new.geometry.a, new.geometry.h, new.geometry.R2) == (
+        case.projectile, case.geometry.a, case.geometry.h, case.geometry.R2)
+    assert apply_settings(case, {"plate.E": "1e9", "a": 0.2}) == dataclasses.replace(
+        case, plate=dataclasses.replace(case.plate, E=1e9), geometry=dataclasses.replace(case.geometry, a=0.2))
+    assert parse_setting("projectile.rho=2650") == ("projectile.rho", 2650.0)
+
+
+@pytest.mark.parametrize(("setting", "expected"), [
+    ("plate.G=1e9", ["unknown setting 'plate.G'", "projectile.E (Pa)", "R2 (m)"]),
+    ("kappa=1e9", ["unknown setting 'kappa'"]),
+    ("R1=abc", ["R1 = 'abc' is not a number", "m"]),
+    ("plate.E", ["NAME=VALUE", "plate.nu"]),
+    ("plate.nu=0.7", ["plate.nu = 0.7", "0 <= nu < 0.5"]),
+    ("plate.E=-1", ["plate.E = -1.0", "> 0"]),
+    ("h=0", ["h = 0.0", "> 0"]),
+    ("v=inf", ["v = inf", "> 0"]),
+    ("plate.yield_strength=0", ["plate.yield_strength = 0.0", "> 0"]),
+])
+def test_bad_settings_raise_naming_the_setting(setting, expected):
+    with pytest.raises(ValueError) as info:
+        seed_case().with_settings([setting])
+    for part in expected:
+        assert part in str(info.value), (part, str(info.value))
+
+
+# ---------------------------------------------------------------------------------------------
+# Hertz closed forms (REFERENCE §4)
+# ---------------------------------------------------------------------------------------------
+
+def _numerical_hertz(m: float, K: float, v: float) -> tuple[float, float]:
+    """Contact time and largest indentation of m delta'' = -K delta^1.5 from delta = 0, delta' = v,
+    integrated to the turning point (time-symmetric: T = 2 t_max)."""
+    def turning(t, y):
+        return y[1]
+    turning.terminal, turning.direction = True, -1
+    t_scale = (m / K) ** 0.4 * v ** -0.2  # Hertz time scale
+    sol = solve_ivp(lambda t, y: [y[1], -K / m * max(y[0], 0.0) ** 1.5], (0, 10 * t_scale), [0.0, v],
+                    events=turning, rtol=1e-12, atol=[1e-16 * v * t_scale, 1e-16 * v], method="DOP853")
+    return 2 * sol.t_events[0][0], sol.y_events[0][0][0]
+
+
+def test_seed_projectile_on_rigid_target_reference_section_4():
+    """REFERENCE §4: seed projectile at 1 m/s on a rigid target: delta_max = 4.69617e-5 m, T = 1.38221e-4 s."""
+    p = seed_parameters(target="rigid")
+    s = hertz_scales(p)
+    assert f"{s['indentation']:.5e}" == "4.69617e-05"
+    assert f"{s['contact_time']:.5e}" == "1.38221e-04"
+    # T = 3.218065... (m^2/(K^2 v))^(1/5) with m = M1 (REFERENCE §4)
+    assert s["contact_time"] == pytest.approx(3.218065 * (p.M1**2 / (p.K**2 * p.v)) ** 0.2, rel=3e-7)
+    assert s["plate_period"] == math.inf
+    assert s["peak_force"] == pytest.approx(p.K * s["indentation"] ** 1.5, rel=1e-14)
+
+
+def test_seed_plate_period():
+    """REFERENCE §4: target period 2 pi sqrt(M2/Kb) about 1.0e-3 s for the seed."""
+    p = seed_parameters()
+    assert hertz_scales(p)["plate_period"] == pytest.approx(2 * math.pi * math.sqrt(p.M2 / p.Kb), rel=1e-14)
+    assert 0.95e-3 < hertz_scales(p)["plate_period"] < 1.05e-3
+
+
+def test_sand_grain_on_rigid_target_matches_integration():
+    """Issue 12 §6: a 100 µm quartz grain at 90 m/s on a rigid target: contact ~1e-7 s; the closed
+    forms agree with a direct integration of the Hertz impact to 1e-8."""
+    p = load_case("sand-gelcoat").parameters(target="rigid")
+    s = hertz_scales(p)
+    assert 1e-7 < s["contact_time"] < 1e-6
+    T, delta = _numerical_hertz(p.M1, p.K, p.v)
+    assert s["contact_time"] == pytest.approx(T, rel=1e-8)
+    assert s["indentation"] == pytest.approx(delta, rel=1e-8)
+
+
+def test_contact_radius_and_pressure_are_hertz():
+    """Johnson 1985 eq. 4.22-4.24: a0 = sqrt(R delta), p0 = 3F/(2 pi a0^2) = (2/pi) E* a0/R, with
+    E* = 1/eta from the materials (REFERENCE §2, eq. 4)."""
+    case = load_case("sand-gelcoat")
+    p = case.parameters()
+    s = hertz_scales(p)
+    R = case.geometry.R1 * case.geometry.R2 / (case.geometry.R1 + case.geometry.R2)
+    e_star = 1 / ((1 - case.projectile.nu**2) / case.projectile.E + (1 - case.plate.nu**2) / case.plate.E)
+    assert s["contact_radius"] == pytest.approx(math.sqrt(R * s["indentation"]), rel=1e-12)
+    assert s["peak_pressure"] == pytest.approx(2 / math.pi * e_star * s["contact_radius"] / R, rel=1e-12)
+    again = hertz_contact(s["peak_force"], p)  # a = (3 F R / (4 E*))^(1/3) gives the same contact
+    assert again["contact_radius"] == pytest.approx(s["contact_radius"], rel=1e-12)
+    assert again["peak_pressure"] == pytest.approx(s["peak_pressure"], rel=1e-12)
+    assert hertz_contact(0.0, p) == {"contact_radius": 0.0, "peak_pressure": 0.0}
+
+
+def test_sand_on_gelcoat_numbers_of_the_issue():
+    """Issue 12 'Why': sand on gelcoat at 90 m/s: contact about 0.3 µs, p0 near 1 GPa, about ten
+    times the gelcoat's compressive strength (IEA-15-240-RWT Xc = 87 MPa)."""
+    case = load_case("sand-gelcoat")
+    s = hertz_scales(case.parameters(), case.plate)
+    assert 0.2e-6 < s["contact_time"] < 0.5e-6
+    assert 0.5e9 < s["peak_pressure"] < 2e9
+    assert 5 < s["peak_pressure"] / case.plate.yield_strength < 20
+    assert s["first_yield_pressure"] == FIRST_YIELD_FACTOR * 8.7e7
+
+
+def test_scales_without_radius_leave_pressure_out():
+    p = Parameters(M1=0.26, M2=0.31, K=2.2e10, Kb=1.2e7, Km=1.7e11)
+    s = hertz_scales(p)
+    assert s["contact_radius"] is None and s["peak_pressure"] is None and s["contact_time"] > 0
+    with pytest.raises(ValueError, match="R = None"):
+        validity(p, STEEL)
+
+
+# ---------------------------------------------------------------------------------------------
+# Validity
+# ---------------------------------------------------------------------------------------------
+
+def test_validity_sand_on_gelcoat_is_out_of_range():
+    case = load_case("sand-gelcoat")
+    verdict = validity(case.parameters(), case.plate, case.projectile)
+    assert verdict != "ok"
+    assert "exceeds 1.6 x yield strength 8.7e+07 Pa of the target" in verdict and "Johnson" in verdict
+
+
+def test_validity_seed_is_ok():
+    """The seed gives no yield strength; its contact radius is about 0.05 R (REFERENCE §2 geometry)."""
+    case = seed_case()
+    assert validity(case.parameters(), case.plate, case.projectile) == "ok"
+
+
+def test_validity_flags_a_soft_coating_by_geometry():
+    """Sand on the PU coating: no yield strength, but the contact radius is about R (Hertz needs a << R)."""
+    case = load_case("sand-lep")
+    verdict = validity(case.parameters(), case.plate)
+    assert "Hertz theory needs a << R" in verdict and "yield" not in verdict
+    assert hertz_scales(case.parameters())["contact_radius"] > CONTACT_RATIO_LIMIT * case.geometry.R1
+
+
+def test_validity_for_force_threshold():
+    """p0 = 3F/(2 pi a^2) with a = (3FR/(4E*))^(1/3), so p0^3 ∝ F: the force at p0 = 1.6 Y is exact,
+    and the verdict flips across it (seed geometry, plate yield strength 250 MPa assumed)."""
+    case = seed_case().with_settings(["plate.yield_strength=2.5e8"])
+    p = case.parameters()
+    e_star = 3 * p.K / (4 * math.sqrt(p.R))
+    p_limit = FIRST_YIELD_FACTOR * 2.5e8
+    f_limit = (p_limit * 2 * math.pi / 3) ** 3 * (3 * p.R / (4 * e_star)) ** 2  # from p0^3 = (3/(2 pi))^3 F (4E*/3R)^2
+    assert hertz_contact(f_limit, p)["peak_pressure"] == pytest.approx(p_limit, rel=1e-12)
+    assert validity_for_force(0.99 * f_limit, p, case.plate) == "ok"
+    assert "yield strength 2.5e+08 Pa of the target" in validity_for_force(1.01 * f_limit, p, case.plate)
+    assert validity_for_force(0.0, p, case.plate) == "ok"
+    # The seed at 1 m/s is far beyond first yield of such a steel (p0 ≈ 3 GPa).
+    assert validity(p, case.plate) != "ok"
+    with pytest.raises(ValueError, match="force = -1.0"):
+        validity_for_force(-1.0, p, case.plate)
+
+
+def test_validity_checks_the_projectile_too():
+    """A hailstone (ice, compressive strength 5.9 MPa) crushes long before elastic Hertz contact ends."""
+    case = load_case("hail-laminate")
+    verdict = validity(case.parameters(), case.plate, case.projectile)
+    assert "of the projectile" in verdict
+    assert "of the projectile" not in validity(case.parameters(), case.plate)
