@@ -581,14 +581,13 @@ def _reasons(pressure: float, radius: float, params: Parameters, plate_material,
         if material is not None and material.yield_strength is not None:
             strength = material.yield_strength
             if pressure > FIRST_YIELD_FACTOR * strength:
-                reasons.append(
-                    f"peak pressure {pressure:.3g} Pa exceeds 1.6 x yield strength {strength:.3g} Pa of the {role} "
-                    "(first yield at p0 ≈ 1.6 Y, Johnson 1985): elastic Hertz contact is out of its range")
+                reasons.append(f"peak pressure {pressure:.3g} Pa exceeds 1.6 x yield strength {strength:.3g} Pa "
+                               f"of the {role} (first yield at p0 ≈ 1.6 Y, Johnson 1985)")
     ratio = radius / params.R
     if ratio > CONTACT_RATIO_LIMIT:
-        reasons.append(f"contact radius {radius:.3g} m is {ratio:.2g} x the effective radius R = {params.R:.3g} m "
-                       f"(> {CONTACT_RATIO_LIMIT:g}): Hertz theory needs a << R")
-    return "; ".join(reasons) if reasons else "ok"
+        reasons.append(f"contact radius {radius:.3g} m is {ratio:.2g} R (Hertz needs a << R; limit "
+                       f"{CONTACT_RATIO_LIMIT:g} R)")
+    return "; ".join(reasons) + ": elastic Hertz contact is out of its range" if reasons else "ok"
 
 
 def validity(params: Parameters, plate_material: Material | None,

@@ -58,7 +58,7 @@ def require_nonnegative(name: str, value) -> None:
 
 
 def require_choice(name: str, value, choices) -> None:
-    require(name, value, "one of " + ", ".join(map(str, choices)), isinstance(value, str) and value in choices)
+    require(name, value, "one of " + ", ".join(map(str, choices)), value in choices)
 
 
 def is_number(value) -> bool:
