@@ -19,34 +19,24 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.special import gamma
 
-from .integrate import Trajectory
-from .model import V1, V2, X1, X2, ContactLaw, as_law, coefficients, jacobian, rhs, target_spring_force
+from .integrate import Trajectory, scales
+from .model import V1, V2, X1, X2, ContactLaw, as_law, jacobian, pack
+from .model.rhs import KB_, KM_, rhs
 from .parameters import Parameters
 
 __all__ = [
     "PLANES",
-    "OUTCOMES",
     "AsymptoticPoints",
-    "Outcome",
     "FixedPoint",
     "EquilibriumSet",
     "find_asymptotic_points",
-    "classify_outcome",
     "fixed_points",
     "plane_coordinates",
-    "hertz_contact_time",
+    "phase_portrait",
 ]
 
 PLANES = (("delta", "deltadot"), ("x1", "x1dot"), ("x2", "x2dot"))
-OUTCOMES = ("rest", "stick", "rebound", "bounded-oscillation", "runaway", "failed")
-_TAU = math.sqrt(math.pi) * gamma(7 / 5) / gamma(9 / 10)  # REFERENCE §4
-
-
-def hertz_contact_time(params: Parameters) -> float:
-    """Undamped Hertz contact time of the impact (REFERENCE §4), the system's fastest scale, s."""
-    return 2 * _TAU * params.hertz_indentation / params.v
 
 
 def plane_coordinates(y: np.ndarray, plane) -> tuple[np.ndarray, np.ndarray]:
@@ -121,7 +111,7 @@ def find_asymptotic_points(trajectory: Trajectory, plane=("delta", "deltadot"), 
     if not (math.isfinite(tol) and 0 < tol < 1):
         raise ValueError(f"tol = {tol!r} is out of range; allowed: 0 < tol < 1")
     if min_dwell is None:
-        min_dwell = 0.01 * hertz_contact_time(trajectory.params)
+        min_dwell = 0.01 * scales(trajectory.params).contact_time
     event_driven = not trajectory.integrator.startswith("rk4")
     if method is None:
         method = "events" if event_driven and plane == PLANES[0] else "distance"
@@ -143,20 +133,8 @@ def find_asymptotic_points(trajectory: Trajectory, plane=("delta", "deltadot"), 
 
 def _stick_points(trajectory: Trajectory):
     """Stick phases of an event-driven run: ``(delta*, 0)`` and how long each lasted."""
-    points, dwell = [], []
-    start = None
-    for event in trajectory.events:
-        if event.kind == "stick":
-            start = event
-        elif event.kind == "slip" and start is not None:
-            points.append((start.delta, 0.0))
-            dwell.append(event.t - start.t)
-            start = None
-    if start is not None:
-        lasts_to = trajectory.t_end if (trajectory.settled or trajectory.ok) else trajectory.t_stop
-        points.append((start.delta, 0.0))
-        dwell.append(lasts_to - start.t)
-    return np.array(points, dtype=float).reshape(-1, 2), np.array(dwell, dtype=float)
+    _, delta, dwell = trajectory.stick_points()
+    return np.column_stack([delta, np.zeros_like(delta)]), dwell
 
 
 def _rest_runs(trajectory: Trajectory, plane, tol: float):
@@ -184,45 +162,6 @@ def _rest_runs(trajectory: Trajectory, plane, tol: float):
             merged_dwell.append(d)
     points = np.array(merged, dtype=float).reshape(-1, 2) * scale
     return points, np.array(merged_dwell, dtype=float)
-
-
-@dataclass(frozen=True)
-class Outcome:
-    """The long-time outcome of one trajectory (REFERENCE §5).
-
-    ``kind`` is one of :data:`OUTCOMES`; ``n_stick`` the number of asymptotic (stick) points
-    in the relative plane; ``message`` a readable reason.
-    """
-
-    kind: str
-    n_stick: int
-    message: str
-
-
-def classify_outcome(trajectory: Trajectory, points: AsymptoticPoints | None = None) -> Outcome:
-    """Classify how ``trajectory`` ends: rest, stick, rebound, bounded oscillation, runaway."""
-    if points is None:
-        method = "events" if not trajectory.integrator.startswith("rk4") else "distance"
-        points = (find_asymptotic_points(trajectory, method=method)
-                  if method == "events" or len(trajectory.t) > 1 else None)
-    n = len(points) if points is not None else 0
-    if trajectory.status == "runaway":
-        return Outcome("runaway", n, trajectory.message)
-    if not trajectory.ok:
-        return Outcome("failed", n, f"{trajectory.status}: {trajectory.message}")
-    p, y = trajectory.params, trajectory.final_state
-    law = trajectory.law
-    delta, deltadot = y[X1] - y[X2], y[V1] - y[V2]
-    resting = (abs(y[V1]) + abs(y[V2]) <= 1e-9 * p.v
-               and (p.target != "plate" or abs(y[X2]) <= 1e-9 * max(abs(delta), 1e-12)))
-    if law.is_filippov and trajectory.final_mode == 0:
-        kind = "rest" if resting else "stick"
-        return Outcome(kind, n, f"stuck at delta = {delta:.6g} m ({n} stick point(s))")
-    if law.is_unilateral and delta <= 0 and (trajectory.settled or deltadot < 0):
-        return Outcome("rebound", n, f"projectile separated, receding at {deltadot:.6g} m/s relative")
-    if resting:
-        return Outcome("rest", n, "at rest")
-    return Outcome("bounded-oscillation", n, "still moving at t_end with bounded energy")
 
 
 @dataclass(frozen=True)
@@ -268,7 +207,7 @@ def fixed_points(params: Parameters, law: ContactLaw | str = "paper", *,
     of ``paper`` (``delta`` arbitrary, frozen), and the translations of a free target.
     """
     law = as_law(law)
-    c = coefficients(params, law)
+    c = pack(params, law)
     scale = params.hertz_indentation
     mode = 0 if law.is_filippov else 1
     found: list = []
@@ -279,8 +218,8 @@ def fixed_points(params: Parameters, law: ContactLaw | str = "paper", *,
         for x1, x2 in starts:
             y = np.array([x1, x2, 0.0, 0.0, 0.0])
             for _ in range(100):
-                f = rhs(y, c, law, mode)[:4]
-                J = jacobian(y, c, law, mode)
+                f = _rhs(y, c, law, mode)
+                J = jacobian(y, params, law, mode)
                 try:
                     dy = np.linalg.lstsq(J, -f, rcond=None)[0]
                 except np.linalg.LinAlgError:
@@ -288,7 +227,7 @@ def fixed_points(params: Parameters, law: ContactLaw | str = "paper", *,
                 y[:4] += dy
                 if np.max(np.abs(dy[:2])) <= tol * scale:
                     break
-            if np.all(np.abs(rhs(y, c, law, mode)[:4]) <= 1e-6 * (1 + abs(float(target_spring_force(scale, c))))):
+            if np.all(np.abs(_rhs(y, c, law, mode)) <= 1e-6 * (1 + abs((c[KB_] + c[KM_] * scale**2) * scale))):
                 if not any(abs(y[X2] - r) <= 1e-9 * scale for r in roots):
                     roots.append(float(y[X2]))
         for x2 in roots:
@@ -298,6 +237,12 @@ def fixed_points(params: Parameters, law: ContactLaw | str = "paper", *,
     return found
 
 
+def _rhs(y, c, law, mode):
+    out = np.empty(5)
+    rhs(law.code, c, y, mode, out)
+    return out[:4]
+
+
 def _equilibria_at(x2, params, c, law, scale):
     """The equilibria with the target at ``x2``: a point or a set, with eigenvalues."""
     deltas = np.linspace(-2 * scale, 2 * scale, 5)
@@ -305,18 +250,43 @@ def _equilibria_at(x2, params, c, law, scale):
     where = f"at x2 = {x2:g} m" if params.target != "free" else "with any x2 (free target)"
     if law.is_filippov:
         y = np.array([x2 + scale, x2, 0.0, 0.0, 0.0])
-        J = jacobian(y, c, law, 0)
+        J = jacobian(y, params, law, 0)
         eig = np.linalg.eigvals(J)
         return [EquilibriumSet(f"stick set: any frozen delta, both at rest, target {where}", members,
                                eig, _stability(eig))]
     if law.is_unilateral:
         y = np.array([x2 - scale, x2, 0.0, 0.0, 0.0])
-        J = jacobian(y, c, law, 1)
+        J = jacobian(y, params, law, 1)
         eig = np.linalg.eigvals(J)
         separated = members[deltas <= 0]
         return [EquilibriumSet(f"separated states: delta <= 0, both at rest, target {where}", separated,
                                eig, _stability(eig))]
     y = np.array([x2, x2, 0.0, 0.0, 0.0])
-    J = jacobian(y, c, law, 1)
+    J = jacobian(y, params, law, 1)
     eig = np.linalg.eigvals(J)
     return [FixedPoint(y[:4].copy(), eig, _stability(eig))]
+
+
+def phase_portrait(params: Parameters, law: ContactLaw | str, kappas=None, *, speeds=None, states=None,
+                   t_end: float | None = None, save="steps", rtol: float = 1e-10) -> list[Trajectory]:
+    """A family of trajectories to draw in any plane: one per ``kappa`` (seed eq. 6 each), per
+    impact speed, or per initial state ``(x1, x2, x1dot, x2dot)`` (exactly one of the three).
+
+    Each keeps its steps (or the times in ``save``) and its events, so
+    ``plane_coordinates(tr.y, plane)`` and ``tr.events`` draw it.
+    """
+    from .integrate import simulate
+
+    law = as_law(law)
+    given = [x is not None for x in (kappas, speeds, states)]
+    if sum(given) != 1:
+        raise ValueError("give exactly one of kappas, speeds= or states=")
+    if kappas is not None:
+        return [simulate(params.replace(kappa=float(k)), law, t_end, save=save, rtol=rtol)
+                for k in np.atleast_1d(kappas)]
+    if speeds is not None:
+        return [simulate(params.replace(v=float(v)), law, t_end, save=save, rtol=rtol) for v in np.atleast_1d(speeds)]
+    states = np.atleast_2d(np.asarray(states, dtype=float))
+    if states.shape[1] != 4 or not np.all(np.isfinite(states)):
+        raise ValueError("states are out of range; allowed: finite rows (x1, x2, x1dot, x2dot)")
+    return [simulate(params, law, t_end, save=save, rtol=rtol, initial=s) for s in states]

@@ -9,7 +9,6 @@ from __future__ import annotations
 from dataclasses import asdict, dataclass
 
 from .integrate import Trajectory
-from .model import WORK, coefficients, energy, initial_state
 
 __all__ = ["ImpactQuantities", "impact_quantities"]
 
@@ -31,7 +30,8 @@ class ImpactQuantities:
     time_equal_displacement : float or None
         First time after contact begins with ``x1 = x2``, s.
     dissipated_energy : float
-        Initial minus final mechanical energy, J.
+        Initial minus final mechanical energy of the run (REFERENCE §4), J. For ``paper`` the
+        elastic term has no potential, so the plastic stick's loss is counted.
     loop_area : float
         ``integral of P d(delta)`` over the run, J: the area of the force-indentation loop
         (equal to the dissipated energy whenever the run ends out of contact).
@@ -50,27 +50,19 @@ class ImpactQuantities:
 
 
 def impact_quantities(trajectory: Trajectory) -> ImpactQuantities:
-    """Derive :class:`ImpactQuantities` from ``trajectory``."""
-    c = coefficients(trajectory.params, trajectory.law)
-    contacts = trajectory.events_of("contact")
-    separations = trajectory.events_of("separation")
-    first_contact = contacts[0] if contacts else None
-    first_separation = next((e for e in separations if first_contact and e.t > first_contact.t), None)
-    duration = restitution = t_equal = None
-    if first_contact is not None and first_separation is not None:
-        duration = first_separation.t - first_contact.t
-        t_equal = first_separation.t
-        if first_contact.deltadot != 0:
-            restitution = -first_separation.deltadot / first_contact.deltadot
-    y0 = initial_state(trajectory.params.v)
-    law = trajectory.law
-    dissipated = float(energy(y0, c, law) - energy(trajectory.final_state, c, law))
+    """Derive :class:`ImpactQuantities` from ``trajectory`` (its summary; energies from its own
+    initial state, REFERENCE §4)."""
+    duration = trajectory.contact_duration
+    t_equal = None
+    if duration is not None:
+        first_contact = trajectory.events_of("contact")[0]
+        t_equal = first_contact.t + duration
     return ImpactQuantities(
         max_force=trajectory.max_force,
         max_indentation=trajectory.max_indentation,
         contact_duration=duration,
-        restitution=restitution,
+        restitution=trajectory.restitution,
         time_equal_displacement=t_equal,
-        dissipated_energy=dissipated,
-        loop_area=float(trajectory.final_state[WORK]),
+        dissipated_energy=trajectory.dissipated_energy,
+        loop_area=trajectory.loop_area,
     )

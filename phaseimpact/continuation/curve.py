@@ -1,0 +1,173 @@
+"""Two-parameter continuation: ``kappa_c``, ``kappa_2`` or a grazing value against a second
+parameter (``v``, or any quantity of either body or the geometry).
+
+Natural-parameter continuation of the defining function with step control: each point is
+predicted from the previous ones (secant in log-log), corrected by Brent's method on a
+bracket around the prediction, and where the prediction is poor the step is halved (the
+intermediate points are computed and kept, flagged as not asked for).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.optimize import brentq
+from tqdm.auto import tqdm
+
+from ..case import Case
+from ..model.laws import ContactLaw, as_law
+from ..parameters import Parameters
+from .transition import closed_form_kappa_c, critical_damping, first_stick_margin, flight_maximum, locate_kappa_2
+
+__all__ = ["CriticalCurve", "critical_curve", "CURVE_QUANTITIES"]
+
+CURVE_QUANTITIES = ("kappa_c", "kappa_2", "grazing")
+
+
+@dataclass(frozen=True)
+class CriticalCurve:
+    """A continued curve: ``values`` of ``param`` and the located ``kappa`` at each.
+
+    Attributes
+    ----------
+    param : str
+        The second parameter's name (``v``, ``R1``, ``plate.E``...).
+    values : ndarray
+        Its values (asked for and intermediate ones), increasing along the walk.
+    kappa : ndarray
+        The continued quantity (``what``), NaN where it could not be continued.
+    requested : ndarray of bool
+        Which values were asked for.
+    closed_form : ndarray
+        REFERENCE §5's closed-form ``kappa_c`` (``paper``), NaN otherwise.
+    predicted : ndarray
+        The predictor's value at each point (how good the continuation's steps were).
+    what : str
+        ``kappa_c``, ``kappa_2`` or ``grazing`` (with ``contact_index``).
+    law, base, rtol
+    """
+
+    param: str
+    values: np.ndarray
+    kappa: np.ndarray
+    requested: np.ndarray
+    closed_form: np.ndarray
+    predicted: np.ndarray
+    what: str
+    law: ContactLaw
+    base: Parameters | Case
+    rtol: float
+    contact_index: int = 1
+    message: str = ""
+
+    @property
+    def kappa_c(self) -> np.ndarray:
+        return self.kappa
+
+    @property
+    def v(self) -> np.ndarray:
+        return self.values
+
+
+def _parameters(base, param, value) -> Parameters:
+    if isinstance(base, Case):
+        return base.parameters(**{param: float(value)})
+    return base.replace(**{param: float(value)})
+
+
+def critical_curve(base: Parameters | Case, law: ContactLaw | str, param: str, values, *,
+                   what: str = "kappa_c", rtol: float = 1e-10, integrator_rtol: float = 1e-10,
+                   contact_index: int = 1, kappa_start: float | None = None, max_halvings: int = 6,
+                   progress: bool = False) -> CriticalCurve:
+    """Continue ``what`` over ``values`` of ``param`` (see the module docstring)."""
+    law = as_law(law)
+    if what not in CURVE_QUANTITIES:
+        raise ValueError(f"what = {what!r} is out of range; allowed: one of {', '.join(CURVE_QUANTITIES)}")
+    if what in ("kappa_c", "kappa_2") and not law.is_filippov:
+        raise ValueError(f"what = {what!r} needs law 'paper'; unilateral laws continue 'grazing'")
+    if what == "grazing" and law.is_filippov and law.contact == "printed":
+        raise ValueError("what = 'grazing' needs a unilateral law")
+    if param == "kappa":
+        raise ValueError("param = 'kappa' is out of range; allowed: any other parameter (kappa is continued)")
+    values = np.asarray(values, dtype=float)
+    if values.ndim != 1 or values.size == 0 or not np.all(np.isfinite(values)) or np.any(np.diff(values) == 0):
+        raise ValueError("values are out of range; allowed: a non-empty 1-d array of distinct finite numbers")
+    _parameters(base, param, values[0]), _parameters(base, param, values[-1])  # both ends valid: check first
+
+    def defining(p: Parameters, quantity: str):
+        """The smooth function whose root in log(kappa) is the quantity (kappa_2 rides on kappa_c)."""
+        if quantity == "grazing":
+            return lambda x: flight_maximum(p.replace(kappa=math.exp(x)), law, contact_index, rtol=integrator_rtol)
+        return lambda x: first_stick_margin(p.replace(kappa=math.exp(x)), law, rtol=integrator_rtol)
+
+    def correct(p: Parameters, guess: float, width: float) -> float | None:
+        """Corrector: the root of the defining function within ``guess * exp(+-width)``."""
+        f = defining(p, "grazing" if what == "grazing" else "kappa_c")
+        lo, hi = math.log(guess) - width, math.log(guess) + width
+        f_lo, f_hi = f(lo), f(hi)
+        if not (math.isfinite(f_lo) and math.isfinite(f_hi)) or (f_lo > 0) == (f_hi > 0):
+            return None
+        return math.exp(brentq(f, lo, hi, xtol=rtol / 4, rtol=4 * np.finfo(float).eps))
+
+    # the first point: an independent search (or the caller's start for a grazing value)
+    p0 = _parameters(base, param, values[0])
+    if what == "grazing":
+        if kappa_start is None:
+            raise ValueError("what = 'grazing' needs kappa_start (a grazing value at the first point, e.g. "
+                             "from transitions())")
+        first = correct(p0, kappa_start, 1e-3) or kappa_start
+    else:
+        found = critical_damping(p0, law, integrator_rtol=integrator_rtol, rtol=rtol)
+        if found.kappa_c is None:
+            raise ValueError(f"no kappa_c at {param} = {values[0]:g}: {found.message}")
+        first = found.kappa_c
+    log_x = bool(np.all(values > 0))
+
+    def coordinate(x):
+        return math.log(x) if log_x else x
+
+    # the walk continues kappa_c (or the grazing value); kappa_2 is located from each kappa_c
+    walk_x, walk_k, walk_req, walk_pred = [float(values[0])], [first], [True], [first]
+    bar = tqdm(total=len(values), desc=f"{what}({param})", unit="pt", disable=not progress)
+    bar.update(1)
+    message = ""
+    for target in values[1:]:
+        pending = [float(target)]
+        halvings = 0
+        while pending:
+            x = pending[-1]
+            p = _parameters(base, param, x)
+            if len(walk_k) >= 2:
+                slope = ((math.log(walk_k[-1]) - math.log(walk_k[-2]))
+                         / (coordinate(walk_x[-1]) - coordinate(walk_x[-2])))
+                guess = math.exp(math.log(walk_k[-1]) + slope * (coordinate(x) - coordinate(walk_x[-1])))
+            else:
+                guess = walk_k[-1]
+            root = correct(p, guess, 0.02) or correct(p, guess, 0.2)
+            if root is None and halvings < max_halvings:
+                halvings += 1  # step control: walk there in a smaller step first
+                pending.append(math.sqrt(walk_x[-1] * x) if log_x else 0.5 * (walk_x[-1] + x))
+                continue
+            pending.pop()
+            if root is None:
+                message = f"lost the curve at {param} = {x:g} (no root near the prediction {guess:.6g})"
+                break
+            walk_x.append(x)
+            walk_k.append(root)
+            walk_pred.append(guess)
+            walk_req.append(not pending)
+        bar.update(1)
+        if message:
+            break
+    bar.close()
+    walk_k = np.asarray(walk_k, dtype=float)
+    if what == "kappa_2":
+        walk_k = np.array([locate_kappa_2(_parameters(base, param, x), law, kc, integrator_rtol=integrator_rtol,
+                                          samples=0)[0] or math.nan for x, kc in zip(walk_x, walk_k, strict=True)])
+    walk_x = np.asarray(walk_x)
+    closed = np.array([(closed_form_kappa_c(_parameters(base, param, x)) or math.nan) if what != "grazing"
+                       else math.nan for x in walk_x])
+    return CriticalCurve(param, walk_x, walk_k, np.asarray(walk_req), closed, np.asarray(walk_pred),
+                         what, law, base, rtol, contact_index, message)

@@ -1,0 +1,185 @@
+"""Grids of named parameters: any parameter is an axis (DESIGN principle 6).
+
+An axis is a name and a 1-d array of values. Names are :class:`~phaseimpact.Parameters` fields
+(``kappa``, ``v``, ``M1``...) and, on a :class:`~phaseimpact.case.Case` base, every quantity of
+either body or the geometry (``plate.E``, ``projectile.rho``, ``R1``, ``h``...). An axis the law
+does not read (``kappa`` under ``abrate`` or a restitution law) is refused before any work.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..case import SETTABLE, Case
+from ..integrate.api import Batch, _atol, _initial, check_rtol, scales
+from ..model.laws import ContactLaw
+from ..model.rhs import ALPHA_, DAMP_, K_, M1_, pack
+from ..parameters import PARAMETER_NAMES, Parameters
+
+__all__ = ["Axis", "Grid", "parse_axis", "MAX_POINTS"]
+
+#: Largest grid held in memory (about 200 bytes a point, plus stick points).
+MAX_POINTS = 10_000_000
+_NUMERIC_FIELDS = tuple(n for n in PARAMETER_NAMES if n not in ("target", "R"))
+
+
+@dataclass(frozen=True)
+class Axis:
+    """One named axis: ``values`` (1-d, finite) and whether it is meant to be read on a log scale."""
+
+    name: str
+    values: np.ndarray
+    log: bool = False
+
+    @classmethod
+    def make(cls, name: str, values, log: bool | None = None) -> Axis:
+        values = np.asarray(values, dtype=float)
+        if values.ndim != 1 or values.size == 0 or not np.all(np.isfinite(values)):
+            raise ValueError(f"axis {name} = {values!r} is out of range; allowed: a non-empty 1-d array of "
+                             "finite numbers")
+        if log is None:
+            log = bool(values.size > 2 and np.all(values > 0) and np.allclose(np.diff(np.log(values)),
+                                                                                  np.log(values[1] / values[0])))
+        return cls(name, values, log)
+
+
+def parse_axis(text: str) -> Axis:
+    """``NAME=START:STOP:NUM[:log]`` (or ``NAME=V1,V2,...``) as an :class:`Axis`."""
+    match = re.fullmatch(r"\s*([A-Za-z_][\w.]*)\s*=\s*(.+)", text)
+    if not match:
+        raise ValueError(f"axis = {text!r} is out of range; allowed: NAME=START:STOP:NUM[:log] or NAME=V1,V2,...")
+    name, spec = match.groups()
+    try:
+        if ":" in spec:
+            parts = spec.split(":")
+            if len(parts) not in (3, 4) or (len(parts) == 4 and parts[3] not in ("log", "lin")):
+                raise ValueError
+            start, stop, num = float(parts[0]), float(parts[1]), float(parts[2])
+            log = len(parts) == 4 and parts[3] == "log"
+        else:
+            return Axis.make(name, [float(v) for v in spec.split(",")], log=False)
+    except ValueError:
+        raise ValueError(f"axis {name} = {spec!r} is out of range; allowed: START:STOP:NUM[:log] with numbers, "
+                         "or V1,V2,...") from None
+    if not (math.isfinite(start) and math.isfinite(stop)) or num != int(num) or not 1 <= num <= MAX_POINTS:
+        raise ValueError(f"axis {name} = {spec!r} is out of range; allowed: finite START and STOP, "
+                         f"an integer 1 <= NUM <= {MAX_POINTS}")
+    if log and not (start > 0 and stop > 0):
+        raise ValueError(f"axis {name} = {spec!r} is out of range; allowed: START > 0 and STOP > 0 with :log")
+    values = np.geomspace(start, stop, int(num)) if log else np.linspace(start, stop, int(num))
+    return Axis(name, values, log)
+
+
+@dataclass(frozen=True)
+class Grid:
+    """A grid of named axes over a base case (Parameters or Case), for one law.
+
+    Points are numbered in C order over the axes (the last axis varies fastest).
+    """
+
+    base: Parameters | Case
+    law: ContactLaw
+    axes: tuple
+
+    def __post_init__(self):
+        if not self.axes:
+            raise ValueError("axes: allowed: at least one axis")
+        names = [a.name for a in self.axes]
+        if len(set(names)) != len(names):
+            raise ValueError(f"axes = {names!r} is out of range; allowed: distinct names")
+        allowed = self.allowed_names()
+        for axis in self.axes:
+            if axis.name not in allowed:
+                raise ValueError(f"axis {axis.name!r} is out of range; allowed: {', '.join(allowed)}")
+            if not self.law.reads(axis.name):
+                source = self.law.damping_source or "no damping"
+                raise ValueError(f"axis {axis.name!r} is not read by law {self.law.label()!r} (its damping "
+                                 f"comes from {source}): every point would be the same")
+        if self.size > MAX_POINTS:
+            raise ValueError(f"grid of {self.size} points is out of range; allowed: at most {MAX_POINTS}")
+        # every corner must be a valid case (checked before any work)
+        for corner in np.ndindex(*(2,) * len(self.axes)):
+            self.parameters_at({a.name: a.values[-1 if k else 0] for a, k in zip(self.axes, corner, strict=True)})
+
+    def allowed_names(self) -> tuple:
+        names = ("kappa", "v", *[n for n in _NUMERIC_FIELDS if n not in ("kappa", "v")])
+        if isinstance(self.base, Case):
+            names += tuple(n for n in SETTABLE if n not in names)
+        return names
+
+    @property
+    def shape(self) -> tuple:
+        return tuple(len(a.values) for a in self.axes)
+
+    @property
+    def size(self) -> int:
+        return int(np.prod(self.shape))
+
+    @property
+    def names(self) -> tuple:
+        return tuple(a.name for a in self.axes)
+
+    def base_parameters(self) -> Parameters:
+        return self.base.parameters() if isinstance(self.base, Case) else self.base
+
+    def parameters_at(self, values: dict) -> Parameters:
+        """Parameters of one point (``values``: axis name -> value)."""
+        if isinstance(self.base, Case):
+            return self.base.parameters(**{k: float(v) for k, v in values.items()})
+        return self.base.replace(**{k: float(v) for k, v in values.items()})
+
+    def point_values(self, index) -> dict:
+        """Axis values of flat point ``index``."""
+        multi = np.unravel_index(int(index), self.shape)
+        return {a.name: float(a.values[i]) for a, i in zip(self.axes, multi, strict=True)}
+
+    def batch(self, indices: np.ndarray, t_end: float | None, rtol: float) -> Batch:
+        """Packed inputs of the points ``indices`` (flat). ``kappa`` and ``v`` axes are packed as
+        arrays (no per-point objects); other axes re-derive each point's parameters."""
+        rtol = check_rtol(rtol)
+        indices = np.asarray(indices, dtype=np.int64)
+        n = len(indices)
+        multi = np.unravel_index(indices, self.shape)
+        columns = {a.name: a.values[m] for a, m in zip(self.axes, multi, strict=True)}
+        if set(columns) <= {"kappa", "v"}:
+            base = self.base_parameters()
+            C = np.tile(pack(base, self.law), (n, 1))
+            v = columns.get("v", np.full(n, base.v))
+            if "kappa" in columns:
+                C[:, DAMP_] = columns["kappa"]
+            elif self.law.damping_source == "restitution" and self.law.entry.chi is not None:
+                C[:, DAMP_] = self.law.entry.chi(self.law.restitution) * base.K / v
+            elif self.law.damping_source == "restitution":
+                C[:, DAMP_] = [self.law.kappa(base.replace(v=float(x))) for x in v]
+            Y0 = np.zeros((n, 5))
+            Y0[:, 2] = v
+            s = scales(base)
+            alpha = C[0, ALPHA_]
+            # the same expressions as Parameters.hertz_indentation and scales(), on arrays
+            indentation = ((alpha + 1) * base.reduced_mass * v**2 / (2 * C[0, K_])) ** (1 / (alpha + 1))
+            A = rtol * np.column_stack([indentation, indentation, v, v, 0.5 * C[:, M1_] * v**2])
+            if t_end is not None:
+                T = np.full(n, t_end)
+            elif math.isfinite(s.plate_period):
+                T = np.full(n, s.horizon)
+            else:  # the horizon scales with the contact time, which scales with the indentation over v
+                T = s.horizon * (indentation / v) / (base.hertz_indentation / base.v)
+            return Batch(self.law, C, Y0, T, A, np.full(n, s.max_step))
+        C = np.empty((n, 9))
+        Y0 = np.empty((n, 5))
+        T = np.empty(n)
+        A = np.empty((n, 5))
+        S = np.empty(n)
+        for i in range(n):
+            p = self.parameters_at({k: v[i] for k, v in columns.items()})
+            s = scales(p)
+            C[i] = pack(p, self.law)
+            Y0[i] = _initial(p, None)
+            T[i] = s.horizon if t_end is None else t_end
+            A[i] = _atol(p, rtol, None)
+            S[i] = s.max_step
+        return Batch(self.law, C, Y0, T, A, S)

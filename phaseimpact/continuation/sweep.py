@@ -1,0 +1,240 @@
+"""Sweeps and atlases: every point of a grid of named parameters, as columns.
+
+:func:`atlas` evaluates an N-d grid (:mod:`.grid`); :func:`sweep` is its one-axis case over
+``kappa``. Each point runs until its outcome settles (or to ``t_end``) on the compiled driver,
+chunk by chunk (:mod:`._parallel`); after each chunk the partial result can be checkpointed
+(``on_chunk``) and a sweep can be resumed from it (``previous``). Points whose run failed are
+recomputed on resume, never taken as done.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+import numpy as np
+from tqdm.auto import tqdm
+
+from .. import __version__
+from ..case import Case
+from ..integrate import driver as drv
+from ..integrate.api import check_real, check_rtol
+from ..integrate.result import SUMMARY_COLUMNS
+from ..model.laws import ContactLaw, as_law
+from ..parameters import Parameters
+from ._parallel import check_jobs, run_chunks
+from .grid import Axis, Grid
+
+__all__ = ["SweepResult", "sweep", "atlas", "ENGINE"]
+
+ENGINE = "phaseimpact driver: DOP853 (scipy tableau) with located events, numba"
+#: Points per chunk: large enough that a chunk's µs-per-point work outweighs its dispatch.
+CHUNK_THREADS, CHUNK_MIN, CHUNK_MAX = 4096, 256, 65536
+
+
+@dataclass
+class SweepResult:
+    """Columns of a grid of runs (points in C order over ``grid.axes``).
+
+    Attributes
+    ----------
+    grid : Grid
+        Base case, law and axes.
+    t_end : float or None
+        Horizon of every run, s (None: each run goes until its outcome settles, capped).
+    settings : dict
+        ``rtol``, ``engine``, ``version``.
+    status, outcome, stop_reason : ndarray of int8, shape (n,)
+        Codes into :data:`~phaseimpact.integrate.STATUSES`, ``OUTCOMES``, ``STOP_REASONS``;
+        -1 where the point is not computed yet.
+    values : dict of ndarray
+        :data:`~phaseimpact.integrate.result.SUMMARY_COLUMNS` (``max_force``, ``n_stick``,
+        ``t_run``...); NaN (or -1 for counts) where undefined or not computed.
+    stick_point, stick_t, stick_delta, stick_dwell : ndarray
+        Every stick phase of every point (an indexed ragged array: ``stick_point`` is the
+        point's flat index), in the order computed.
+    """
+
+    grid: Grid
+    t_end: float | None
+    settings: dict
+    status: np.ndarray = None
+    outcome: np.ndarray = None
+    stop_reason: np.ndarray = None
+    values: dict = None
+    stick_point: np.ndarray = None
+    stick_t: np.ndarray = None
+    stick_delta: np.ndarray = None
+    stick_dwell: np.ndarray = None
+    extras: dict = field(default_factory=dict)
+
+    def __post_init__(self):
+        n = self.grid.size
+        for name in ("status", "outcome", "stop_reason"):
+            if getattr(self, name) is None:
+                setattr(self, name, np.full(n, -1, dtype=np.int8))
+        if self.values is None:
+            self.values = {name: np.full(n, -1 if dtype is np.int64 else np.nan, dtype=dtype)
+                           for name, _, dtype, _ in SUMMARY_COLUMNS}
+        for name, dtype in (("stick_point", np.int64), ("stick_t", float), ("stick_delta", float),
+                            ("stick_dwell", float)):
+            if getattr(self, name) is None:
+                setattr(self, name, np.empty(0, dtype=dtype))
+
+    def __getattr__(self, name):
+        values = self.__dict__.get("values")
+        if values is not None and name in values:
+            return values[name]
+        raise AttributeError(name)
+
+    @property
+    def law(self) -> ContactLaw:
+        return self.grid.law
+
+    @property
+    def shape(self) -> tuple:
+        return self.grid.shape
+
+    def axis(self, name: str) -> np.ndarray:
+        for a in self.grid.axes:
+            if a.name == name:
+                return a.values
+        raise ValueError(f"axis {name!r} is not in this result; allowed: {', '.join(self.grid.names)}")
+
+    @property
+    def kappa(self) -> np.ndarray:
+        return self.axis("kappa")
+
+    @property
+    def done(self) -> np.ndarray:
+        """Points computed without a numerical failure."""
+        return self.status == drv.SUCCESS
+
+    @property
+    def failed(self) -> np.ndarray:
+        return self.status > drv.SUCCESS
+
+    @property
+    def cut(self) -> np.ndarray:
+        """Points whose horizon ended the run before the outcome settled (counts are lower bounds)."""
+        return self.stop_reason == drv.HORIZON
+
+    def outcome_names(self) -> np.ndarray:
+        names = np.array(drv.OUTCOMES + ("not computed",), dtype=object)
+        return names[np.where(self.outcome < 0, len(drv.OUTCOMES), self.outcome)]
+
+    def status_names(self) -> np.ndarray:
+        names = np.array(drv.STATUSES + ("not computed",), dtype=object)
+        return names[np.where(self.status < 0, len(drv.STATUSES), self.status)]
+
+    def sticks_of(self, index: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Stick times, depths and dwells of flat point ``index``, in time order."""
+        keep = self.stick_point == index
+        order = np.argsort(self.stick_t[keep], kind="stable")
+        return self.stick_t[keep][order], self.stick_delta[keep][order], self.stick_dwell[keep][order]
+
+    def store(self, indices: np.ndarray, columns) -> None:
+        """Put a chunk's :class:`~phaseimpact.integrate.Columns` at flat ``indices``."""
+        indices = np.asarray(indices, dtype=np.int64)
+        redo = np.isin(self.stick_point, indices)
+        if np.any(redo):  # a recomputed (previously failed) point replaces its old stick points
+            for name in ("stick_point", "stick_t", "stick_delta", "stick_dwell"):
+                setattr(self, name, getattr(self, name)[~redo])
+        self.status[indices] = columns.status
+        self.outcome[indices] = columns.outcome
+        self.stop_reason[indices] = columns.stop_reason
+        for name, values in columns.values.items():
+            self.values[name][indices] = values
+        self.stick_point = np.concatenate([self.stick_point, np.repeat(indices, columns.stick_count)])
+        self.stick_t = np.concatenate([self.stick_t, columns.stick_t])
+        self.stick_delta = np.concatenate([self.stick_delta, columns.stick_delta])
+        self.stick_dwell = np.concatenate([self.stick_dwell, columns.stick_dwell])
+
+    def summary(self) -> dict:
+        """Counts of outcomes and failures, for people."""
+        names, counts = np.unique(self.outcome_names(), return_counts=True)
+        return {"points": int(self.grid.size), "computed": int(np.count_nonzero(self.status >= 0)),
+                "failed": int(np.count_nonzero(self.failed)), "cut_by_horizon": int(np.count_nonzero(self.cut)),
+                "outcomes": {str(k): int(v) for k, v in zip(names, counts, strict=True)}}
+
+
+def _check_previous(previous: SweepResult, grid: Grid, t_end, rtol) -> None:
+    same_axes = previous.grid.names == grid.names and all(
+        np.array_equal(a.values, b.values) for a, b in zip(previous.grid.axes, grid.axes, strict=True))
+    if not same_axes:
+        raise ValueError("resume: the archive's axes differ from the requested ones")
+    if previous.grid.law != grid.law:
+        raise ValueError(f"resume: the archive was computed with law {previous.grid.law.label()!r}, "
+                         f"asked: {grid.law.label()!r}")
+    if previous.t_end != t_end or previous.settings.get("rtol") != rtol:
+        raise ValueError(f"resume: the archive was computed with t_end = {previous.t_end!r}, rtol = "
+                         f"{previous.settings.get('rtol')!r}; asked: t_end = {t_end!r}, rtol = {rtol!r}")
+
+
+def atlas(base: Parameters | Case, law: ContactLaw | str, axes, *, t_end: float | None = None, rtol: float = 1e-10,
+          n_jobs: int = 1, backend: str = "threads", scheduler: str | None = None, progress: bool = False,
+          previous: SweepResult | None = None,
+          on_chunk: Callable[[SweepResult], None] | None = None) -> SweepResult:
+    """Evaluate every point of a grid of named parameters (an atlas).
+
+    Parameters
+    ----------
+    base : Parameters or Case
+        The case the axes vary (a :class:`~phaseimpact.case.Case` allows material and geometry
+        axes such as ``plate.E`` or ``R1``).
+    law : ContactLaw or str
+    axes : sequence of Axis, or dict name -> values
+        E.g. ``{"kappa": np.geomspace(1e10, 1e14, 400), "v": np.linspace(0.5, 13, 300)}``.
+    t_end : float, optional
+        Horizon of every run, s; default: until the outcome settles (capped by the case's scales).
+    rtol : float
+        Integrator tolerance.
+    n_jobs, backend, scheduler
+        Threads of this process (``threads``), joblib processes (``loky``) or a Dask cluster
+        (``dask``, at ``scheduler`` or a local one).
+    previous : SweepResult, optional
+        A partial result of the same grid to complete.
+    on_chunk : callable, optional
+        Called with the partial result after each chunk (checkpoints).
+    """
+    law = as_law(law)
+    if isinstance(axes, dict):
+        axes = [Axis.make(k, v) for k, v in axes.items()]
+    grid = Grid(base, law, tuple(axes))
+    rtol = check_rtol(rtol)
+    if t_end is not None:
+        t_end = check_real("t_end", t_end, "a finite number > 0", lambda x: x > 0)
+    jobs = check_jobs(n_jobs, backend, scheduler)
+    if previous is not None:
+        _check_previous(previous, grid, t_end, rtol)
+        result = previous
+    else:
+        result = SweepResult(grid, t_end, {"rtol": rtol, "engine": ENGINE, "version": __version__})
+    todo = np.flatnonzero(result.status != drv.SUCCESS)
+    if backend == "threads":
+        chunk = CHUNK_THREADS
+    else:
+        chunk = int(np.clip(math.ceil(len(todo) / (4 * jobs)), CHUNK_MIN, CHUNK_MAX))
+    chunks = [todo[i:i + chunk] for i in range(0, len(todo), chunk)]
+    batches = (grid.batch(idx, t_end, rtol) for idx in chunks)
+    bar = tqdm(total=len(todo), desc=f"{'sweep' if len(grid.axes) == 1 else 'atlas'} {law.name}", unit="pt",
+               disable=not progress)
+    try:
+        for idx, columns in zip(chunks, run_chunks(batches, rtol=rtol, settle=True, stop_on=None, n_jobs=jobs,
+                                                   backend=backend, scheduler=scheduler), strict=True):
+            result.store(idx, columns)
+            bar.update(len(idx))
+            if on_chunk is not None:
+                on_chunk(result)
+    finally:
+        bar.close()
+    return result
+
+
+def sweep(params: Parameters | Case, law: ContactLaw | str, kappas, **options) -> SweepResult:
+    """:func:`atlas` over ``kappa`` alone (N s/m^(1+alpha)), e.g. ``np.geomspace(1e8, 1e13, 2000)``."""
+    kappas = np.asarray(kappas, dtype=float)
+    if kappas.ndim != 1 or kappas.size == 0 or not np.all(np.isfinite(kappas)) or np.any(kappas < 0):
+        raise ValueError("kappa values are out of range; allowed: a non-empty 1-d array of finite numbers >= 0")
+    return atlas(params, law, [Axis.make("kappa", kappas)], **options)

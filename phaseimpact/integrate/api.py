@@ -1,0 +1,297 @@
+"""Entry points: :func:`simulate` (one run, a :class:`Trajectory`) and :func:`simulate_many`
+(many runs in parallel threads, :class:`Columns`). Both check every argument before any work,
+derive horizons and tolerances from the case's own scales, and call the one compiled driver."""
+
+from __future__ import annotations
+
+import math
+import numbers
+from dataclasses import dataclass
+
+import numba
+import numpy as np
+from scipy.special import gamma
+
+from ..model.laws import ContactLaw, as_law
+from ..model.rhs import initial_state, pack
+from ..parameters import Parameters
+from . import driver as d
+from .events import EVENT_KINDS
+from .result import Columns, Trajectory, run_message
+
+__all__ = ["simulate", "simulate_many", "Scales", "scales", "INTEGRATORS", "RTOL_RANGE"]
+
+INTEGRATORS = ("exact", "rk4")
+#: Allowed integrator tolerances: tighter than 1e-13 is below rounding; looser than 1e-3 can
+#: change an outcome class (a stick missed), which no allowed setting may do.
+RTOL_RANGE = (1e-13, 1e-3)
+#: Horizon when none is given, in units of the case's slowest time scale (plate period, or
+#: contact time without a plate): near the critical damping the escape takes thousands of periods.
+HORIZON_CAP_PERIODS = 1e4
+MAX_STEPS = 50_000_000
+MAX_EVENTS = 5_000_000
+
+
+def is_real(value) -> bool:
+    return isinstance(value, numbers.Real) and not isinstance(value, bool)
+
+
+def check_real(name: str, value, allowed: str, ok) -> float:
+    """``value`` as a float if it is a real number and ``ok(value)``; else ``ValueError``."""
+    if not is_real(value) or not math.isfinite(value) or not ok(float(value)):
+        raise ValueError(f"{name} = {value!r} is out of range; allowed: {allowed}")
+    return float(value)
+
+
+def check_rtol(rtol) -> float:
+    lo, hi = RTOL_RANGE
+    return check_real("rtol", rtol, f"{lo:g} <= rtol <= {hi:g}", lambda x: lo <= x <= hi)
+
+
+@dataclass(frozen=True)
+class Scales:
+    """A case's own scales (DESIGN principle 5; REFERENCE §4).
+
+    Attributes
+    ----------
+    indentation : float
+        Largest indentation of the undamped impact of the reduced mass, m.
+    contact_time : float
+        Its duration, ``2 tau delta_max / v``, s.
+    plate_period : float
+        Small-amplitude period of the target, s (inf without springs).
+    horizon : float
+        Default cap on a run that goes until its outcome settles, s.
+    max_step : float
+        Largest step the driver takes (an eighth of the fastest oscillation), s.
+    """
+
+    indentation: float
+    contact_time: float
+    plate_period: float
+    horizon: float
+    max_step: float
+
+
+def scales(params: Parameters) -> Scales:
+    """The time and length scales of ``params``."""
+    a = params.alpha
+    tau = math.sqrt(math.pi) * gamma(1 + 1 / (a + 1)) / gamma(0.5 + 1 / (a + 1))  # 1.4716 for Hertz
+    indentation = params.hertz_indentation
+    contact_time = 2 * tau * indentation / params.v
+    period = params.target_period
+    slow = period if math.isfinite(period) else contact_time
+    max_step = period / 8 if math.isfinite(period) else math.inf
+    return Scales(indentation, contact_time, period, HORIZON_CAP_PERIODS * slow, max_step)
+
+
+def _atol(params: Parameters, rtol: float, atol) -> np.ndarray:
+    """Absolute tolerances from the state scales: positions by the Hertz indentation,
+    velocities by the impact speed, the work by the impact energy."""
+    if atol is not None:
+        return np.full(5, check_real("atol", atol, "a number > 0", lambda x: x > 0))
+    s = params.hertz_indentation
+    return rtol * np.array([s, s, params.v, params.v, 0.5 * params.M1 * params.v**2])
+
+
+def _initial(params: Parameters, initial) -> np.ndarray:
+    y = initial_state(params.v)
+    if initial is not None:
+        state = np.asarray(initial, dtype=float)
+        if state.shape != (4,) or not np.all(np.isfinite(state)):
+            raise ValueError(f"initial = {initial!r} is out of range; allowed: 4 finite numbers "
+                             "(x1, x2, x1dot, x2dot)")
+        y[:4] = state
+    return y
+
+
+def _stop_on(stop_on) -> tuple[int, int]:
+    """``stop_on`` as (event kind code, count): stop at the n-th event of that kind."""
+    if stop_on is None:
+        return -1, 0
+    kind, n = (stop_on, 1) if isinstance(stop_on, str) else stop_on
+    if kind not in EVENT_KINDS:
+        raise ValueError(f"stop_on = {stop_on!r} is out of range; allowed: an event kind "
+                         f"({', '.join(EVENT_KINDS)}) or (kind, n)")
+    if not (isinstance(n, numbers.Integral) and n >= 1):
+        raise ValueError(f"stop_on count = {n!r} is out of range; allowed: an integer >= 1")
+    return EVENT_KINDS.index(kind), int(n)
+
+
+def _save(save):
+    if isinstance(save, str):
+        if save not in ("summary", "steps"):
+            raise ValueError(f"save = {save!r} is out of range; allowed: 'summary', 'steps' or an array of times")
+        return (d.SAVE_SUMMARY if save == "summary" else d.SAVE_STEPS), np.empty(0)
+    times = np.asarray(save, dtype=float)
+    if times.ndim != 1 or not np.all(np.isfinite(times)) or np.any(np.diff(times) <= 0):
+        raise ValueError("save: output times must be a finite, strictly increasing 1-d array")
+    return d.SAVE_TIMES, times
+
+
+def simulate(params: Parameters, law: ContactLaw | str = "paper", t_end: float | None = None, *,
+             integrator: str = "exact", save="summary", stop_when_settled: bool | None = None,
+             rtol: float = 1e-10, atol: float | None = None, step: float | None = None, every: int = 1,
+             initial=None, stop_on=None, max_steps: int = MAX_STEPS) -> Trajectory:
+    """Integrate one impact from seed eq. 6 (``x1dot = v`` at ``x1 = x2 = 0``) or ``initial``.
+
+    Parameters
+    ----------
+    params : Parameters
+    law : ContactLaw or str
+        A law of :data:`phaseimpact.model.LAWS` with its options.
+    t_end : float, optional
+        Horizon, s. Default: run until the outcome settles (permanent stick, escape, projectile
+        out of reach), capped at :attr:`Scales.horizon`; :attr:`Trajectory.cut` says when the
+        cap ended it.
+    integrator : {"exact", "rk4"}
+        ``exact``: event-driven DOP853, stick and slip resolved exactly. ``rk4``: the seed's
+        classic fixed-step RK4 on eq. 8 read literally (``step`` s, default a thousandth of the
+        contact time), keeping every ``every``-th step.
+    save : "summary", "steps" or array of times
+        What to keep: a sweep point needs only the summary; a figure the steps or a time grid.
+    stop_when_settled : bool, optional
+        Stop once nothing can change any more; default True when ``t_end`` is None or for a
+        summary.
+    rtol, atol : float
+        Tolerances; ``atol`` defaults to ``rtol`` times the state scales.
+    initial : 4 numbers, optional
+        ``(x1, x2, x1dot, x2dot)`` to start from instead of eq. 6.
+    stop_on : str or (str, int), optional
+        Stop at the n-th event of a kind (``"stick"``, ``("stick", 2)``).
+    """
+    law = as_law(law)
+    if not isinstance(params, Parameters):
+        raise ValueError(f"params = {params!r} is out of range; allowed: a Parameters instance")
+    if integrator not in INTEGRATORS:
+        raise ValueError(f"integrator = {integrator!r} is out of range; allowed: one of {', '.join(INTEGRATORS)}")
+    s = scales(params)
+    horizon = s.horizon if t_end is None else check_real("t_end", t_end, "a finite number > 0", lambda x: x > 0)
+    rtol = check_rtol(rtol)
+    save_kind, times = _save(save)
+    settle = (t_end is None or save_kind == d.SAVE_SUMMARY) if stop_when_settled is None else bool(stop_when_settled)
+    stop_kind, stop_count = _stop_on(stop_on)
+    y0 = _initial(params, initial)
+    rk4_step = 0.0
+    if integrator == "rk4":
+        rk4_step = s.contact_time / 1000 if step is None else check_real("step", step, "a number > 0", lambda x: x > 0)
+        if not (isinstance(every, numbers.Integral) and every >= 1):
+            raise ValueError(f"every = {every!r} is out of range; allowed: an integer >= 1")
+        if horizon / rk4_step > max_steps:
+            raise ValueError(f"step = {rk4_step!r} needs {horizon / rk4_step:.3g} steps; allowed: at most "
+                             f"max_steps = {max_steps}")
+    out = d.run(law.code, pack(params, law), y0, horizon, rtol, _atol(params, rtol, atol), s.max_step, settle,
+                stop_kind, stop_count, save_kind, times, int(max_steps), MAX_EVENTS, rk4_step, int(every))
+    summary, ev_t, ev_kind, ev_mode, ev_y, ev_force, s_t, s_y, s_mode, s_force, y_final = out
+    status = d.STATUSES[int(summary[d.S_STATUS])]
+    reason = d.STOP_REASONS[int(summary[d.S_REASON])]
+    outcome = d.OUTCOMES[int(summary[d.S_OUTCOME])]
+    name = f"rk4[step={rk4_step:.3g}]" if rk4_step else f"exact[DOP853, rtol={rtol:g}]"
+    return Trajectory(
+        t=s_t, y=s_y, force=s_force, mode=s_mode, event_t=ev_t, event_kind=ev_kind, event_mode=ev_mode,
+        event_y=ev_y, event_force=ev_force, params=params, law=law, initial_state=y0, final_state=y_final,
+        t_end=horizon, status=status, stop_reason=reason, outcome=outcome,
+        message=run_message(status, reason, float(summary[d.S_T_STOP]), outcome), summary=summary,
+        integrator=name)
+
+
+@dataclass(frozen=True)
+class Batch:
+    """Packed inputs of many runs of one law: coefficients (n, 9), initial states (n, 5),
+    horizons, absolute tolerances (n, 5) and step caps (n,)."""
+
+    law: ContactLaw
+    C: np.ndarray
+    Y0: np.ndarray
+    t_end: np.ndarray
+    atol: np.ndarray
+    max_step: np.ndarray
+
+    def __len__(self) -> int:
+        return len(self.C)
+
+    def take(self, idx) -> Batch:
+        return Batch(self.law, self.C[idx], self.Y0[idx], self.t_end[idx], self.atol[idx], self.max_step[idx])
+
+
+def pack_batch(params_seq, law: ContactLaw, t_end, rtol: float, initial=None) -> Batch:
+    """Pack a sequence of :class:`Parameters` (one law) for :func:`run_batch`."""
+    law = as_law(law)
+    params_seq = list(params_seq)
+    if not params_seq:
+        raise ValueError("params: allowed: a non-empty sequence of Parameters")
+    n = len(params_seq)
+    C = np.empty((n, 9))
+    Y0 = np.empty((n, 5))
+    T = np.empty(n)
+    A = np.empty((n, 5))
+    S = np.empty(n)
+    for i, p in enumerate(params_seq):
+        s = scales(p)
+        C[i] = pack(p, law)
+        Y0[i] = _initial(p, initial)
+        T[i] = s.horizon if t_end is None else t_end
+        A[i] = _atol(p, rtol, None)
+        S[i] = s.max_step
+    return Batch(law, C, Y0, T, A, S)
+
+
+def run_batch(batch: Batch, *, rtol: float, settle: bool = True, stop_on=None, n_threads: int = 1,
+              capacity: int = 32) -> Columns:
+    """Run a packed batch in ``n_threads`` threads; each run is independent of the others, so
+    the columns do not depend on the thread count or on how a sweep was cut into batches."""
+    stop_kind, stop_count = _stop_on(stop_on)
+    n = len(batch)
+    summary = np.empty((n, d.N_SUMMARY))
+    st = np.empty((3, n, capacity))
+    count = np.empty(n, np.int64)
+    previous = numba.get_num_threads()
+    numba.set_num_threads(max(1, min(int(n_threads), numba.config.NUMBA_NUM_THREADS)))
+    try:
+        d.run_many(batch.law.code, batch.C, batch.Y0, batch.t_end, rtol, batch.atol, batch.max_step, settle,
+                   stop_kind, stop_count, MAX_STEPS, MAX_EVENTS, 0.0, capacity, summary, st[0], st[1], st[2],
+                   count)
+    finally:
+        numba.set_num_threads(previous)
+    parts_t, parts_delta, parts_dwell = [], [], []
+    for i in range(n):
+        k = int(count[i])
+        if k <= capacity:
+            parts_t.append(st[0, i, :k])
+            parts_delta.append(st[1, i, :k])
+            parts_dwell.append(st[2, i, :k])
+            continue
+        # more stick phases than the buffer holds (near kappa_c): rerun this one for all of them
+        out = d.run(batch.law.code, batch.C[i], batch.Y0[i], batch.t_end[i], rtol, batch.atol[i],
+                    batch.max_step[i], settle, stop_kind, stop_count, d.SAVE_SUMMARY, np.empty(0), MAX_STEPS,
+                    MAX_EVENTS, 0.0, 1)
+        full = np.empty((3, k))
+        s = out[0]
+        d.stick_points(len(out[1]), out[1], out[2], out[4], s[d.S_T_STOP], s[d.S_OUTCOME] == d.PERMANENT_STICK,
+                       full[0], full[1], full[2])
+        parts_t.append(full[0])
+        parts_delta.append(full[1])
+        parts_dwell.append(full[2])
+
+    def cat(parts):
+        return np.concatenate(parts) if parts else np.empty(0)
+
+    return Columns.from_summary(summary, count, cat(parts_t), cat(parts_delta), cat(parts_dwell))
+
+
+def simulate_many(params_seq, law: ContactLaw | str = "paper", t_end: float | None = None, *,
+                  rtol: float = 1e-10, stop_when_settled: bool = True, stop_on=None, initial=None,
+                  n_threads: int = 1) -> Columns:
+    """Many impacts (one per :class:`Parameters` of ``params_seq``), summaries only, as columns.
+
+    Same driver and arguments as :func:`simulate`; runs go in ``n_threads`` threads inside this
+    process and the result is bit-identical for any thread count.
+    """
+    law = as_law(law)
+    rtol = check_rtol(rtol)
+    if t_end is not None:
+        t_end = check_real("t_end", t_end, "a finite number > 0", lambda x: x > 0)
+    if not (isinstance(n_threads, numbers.Integral) and n_threads >= 1):
+        raise ValueError(f"n_threads = {n_threads!r} is out of range; allowed: an integer >= 1")
+    batch = pack_batch(params_seq, law, t_end, rtol, initial)
+    return run_batch(batch, rtol=rtol, settle=stop_when_settled, stop_on=stop_on, n_threads=n_threads)

@@ -1,0 +1,578 @@
+"""The one hybrid (event-driven) loop, compiled: every trajectory of the project runs here.
+
+Between events the right-hand side of the current mode is smooth and a stepper advances it:
+adaptive DOP853 (:mod:`.dop853`) or the seed's fixed-step RK4 (``rk4_step > 0``; eq. 8 read
+literally, no events resolved, so its chattering across ``deltadot = 0`` stays visible). After
+each DOP853 step the event table (:mod:`.events`) is checked for crossings; each crossing is
+located by Brent's method on the step's 7th-order dense output; recorded events are logged, and
+at the first event that changes the phase the state is taken from a fresh step that ends
+exactly at the root, the transition is applied and the run restarts there in the new mode.
+
+Everything here is scalars and small arrays (numba's subset); strings, objects and messages are
+made outside (:mod:`.api`). The same source runs uncompiled with ``NUMBA_DISABLE_JIT=1``.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numba
+import numpy as np
+
+from ..model.laws import PLAIN, STUCK
+from ..model.rhs import V1, V2, WORK, X1, X2, energy, rhs, stick_margin
+from . import dop853
+from .events import (
+    CONTACT,
+    DELTA,
+    DELTADOT,
+    ENERGY,
+    FORCE_PEAK,
+    FORCE_RATE,
+    N_EVENTS,
+    REACH,
+    REVERSAL,
+    SEPARATION,
+    SETTLED,
+    SLIP,
+    STICK,
+    STOP_RUNAWAY,
+    STOP_SETTLED,
+    crossed,
+    departure_sign,
+    energy_limit_of,
+    event_values,
+    initial_mode,
+    restarts,
+    transition,
+)
+
+# Run status (numerical health) and why the run stopped.
+SUCCESS, STEP_SIZE_COLLAPSE, TOO_MANY_STEPS, NON_FINITE = range(4)
+STATUSES = ("success", "step-size-collapse", "too-many-steps", "non-finite")
+HORIZON, SETTLED_STOP, RUNAWAY_STOP, ASKED_STOP, FAILED_STOP = range(5)
+STOP_REASONS = ("horizon", "settled", "runaway", "asked", "failed")
+# Outcome classes (REFERENCE §5).
+FAILED, PERMANENT_STICK, RATCHET_ESCAPE, REBOUND, RUNAWAY_OUTCOME, BOUNDED, UNSETTLED = range(7)
+OUTCOMES = ("failed", "permanent-stick", "ratchet-escape", "rebound", "runaway", "bounded", "unsettled")
+# Save kinds.
+SAVE_SUMMARY, SAVE_STEPS, SAVE_TIMES = range(3)
+
+# Summary vector of one run (columns of many runs).
+(S_STATUS, S_REASON, S_OUTCOME, S_T_STOP, S_MAX_FORCE, S_MAX_INDENTATION, S_RESTITUTION,
+ S_CONTACT_DURATION, S_DISSIPATED, S_LOOP_AREA, S_N_STICK, S_N_CONTACTS, S_T_RUN, S_FIRST_STICK_DELTA,
+ S_FIRST_STICK_MARGIN, S_FIRST_STICK_T, S_NSTEPS, S_NFEV, S_MODE) = range(19)
+N_SUMMARY = 19
+
+_TINY = np.finfo(np.float64).tiny
+_EPS = np.finfo(np.float64).eps
+
+
+@numba.njit(cache=True)
+def _grow(a, n):
+    b = np.empty((max(2 * a.shape[0], 16),) + a.shape[1:], a.dtype)
+    b[:n] = a[:n]
+    return b
+
+
+@numba.njit(cache=True)
+def _event_at(code, c, mode, energy_limit, column, F, y0, t0, h, s, ys, fs, gs):
+    """Event function ``column`` at time ``s`` on the dense output of the step."""
+    dop853.dense_eval(F, y0, t0, h, s, ys)
+    force = rhs(code, c, ys, mode, fs)
+    event_values(code, c, ys, fs, force, mode, energy_limit, gs)
+    return gs[column]
+
+
+@numba.njit(cache=True)
+def _brent(code, c, mode, energy_limit, column, F, y0, t0, h, xa, xb, fa, fb, ys, fs, gs):
+    """Zero of event ``column`` in ``[xa, xb]`` (signs of ``fa``, ``fb`` differ): scipy's brentq."""
+    xpre, xcur, fpre, fcur = xa, xb, fa, fb
+    xblk = fblk = spre = scur = 0.0
+    xtol = 4.0 * _EPS * max(abs(xa), abs(xb))
+    for _ in range(200):
+        if fpre != 0 and fcur != 0 and (fpre < 0) != (fcur < 0):
+            xblk, fblk = xpre, fpre
+            spre = scur = xcur - xpre
+        if abs(fblk) < abs(fcur):
+            xpre, xcur, xblk = xcur, xblk, xcur
+            fpre, fcur, fblk = fcur, fblk, fcur
+        tol = 0.5 * (xtol + 4.0 * _EPS * abs(xcur))
+        sbis = 0.5 * (xblk - xcur)
+        if fcur == 0 or abs(sbis) < tol:
+            return xcur
+        if abs(spre) > tol and abs(fcur) < abs(fpre):
+            if xpre == xblk:
+                stry = -fcur * (xcur - xpre) / (fcur - fpre)
+            else:
+                dpre = (fpre - fcur) / (xpre - xcur)
+                dblk = (fblk - fcur) / (xblk - xcur)
+                stry = -fcur * (fblk * dblk - fpre * dpre) / (dblk * dpre * (fblk - fpre))
+            if 2.0 * abs(stry) < min(abs(spre), 3.0 * abs(sbis) - tol):
+                spre, scur = scur, stry
+            else:
+                spre = scur = sbis
+        else:
+            spre = scur = sbis
+        xpre, fpre = xcur, fcur
+        xcur += scur if abs(scur) > tol else (tol if sbis > 0 else -tol)
+        fcur = _event_at(code, c, mode, energy_limit, column, F, y0, t0, h, xcur, ys, fs, gs)
+    return xcur
+
+
+@numba.njit(cache=True)
+def _locate(code, c, mode, energy_limit, column, F, y0, t0, h, t1, g_start, g_end, ys, fs, gs):
+    """Time of the first zero of event ``column`` in ``[t0, t1]`` on the dense output.
+
+    A run that restarts on this event's zero (``g_start`` a signed tiny number) may leave it
+    and come back within one step, as a brief slip does near a grazing stick break: the dense
+    output is then sampled to find where the function has left zero, and the return is
+    bracketed from there.
+    """
+    expected = 1.0 if g_start > 0 else -1.0
+    a, ga, b, gb = t0, g_start, t1, g_end
+    g0 = _event_at(code, c, mode, energy_limit, column, F, y0, t0, h, t0, ys, fs, gs)
+    if g0 * expected <= 0:
+        found_away = False
+        prev = t0
+        for i in range(1, 33):
+            s = t0 + (t1 - t0) * i / 32.0
+            gv = _event_at(code, c, mode, energy_limit, column, F, y0, t0, h, s, ys, fs, gs)
+            if not found_away:
+                if gv * expected > 0:
+                    found_away = True
+                    a, ga = s, gv
+            elif gv * expected <= 0:
+                a, b, gb = prev, s, gv
+                ga = _event_at(code, c, mode, energy_limit, column, F, y0, t0, h, a, ys, fs, gs)
+                break
+            prev = s
+        if not found_away:
+            return t0  # the excursion is below what the step resolves
+    if gb == 0 or ga * gb > 0:
+        return b
+    return _brent(code, c, mode, energy_limit, column, F, y0, t0, h, a, b, ga, gb, ys, fs, gs)
+
+
+@numba.njit(cache=True)
+def run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count, save_kind, times,
+        max_steps, max_events, rk4_step, rk4_every):
+    """Integrate one trajectory. See :func:`phaseimpact.integrate.simulate` for the meaning.
+
+    Returns ``(summary, ev_t, ev_kind, ev_mode, ev_y, ev_force, s_t, s_y, s_mode, s_force, y_final)``
+    with arrays trimmed to their lengths.
+    """
+    y = y0.copy()
+    t = 0.0
+    mode = PLAIN if rk4_step > 0 else initial_mode(code, c, y)
+    f = np.empty(5)
+    force = rhs(code, c, y, mode, f)
+    nfev = 1
+    nsteps = 0
+    energy_limit = energy_limit_of(code, c, y0)
+
+    ev_t = np.empty(64)
+    ev_kind = np.empty(64, np.int64)
+    ev_mode = np.empty(64, np.int64)
+    ev_y = np.empty((64, 5))
+    ev_force = np.empty(64)
+    n_ev = 0
+    s_t = np.empty(256 if save_kind != SAVE_SUMMARY else 1)
+    s_y = np.empty((s_t.shape[0], 5))
+    s_mode = np.empty(s_t.shape[0], np.int64)
+    s_force = np.empty(s_t.shape[0])
+    n_s = 0
+    counts = np.zeros(8, np.int64)
+    max_force = force
+    max_indentation = y[X1] - y[X2]
+    i_time = 0  # next output time (save_kind == SAVE_TIMES)
+
+    if y[X1] == y[X2] and y[V1] > y[V2]:
+        ev_t[0] = 0.0
+        ev_kind[0] = CONTACT
+        ev_mode[0] = mode
+        ev_y[0] = y
+        ev_force[0] = force
+        n_ev = 1
+        counts[CONTACT] += 1
+    if save_kind == SAVE_STEPS:
+        s_t[0] = 0.0
+        s_y[0] = y
+        s_mode[0] = mode
+        s_force[0] = force
+        n_s = 1
+    if save_kind == SAVE_TIMES:
+        while i_time < times.shape[0] and times[i_time] <= 0.0:
+            if n_s == s_t.shape[0]:
+                s_t, s_y, s_mode, s_force = _grow(s_t, n_s), _grow(s_y, n_s), _grow(s_mode, n_s), _grow(s_force, n_s)
+            s_t[n_s] = times[i_time]
+            s_y[n_s] = y
+            s_mode[n_s] = mode
+            s_force[n_s] = force
+            n_s += 1
+            i_time += 1
+
+    status = SUCCESS
+    reason = HORIZON
+    K = np.empty((16, 5))
+    F = np.empty((7, 5))
+    tmp = np.empty(5)
+    y_new = np.empty(5)
+    f_new = np.empty(5)
+    y_r = np.empty(5)
+    f_r = np.empty(5)
+    ys = np.empty(5)
+    fs = np.empty(5)
+    gs = np.empty(N_EVENTS)
+    g_old = np.empty(N_EVENTS)
+    g_new = np.empty(N_EVENTS)
+    roots = np.empty(N_EVENTS)
+    fired = np.zeros(N_EVENTS, np.bool_)
+
+    if rk4_step > 0:
+        # ---- the seed's classic RK4: plain right-hand side, fixed step, nothing resolved ----
+        k1 = np.empty(5)
+        k2 = np.empty(5)
+        k3 = np.empty(5)
+        k4 = np.empty(5)
+        while t < t_end:
+            if nsteps >= max_steps:
+                status, reason = TOO_MANY_STEPS, FAILED_STOP
+                break
+            h = min(rk4_step, t_end - t)
+            rhs(code, c, y, mode, k1)
+            for j in range(5):
+                tmp[j] = y[j] + 0.5 * h * k1[j]
+            rhs(code, c, tmp, mode, k2)
+            for j in range(5):
+                tmp[j] = y[j] + 0.5 * h * k2[j]
+            rhs(code, c, tmp, mode, k3)
+            for j in range(5):
+                tmp[j] = y[j] + h * k3[j]
+            rhs(code, c, tmp, mode, k4)
+            finite = True
+            for j in range(5):
+                y_new[j] = y[j] + h / 6.0 * (k1[j] + 2.0 * k2[j] + 2.0 * k3[j] + k4[j])
+                finite = finite and math.isfinite(y_new[j])
+            nfev += 4
+            nsteps += 1
+            if not finite:
+                status, reason = NON_FINITE, FAILED_STOP
+                break
+            force_new = rhs(code, c, y_new, mode, f_new)
+            d_old = y[X1] - y[X2]
+            d_new = y_new[X1] - y_new[X2]
+            if (d_old <= 0 < d_new) or (d_old > 0 >= d_new):
+                if n_ev == ev_t.shape[0]:
+                    ev_t, ev_kind, ev_mode = _grow(ev_t, n_ev), _grow(ev_kind, n_ev), _grow(ev_mode, n_ev)
+                    ev_y, ev_force = _grow(ev_y, n_ev), _grow(ev_force, n_ev)
+                kind = CONTACT if d_new > 0 else SEPARATION
+                ev_t[n_ev] = t + h * d_old / (d_old - d_new)  # linear: RK4 resolves no event
+                ev_kind[n_ev] = kind
+                ev_mode[n_ev] = mode
+                ev_y[n_ev] = y_new
+                ev_force[n_ev] = force_new
+                n_ev += 1
+                counts[kind] += 1
+            t += h
+            for j in range(5):
+                y[j] = y_new[j]
+            max_force = max(max_force, force_new)
+            max_indentation = max(max_indentation, d_new)
+            if save_kind == SAVE_STEPS and (nsteps % rk4_every == 0 or t >= t_end):
+                if n_s == s_t.shape[0]:
+                    s_t, s_y, s_mode, s_force = _grow(s_t, n_s), _grow(s_y, n_s), _grow(s_mode, n_s), _grow(s_force, n_s)
+                s_t[n_s] = t
+                s_y[n_s] = y
+                s_mode[n_s] = mode
+                s_force[n_s] = force_new
+                n_s += 1
+            if energy(code, c, y) > energy_limit:
+                reason = RUNAWAY_STOP
+                break
+        summary = _summarize(code, c, y0, y, mode, status, reason, t, max_force, max_indentation, counts,
+                             n_ev, ev_t, ev_kind, ev_y, nsteps, nfev)
+        return (summary, ev_t[:n_ev], ev_kind[:n_ev], ev_mode[:n_ev], ev_y[:n_ev], ev_force[:n_ev],
+                s_t[:n_s], s_y[:n_s], s_mode[:n_s], s_force[:n_s], y)
+
+    # ---- adaptive DOP853 with events ----
+    quiet = DELTA
+    event_values(code, c, y, f, force, mode, energy_limit, g_old)
+    for col in range(N_EVENTS):
+        if col == quiet or g_old[col] == 0:
+            g_old[col] = departure_sign(col, y, mode) * _TINY
+    h_abs = dop853.initial_step(code, c, mode, y, f, rtol, atol, t_end, max_step, tmp, f_new)
+    nfev += 1
+
+    while t < t_end:
+        if nsteps >= max_steps or n_ev >= max_events:
+            status, reason = TOO_MANY_STEPS, FAILED_STOP
+            break
+        h_abs = min(h_abs, max_step)
+        rejected = False
+        h = 0.0
+        h_next = 0.0
+        force_new = 0.0
+        while True:
+            min_step = 10.0 * (np.nextafter(t, np.inf) - t)
+            if h_abs < min_step:
+                status, reason = STEP_SIZE_COLLAPSE, FAILED_STOP
+                break
+            h = h_abs
+            t_new = t + h
+            if t_new > t_end:
+                t_new = t_end
+            h = t_new - t
+            force_new = dop853.step(code, c, mode, y, f, h, K, y_new, f_new, tmp)
+            nfev += 12
+            err = dop853.error_norm(K, h, y, y_new, rtol, atol)
+            if err < 1.0:
+                factor = dop853.MAX_FACTOR if err == 0 else min(dop853.MAX_FACTOR,
+                                                               dop853.SAFETY * err**dop853.ERROR_EXPONENT)
+                if rejected:
+                    factor = min(1.0, factor)
+                h_next = h * factor
+                break
+            h_abs = h * max(dop853.MIN_FACTOR, dop853.SAFETY * err**dop853.ERROR_EXPONENT)
+            rejected = True
+        if status != SUCCESS:
+            break
+        nsteps += 1
+        t_new = t + h
+        event_values(code, c, y_new, f_new, force_new, mode, energy_limit, g_new)
+        any_fired = False
+        for col in range(N_EVENTS):
+            fired[col] = crossed(col, g_old, g_new)
+            any_fired = any_fired or fired[col]
+        have_dense = False
+        restart_col = -1
+        t_restart = math.inf
+        if any_fired:
+            dop853.dense_coefficients(code, c, mode, y, f, y_new, f_new, h, K, F, tmp)
+            nfev += 3
+            have_dense = True
+            for col in range(N_EVENTS):
+                if fired[col]:
+                    roots[col] = _locate(code, c, mode, energy_limit, col, F, y, t, h, t_new, g_old[col],
+                                         g_new[col], ys, fs, gs)
+            if fired[DELTADOT] and not fired[DELTA]:
+                # an extreme of delta inside the step on the other side of zero: a contact (or
+                # separation) and its return both fell inside the step
+                d_ext = _event_at(code, c, mode, energy_limit, DELTA, F, y, t, h, roots[DELTADOT], ys, fs, gs)
+                if d_ext * g_old[DELTA] < 0:
+                    fired[DELTA] = True
+                    roots[DELTA] = _brent(code, c, mode, energy_limit, DELTA, F, y, t, h, t, roots[DELTADOT],
+                                          g_old[DELTA], d_ext, ys, fs, gs)
+            for col in range(N_EVENTS):
+                if fired[col] and (restarts(code, col, mode, settle) or col == ENERGY) and roots[col] < t_restart:
+                    restart_col, t_restart = col, roots[col]
+            # recorded events before the restart, in time order
+            while True:
+                best = -1
+                for col in range(N_EVENTS):
+                    if fired[col] and not (restarts(code, col, mode, settle) or col == ENERGY) \
+                            and roots[col] <= t_restart and (best < 0 or roots[col] < roots[best]):
+                        best = col
+                if best < 0:
+                    break
+                fired[best] = False
+                _event_at(code, c, mode, energy_limit, best, F, y, t, h, roots[best], ys, fs, gs)
+                f_ev = rhs(code, c, ys, mode, fs)
+                kind = FORCE_PEAK if best == FORCE_RATE else REVERSAL
+                if best == REACH:
+                    kind = SETTLED  # recorded only: the run goes on
+                if n_ev == ev_t.shape[0]:
+                    ev_t, ev_kind, ev_mode = _grow(ev_t, n_ev), _grow(ev_kind, n_ev), _grow(ev_mode, n_ev)
+                    ev_y, ev_force = _grow(ev_y, n_ev), _grow(ev_force, n_ev)
+                ev_t[n_ev] = roots[best]
+                ev_kind[n_ev] = kind
+                ev_mode[n_ev] = mode
+                ev_y[n_ev] = ys
+                ev_force[n_ev] = f_ev
+                n_ev += 1
+                counts[kind] += 1
+                max_force = max(max_force, f_ev)
+                max_indentation = max(max_indentation, ys[X1] - ys[X2])
+        t_seg = t_restart if restart_col >= 0 else t_new
+        if save_kind == SAVE_TIMES:
+            while i_time < times.shape[0] and times[i_time] <= t_seg:
+                if not have_dense:
+                    dop853.dense_coefficients(code, c, mode, y, f, y_new, f_new, h, K, F, tmp)
+                    nfev += 3
+                    have_dense = True
+                if n_s == s_t.shape[0]:
+                    s_t, s_y, s_mode, s_force = _grow(s_t, n_s), _grow(s_y, n_s), _grow(s_mode, n_s), _grow(s_force, n_s)
+                dop853.dense_eval(F, y, t, h, times[i_time], ys)
+                s_t[n_s] = times[i_time]
+                s_y[n_s] = ys
+                s_mode[n_s] = mode
+                s_force[n_s] = rhs(code, c, ys, mode, fs)
+                n_s += 1
+                i_time += 1
+        if restart_col >= 0:
+            # the state at the root from a fresh step that ends there (|delta|^alpha is only C^1
+            # at delta = 0, and the stages beyond the root spoil the interpolant there)
+            h_r = t_restart - t
+            if h_r > 0:
+                dop853.step(code, c, mode, y, f, h_r, K, y_r, f_r, tmp)
+                nfev += 12
+            else:
+                y_r[:] = y
+            kind, mode, action = transition(code, c, restart_col, y_r, mode, settle)
+            t = t_restart
+            y[:] = y_r
+            force = rhs(code, c, y, mode, f)
+            nfev += 1
+            if n_ev == ev_t.shape[0]:
+                ev_t, ev_kind, ev_mode = _grow(ev_t, n_ev), _grow(ev_kind, n_ev), _grow(ev_mode, n_ev)
+                ev_y, ev_force = _grow(ev_y, n_ev), _grow(ev_force, n_ev)
+            ev_t[n_ev] = t
+            ev_kind[n_ev] = kind
+            ev_mode[n_ev] = mode
+            ev_y[n_ev] = y
+            ev_force[n_ev] = force
+            n_ev += 1
+            counts[kind] += 1
+            max_force = max(max_force, force)
+            max_indentation = max(max_indentation, y[X1] - y[X2])
+            if save_kind == SAVE_STEPS:
+                if n_s == s_t.shape[0]:
+                    s_t, s_y, s_mode, s_force = _grow(s_t, n_s), _grow(s_y, n_s), _grow(s_mode, n_s), _grow(s_force, n_s)
+                s_t[n_s] = t
+                s_y[n_s] = y
+                s_mode[n_s] = mode
+                s_force[n_s] = force
+                n_s += 1
+            if action == STOP_SETTLED:
+                reason = SETTLED_STOP
+                break
+            if action == STOP_RUNAWAY:
+                reason = RUNAWAY_STOP
+                break
+            if kind == stop_kind and counts[kind] >= stop_count:
+                reason = ASKED_STOP
+                break
+            quiet = restart_col
+            event_values(code, c, y, f, force, mode, energy_limit, g_old)
+            for col in range(N_EVENTS):
+                if col == quiet or g_old[col] == 0:
+                    g_old[col] = departure_sign(col, y, mode) * _TINY
+            h_abs = max(h_next, h_r)
+            continue
+        # the whole step stands
+        t = t_new
+        for j in range(5):
+            y[j] = y_new[j]
+            f[j] = f_new[j]
+        force = force_new
+        for col in range(N_EVENTS):
+            g_old[col] = g_new[col]
+        h_abs = h_next
+        max_force = max(max_force, force)
+        max_indentation = max(max_indentation, y[X1] - y[X2])
+        if save_kind == SAVE_STEPS:
+            if n_s == s_t.shape[0]:
+                s_t, s_y, s_mode, s_force = _grow(s_t, n_s), _grow(s_y, n_s), _grow(s_mode, n_s), _grow(s_force, n_s)
+            s_t[n_s] = t
+            s_y[n_s] = y
+            s_mode[n_s] = mode
+            s_force[n_s] = force
+            n_s += 1
+
+    summary = _summarize(code, c, y0, y, mode, status, reason, t, max_force, max_indentation, counts,
+                         n_ev, ev_t, ev_kind, ev_y, nsteps, nfev)
+    return (summary, ev_t[:n_ev], ev_kind[:n_ev], ev_mode[:n_ev], ev_y[:n_ev], ev_force[:n_ev],
+            s_t[:n_s], s_y[:n_s], s_mode[:n_s], s_force[:n_s], y)
+
+
+@numba.njit(cache=True)
+def _summarize(code, c, y0, y, mode, status, reason, t_stop, max_force, max_indentation, counts,
+               n_ev, ev_t, ev_kind, ev_y, nsteps, nfev):
+    """The summary vector of a run (indices ``S_*``); undefined entries are NaN."""
+    s = np.full(N_SUMMARY, np.nan)
+    s[S_STATUS] = status
+    s[S_REASON] = reason
+    s[S_T_STOP] = t_stop
+    s[S_MAX_FORCE] = max_force
+    s[S_MAX_INDENTATION] = max_indentation
+    s[S_DISSIPATED] = energy(code, c, y0) - energy(code, c, y)
+    s[S_LOOP_AREA] = y[WORK] - y0[WORK]
+    s[S_N_STICK] = counts[STICK]
+    s[S_N_CONTACTS] = counts[CONTACT]
+    s[S_NSTEPS] = nsteps
+    s[S_NFEV] = nfev
+    s[S_MODE] = mode
+    first_contact = -1
+    first_stick = -1
+    for i in range(n_ev):
+        kind = ev_kind[i]
+        if kind == CONTACT and first_contact < 0:
+            first_contact = i
+        elif kind == SEPARATION and first_contact >= 0 and math.isnan(s[S_CONTACT_DURATION]):
+            s[S_CONTACT_DURATION] = ev_t[i] - ev_t[first_contact]
+            dd0 = ev_y[first_contact, V1] - ev_y[first_contact, V2]
+            if dd0 != 0:
+                s[S_RESTITUTION] = -(ev_y[i, V1] - ev_y[i, V2]) / dd0
+        if kind == STICK and first_stick < 0:
+            first_stick = i
+            s[S_FIRST_STICK_T] = ev_t[i]
+            s[S_FIRST_STICK_DELTA] = ev_y[i, X1] - ev_y[i, X2]
+            s[S_FIRST_STICK_MARGIN] = stick_margin(c, ev_y[i])
+        if kind == SEPARATION and first_stick >= 0 and math.isnan(s[S_T_RUN]):
+            s[S_T_RUN] = ev_t[i]
+    if status != SUCCESS:
+        outcome = FAILED
+    elif reason == RUNAWAY_STOP:
+        outcome = RATCHET_ESCAPE if counts[STICK] > 0 else RUNAWAY_OUTCOME
+    elif reason == SETTLED_STOP:
+        if mode == STUCK:
+            outcome = PERMANENT_STICK
+        else:
+            outcome = RATCHET_ESCAPE if counts[STICK] > 0 else REBOUND
+    elif reason == ASKED_STOP:
+        outcome = UNSETTLED
+    else:
+        outcome = BOUNDED
+    s[S_OUTCOME] = outcome
+    return s
+
+
+@numba.njit(cache=True)
+def stick_points(n_ev, ev_t, ev_kind, ev_y, t_stop, permanent, out_t, out_delta, out_dwell):
+    """Stick phases of a log: time, ``delta*`` and dwell (to the next slip; to ``t_stop``, or
+    inf if the last stick is permanent). Writes up to ``len(out_t)``; returns their number."""
+    n = 0
+    cap = out_t.shape[0]
+    for i in range(n_ev):
+        if ev_kind[i] != STICK:
+            continue
+        end = math.inf if permanent else t_stop
+        for j in range(i + 1, n_ev):
+            if ev_kind[j] == SLIP:
+                end = ev_t[j]
+                break
+        if n < cap:
+            out_t[n] = ev_t[i]
+            out_delta[n] = ev_y[i, X1] - ev_y[i, X2]
+            out_dwell[n] = end - ev_t[i]
+        n += 1
+    return n
+
+
+@numba.njit(cache=True, parallel=True)
+def run_many(code, C, Y0, t_end, rtol, ATOL, max_step, settle, stop_kind, stop_count, max_steps, max_events,
+             rk4_step, capacity, summary, st_t, st_delta, st_dwell, st_count):
+    """Many runs in parallel (one thread per run; each run's numbers do not depend on the others
+    or on the thread count). Fills ``summary`` (n, N_SUMMARY) and the first ``capacity`` stick
+    points of each run; ``st_count`` holds each run's full number of stick points."""
+    empty = np.empty(0)
+    for i in numba.prange(C.shape[0]):
+        out = run(code, C[i], Y0[i], t_end[i], rtol, ATOL[i], max_step[i], settle, stop_kind, stop_count,
+                  SAVE_SUMMARY, empty, max_steps, max_events, rk4_step, 1)
+        s = out[0]
+        summary[i] = s
+        permanent = s[S_OUTCOME] == PERMANENT_STICK
+        st_count[i] = stick_points(out[1].shape[0], out[1], out[2], out[4], s[S_T_STOP], permanent,
+                                   st_t[i], st_delta[i], st_dwell[i])
+
+

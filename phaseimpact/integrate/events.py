@@ -1,0 +1,210 @@
+"""The event table of the hybrid system, compiled (REFERENCE §3, §5).
+
+Each event is a column of :func:`event_values`, with the direction that fires it and what the
+driver does then (:data:`ACTIONS`); :func:`transition` applies an event located at a state.
+
+==================  =========  =========  ===================================================
+column              direction  action     meaning
+==================  =========  =========  ===================================================
+``DELTA``           both       restart    ``delta``: contact onset (up), separation (down)
+``DELTADOT``        both       restart*   ``deltadot``: extreme indentation; ``paper``
+                                          slipping: stick, or a reversal of the slip
+``FORCE_RATE``      down       record     ``dP/dt``: a maximum of the contact force
+``STICK_BREAK``     down       restart    monotone stick-break distance while stuck: slip
+``ENERGY``          down       stop       ``2 E(0) - E``: the energy has doubled (runaway)
+``REACH``           up         stop**     ``-(x1 + A)``: a receding projectile is beyond the
+                                          reach ``A`` of the plate: no contact can follow
+==================  =========  =========  ===================================================
+
+(*) record only for laws without stick; (**) stop when the run stops once settled.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numba
+import numpy as np
+
+from ..model.laws import ABRATE_BILATERAL, PAPER_PRINTED, PAPER_UNILATERAL, STUCK, force_partials, hertz_power
+from ..model.rhs import (
+    ALPHA_,
+    DAMP_,
+    K_,
+    KB_,
+    KM_,
+    M1_,
+    M2_,
+    RIGID_,
+    SPRINGS_,
+    V1,
+    V2,
+    X1,
+    X2,
+    energy,
+    stick_break_distance,
+    stick_force,
+    stick_margin,
+    target_reach,
+)
+
+DELTA, DELTADOT, FORCE_RATE, STICK_BREAK, ENERGY, REACH = range(6)
+N_EVENTS = 6
+#: +1 fires on an increase through zero, -1 on a decrease, 0 on both.
+DIRECTIONS = np.array([0, 0, -1, -1, -1, 1], dtype=np.int64)
+
+# Event kinds in the log.
+CONTACT, SEPARATION, REVERSAL, STICK, SLIP, FORCE_PEAK, SETTLED, RUNAWAY = range(8)
+EVENT_KINDS = ("contact", "separation", "reversal", "stick", "slip", "force-peak", "settled", "runaway")
+# What a transition asks of the driver.
+GO_ON, STOP_SETTLED, STOP_RUNAWAY = 0, 1, 2
+
+#: Energy growth, relative to the run's initial energy, that ends a run as a runaway.
+RUNAWAY_ENERGY_FACTOR = 2.0
+
+
+@numba.njit(cache=True)
+def is_filippov(code):
+    return code == PAPER_PRINTED or code == PAPER_UNILATERAL
+
+
+@numba.njit(cache=True)
+def is_unilateral(code):
+    return code != ABRATE_BILATERAL and code != PAPER_PRINTED
+
+
+@numba.njit(cache=True)
+def event_values(code, c, y, f, force, mode, energy_limit, g):
+    """All event functions at ``y`` (``f`` its derivative, ``force`` its contact force) into ``g``.
+
+    Inactive events are held at +-1 so that they never fire.
+    """
+    delta = y[X1] - y[X2]
+    deltadot = y[V1] - y[V2]
+    g[DELTA] = delta
+    g[ENERGY] = energy_limit - energy(code, c, y)
+    g[REACH] = -1.0
+    g[STICK_BREAK] = 1.0
+    if mode == STUCK:
+        g[DELTADOT] = 1.0
+        # the stuck force M1/M S(x2) peaks where x2 does
+        g[FORCE_RATE] = (c[KB_] + 3.0 * c[KM_] * y[X2] * y[X2]) * y[V2] * c[M1_] / (c[M1_] + c[M2_])
+        g[STICK_BREAK] = stick_break_distance(c, y)
+        return
+    g[DELTADOT] = deltadot
+    p_delta, p_rate = force_partials(code, delta, deltadot, mode, c[K_], c[DAMP_], c[ALPHA_])
+    rate = p_delta * deltadot + p_rate * (f[V1] - f[V2])
+    touching = force != 0.0 or not is_unilateral(code)
+    g[FORCE_RATE] = rate if touching else -1.0
+    if is_unilateral(code) and c[SPRINGS_] > 0 and delta < 0 and y[V1] < 0:
+        g[REACH] = -(y[X1] + target_reach(c, y))
+
+
+@numba.njit(cache=True)
+def crossed(column, g_old, g_new):
+    """Whether event ``column`` fires between two evaluations (strict start: a restart at a zero
+    is quiet)."""
+    up = g_old[column] < 0 and g_new[column] >= 0
+    down = g_old[column] > 0 and g_new[column] <= 0
+    d = DIRECTIONS[column]
+    if d > 0:
+        return up
+    if d < 0:
+        return down
+    return up or down
+
+
+@numba.njit(cache=True)
+def departure_sign(column, y, mode):
+    """Sign event ``column`` takes just after a run restarts on its zero at ``y``."""
+    if column == DELTA:
+        dd = y[V1] - y[V2]
+        return 1.0 if dd >= 0 else -1.0
+    if column == DELTADOT:
+        return -1.0 if mode < 0 else 1.0
+    return 1.0
+
+
+@numba.njit(cache=True)
+def restarts(code, column, mode, settle):
+    """Whether an event of ``column`` changes the phase (restart) rather than being recorded."""
+    if column == FORCE_RATE:
+        return False
+    if column == DELTADOT:
+        return is_filippov(code) and mode != 2
+    if column == REACH:
+        return settle
+    return True
+
+
+@numba.njit(cache=True)
+def _stick_bound(code, c, y):
+    delta = y[X1] - y[X2]
+    if code == PAPER_UNILATERAL and delta <= 0:
+        return 0.0
+    return c[K_] * hertz_power(abs(delta), c[ALPHA_])
+
+
+@numba.njit(cache=True)
+def initial_mode(code, c, y):
+    """Mode of a run starting at ``y``: the sign of ``deltadot``, or stuck (``paper``) when the
+    relative velocity is zero and the stick bound holds (seed eq. 6 gives +1)."""
+    if not is_filippov(code):
+        return 1
+    deltadot = y[V1] - y[V2]
+    if deltadot > 0:
+        return 1
+    if deltadot < 0:
+        return -1
+    required = stick_force(c, y)
+    if abs(required) <= _stick_bound(code, c, y):
+        return STUCK
+    return -1 if required < 0 else 1
+
+
+@numba.njit(cache=True)
+def transition(code, c, column, y, mode, settle):
+    """Apply event ``column`` located at ``y`` (corrected in place).
+
+    Returns ``(kind, new_mode, action)``.
+    """
+    action = GO_ON
+    if column == DELTA:
+        y[X1] = y[X2]  # the event is delta = 0: remove the root finder's residue
+        deltadot = y[V1] - y[V2]
+        kind = CONTACT if deltadot > 0 else SEPARATION
+        if is_filippov(code) and mode != STUCK and deltadot != 0:
+            mode = 1 if deltadot > 0 else -1
+        if kind == SEPARATION and is_unilateral(code) and c[SPRINGS_] == 0 and settle:
+            action = STOP_SETTLED  # a wall or a free target never meets the projectile again
+        return kind, mode, action
+    if column == DELTADOT:
+        if not is_filippov(code) or mode == 2:
+            return REVERSAL, mode, action
+        if code == PAPER_UNILATERAL and y[X1] - y[X2] <= 0:
+            return REVERSAL, -mode, action  # the extreme of delta in flight
+        required = stick_force(c, y)
+        if abs(required) <= _stick_bound(code, c, y):
+            common = 0.0 if c[RIGID_] > 0 else (c[M1_] * y[V1] + c[M2_] * y[V2]) / (c[M1_] + c[M2_])
+            y[V1] = common
+            y[V2] = common
+            if settle and stick_margin(c, y) >= 0:
+                action = STOP_SETTLED
+            return STICK, STUCK, action
+        new = 1 if required > 0 else (-1 if required < 0 else 0)
+        return REVERSAL, (-mode if (new == 0 or new == mode) else new), action
+    if column == STICK_BREAK:
+        return SLIP, (-1 if stick_force(c, y) < 0 else 1), action
+    if column == FORCE_RATE:
+        return FORCE_PEAK, mode, action
+    if column == ENERGY:
+        return RUNAWAY, mode, STOP_RUNAWAY
+    # REACH
+    return SETTLED, mode, (STOP_SETTLED if settle else GO_ON)
+
+
+@numba.njit(cache=True)
+def energy_limit_of(code, c, y0):
+    """Energy at which a run counts as a runaway: twice its own initial energy."""
+    e0 = energy(code, c, y0)
+    return RUNAWAY_ENERGY_FACTOR * e0 if e0 > 0 else math.inf

@@ -1,0 +1,44 @@
+"""Coefficient of restitution of Hunt-Crossley contact and its exact inverse (REFERENCE §4)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from scipy.optimize import brentq
+from scipy.special import lambertw
+
+from ..parameters import Parameters, require
+
+__all__ = ["hunt_crossley_restitution", "kappa_for_restitution"]
+
+#: Taylor coefficients of e(a) at a = 0 (from the implicit equation of REFERENCE §4).
+_RESTITUTION_SERIES = (1.0, -2 / 3, 4 / 9, -44 / 135, 104 / 405, -40 / 189, 7648 / 42525, -2848 / 18225)
+_SERIES_BELOW = 0.02  # the series' truncation error there is ~1e-15; W0's rounding error is ~eps/a^2
+
+
+def hunt_crossley_restitution(a):
+    """Exact restitution of Hunt-Crossley contact, ``a = kappa v0 / K`` (REFERENCE §4).
+
+    ``e = (1 + W0(-(1+a) exp(-(1+a)))) / a``. Next to ``a = 0`` the argument of ``W0`` sits on
+    its branch point and rounding costs ``eps/a^2``; there the Taylor series is used instead.
+    """
+    a = np.asarray(a, dtype=float)
+    safe = np.where(a >= _SERIES_BELOW, a, 1.0)
+    w = lambertw(-(1 + safe) * np.exp(-(1 + safe)), 0).real
+    series = np.polynomial.polynomial.polyval(a, _RESTITUTION_SERIES)
+    return np.where(a >= _SERIES_BELOW, (1 + w) / safe, series)
+
+
+def kappa_for_restitution(e: float, params: Parameters) -> float:
+    """The ``kappa`` whose Hunt-Crossley contact restitutes exactly ``e`` at speed ``params.v``.
+
+    Inverts :func:`hunt_crossley_restitution` (valid for a rigid or free target), for
+    ``1e-6 <= e <= 1`` (below that ``a`` exceeds 1e6 and ``e ~ 1/a`` is all that is left).
+    """
+    require("restitution", e, "a number with 1e-6 <= e <= 1", math.isfinite(e) and 1e-6 <= e <= 1)
+    if e == 1:
+        return 0.0
+    a = brentq(lambda a: float(hunt_crossley_restitution(a)) - e, 1e-12, 1e12,
+               xtol=1e-300, rtol=4 * np.finfo(float).eps, maxiter=500)
+    return a * params.K / params.v

@@ -1,0 +1,223 @@
+r"""Equations of motion composed from a law's kernels (seed eq. 1 and 8; REFERENCE §3-§4).
+
+State ``y = (x1, x2, x1dot, x2dot, W)``: projectile and target-centre displacements (m), their
+velocities (m/s), and ``W = \int P d(delta)``, the work of the contact force on the relative
+motion (J)::
+
+    M1 x1'' = -P
+    M2 x2'' = -S(x2) + P,        S(x2) = Kb x2 + Km x2^3   (plate; 0 for a free target)
+    delta = x1 - x2,  deltadot = x1dot - x2dot,  W' = P deltadot
+
+A rigid target is held at ``x2 = 0``. While ``paper`` is stuck the bodies move as one of mass
+``M1 + M2`` and ``P = F_req = M1/(M1+M2) S(x2)``. Coefficients travel packed in one float array
+(:func:`pack`), the layout every compiled function reads.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numba
+import numpy as np
+
+from ..parameters import Parameters
+from .laws import STUCK, ContactLaw, as_law, contact_force, contact_potential, force_partials, hertz_power
+
+__all__ = [
+    "X1", "X2", "V1", "V2", "WORK", "pack", "N_COEF",
+    "rhs", "energy", "stick_force", "stick_orbit", "stick_margin", "stick_break_distance",
+    "jacobian", "contact_force_of_states", "energy_of_states", "initial_state",
+]
+
+X1, X2, V1, V2, WORK = range(5)
+# Packed coefficients.
+M1_, M2_, K_, KB_, KM_, DAMP_, ALPHA_, SPRINGS_, RIGID_ = range(9)
+N_COEF = 9
+
+
+def pack(params: Parameters, law: ContactLaw) -> np.ndarray:
+    """The packed coefficient array of ``params`` under ``law`` (springs only on a plate)."""
+    springs = params.target == "plate"
+    return np.array([params.M1, params.M2, params.K, params.Kb if springs else 0.0,
+                     params.Km if springs else 0.0, law.kappa(params), params.alpha,
+                     1.0 if springs else 0.0, 1.0 if params.target == "rigid" else 0.0])
+
+
+@numba.njit(cache=True)
+def spring_force(c, x2):
+    """``S(x2) = Kb x2 + Km x2^3``, N."""
+    return (c[KB_] + c[KM_] * x2 * x2) * x2
+
+
+@numba.njit(cache=True)
+def stick_force(c, y):
+    """Force that keeps the projectile with the target while stuck, ``F_req``, N."""
+    return c[M1_] / (c[M1_] + c[M2_]) * spring_force(c, y[X2])
+
+
+@numba.njit(cache=True)
+def rhs(code, c, y, mode, out):
+    """Write ``dy/dt`` into ``out`` (shape (5,)); return the contact force ``P``, N."""
+    x2, v1, v2 = y[X2], y[V1], y[V2]
+    out[X1] = v1
+    out[X2] = v2
+    if mode == STUCK:
+        if c[RIGID_] > 0:
+            out[V1] = out[V2] = out[WORK] = 0.0
+            return 0.0
+        accel = -spring_force(c, x2) / (c[M1_] + c[M2_])
+        out[V1] = out[V2] = accel
+        force = stick_force(c, y)
+        out[WORK] = force * (v1 - v2)
+        return force
+    force = contact_force(code, y[X1] - x2, v1 - v2, mode, c[K_], c[DAMP_], c[ALPHA_])
+    out[V1] = -force / c[M1_]
+    out[V2] = 0.0 if c[RIGID_] > 0 else (force - spring_force(c, x2)) / c[M2_]
+    out[WORK] = force * (v1 - v2)
+    return force
+
+
+@numba.njit(cache=True)
+def energy(code, c, y):
+    """Mechanical energy (REFERENCE §4), J: kinetic + target springs + the contact potential
+    of laws whose elastic term is conservative."""
+    x2 = y[X2]
+    x2sq = x2 * x2
+    kinetic = 0.5 * c[M1_] * y[V1] * y[V1] + 0.5 * c[M2_] * y[V2] * y[V2]
+    springs = (0.5 * c[KB_] + 0.25 * c[KM_] * x2sq) * x2sq
+    return kinetic + springs + contact_potential(code, y[X1] - x2, c[K_], c[ALPHA_])
+
+
+@numba.njit(cache=True)
+def _orbit_amplitude(c, x2, v, mass):
+    """Turning point of an oscillator of ``mass`` on the springs ``S`` through ``(x2, v)``, m."""
+    orbit_energy = 0.5 * mass * v * v + (0.5 * c[KB_] + 0.25 * c[KM_] * x2 * x2) * x2 * x2
+    root = math.sqrt(c[KB_] * c[KB_] + 4.0 * c[KM_] * orbit_energy)
+    if c[KB_] + root <= 0:
+        return abs(x2)
+    return math.sqrt(4.0 * orbit_energy / (c[KB_] + root))
+
+
+@numba.njit(cache=True)
+def target_reach(c, y):
+    """Largest ``|x2|`` the target can reach with its current energy, m."""
+    return _orbit_amplitude(c, y[X2], y[V2], c[M2_])
+
+
+@numba.njit(cache=True)
+def stick_orbit(c, y):
+    """Amplitude ``A`` of the stuck pair's orbit and the ``|x2|`` at which the stick breaks.
+
+    The pair oscillates with conserved energy ``M v^2/2 + Kb x2^2/2 + Km x2^4/4``
+    (``M = M1 + M2``); the force it needs, ``M1/M S(x2)``, reaches the bound ``K |delta|^alpha``
+    at ``x_break``, the real root of ``Km x^3 + Kb x = M/M1 * bound`` (Cardano). REFERENCE §5.
+    """
+    M = c[M1_] + c[M2_]
+    amplitude = _orbit_amplitude(c, y[X2], y[V2], M)
+    bound = M / c[M1_] * c[K_] * hertz_power(abs(y[X1] - y[X2]), c[ALPHA_])
+    if c[KM_] > 0:
+        p = c[KB_] / (3.0 * c[KM_])
+        if p > 0:
+            x_break = 2.0 * math.sqrt(p) * math.sinh(math.asinh(bound / (2.0 * c[KM_]) / p**1.5) / 3.0)
+        else:
+            x_break = (bound / c[KM_]) ** (1.0 / 3.0)
+    else:
+        x_break = bound / c[KB_] if c[KB_] > 0 else math.inf
+    return amplitude, x_break
+
+
+@numba.njit(cache=True)
+def stick_margin(c, y):
+    """Relative margin of a stick entered at ``y``: ``1 - M1/M S(A) / (K |delta*|^alpha)``.
+
+    ``>= 0``: the stick never breaks (permanent); the critical damping is its root
+    (REFERENCE §5). 1 without target springs (nothing pulls the pair apart).
+    """
+    if c[SPRINGS_] == 0:
+        return 1.0
+    amplitude, _ = stick_orbit(c, y)
+    bound = c[K_] * hertz_power(abs(y[X1] - y[X2]), c[ALPHA_])
+    required = c[M1_] / (c[M1_] + c[M2_]) * spring_force(c, amplitude)
+    if bound <= 0:
+        return -math.inf if required > 0 else 1.0
+    return 1.0 - required / bound
+
+
+@numba.njit(cache=True)
+def stick_break_distance(c, y):
+    """Stick-break event function, monotone along each half-swing of the stuck pair, m.
+
+    ``x_break - |x2|`` swinging out and ``x_break - 2A + |x2|`` swinging back (continuous at the
+    turning point, where it is ``x_break - A``). A plain ``bound - |F_req|`` only grazes zero at
+    the turning point when the violation is small, and a step can jump over it; this one is
+    negative at the turning point whenever the orbit leaves the stick bound. +1 when the orbit
+    never reaches ``x_break``.
+    """
+    if c[SPRINGS_] == 0:
+        return 1.0
+    amplitude, x_break = stick_orbit(c, y)
+    if amplitude <= x_break:
+        return 1.0
+    x2 = y[X2]
+    if x2 * y[V2] >= 0:
+        return x_break - abs(x2)
+    return x_break - 2.0 * amplitude + abs(x2)
+
+
+def initial_state(v: float) -> np.ndarray:
+    """Seed eq. 6: ``x1 = x2 = 0``, ``x1dot = v``, ``x2dot = 0``, no work done."""
+    return np.array([0.0, 0.0, float(v), 0.0, 0.0])
+
+
+def jacobian(y, params: Parameters, law, mode: int = 1) -> np.ndarray:
+    """Exact Jacobian of the mechanical right-hand side ``(x1, x2, x1dot, x2dot)``, shape (4, 4)."""
+    law = as_law(law)
+    c = pack(params, law)
+    y = np.asarray(y, dtype=float)
+    J = np.zeros((4, 4))
+    J[0, 2] = J[1, 3] = 1.0
+    spring_rate = c[KB_] + 3.0 * c[KM_] * y[X2] ** 2
+    if c[RIGID_] > 0 and mode == STUCK:
+        return J
+    if mode == STUCK:
+        J[2, 1] = J[3, 1] = -spring_rate / (c[M1_] + c[M2_])
+        return J
+    P_delta, P_rate = force_partials(law.code, y[X1] - y[X2], y[V1] - y[V2], mode, c[K_], c[DAMP_], c[ALPHA_])
+    dP = np.array([P_delta, -P_delta, P_rate, -P_rate])
+    J[2] = -dP / c[M1_]
+    if c[RIGID_] == 0:
+        J[3] = dP / c[M2_]
+        J[3, 1] -= spring_rate / c[M2_]
+    return J
+
+
+@numba.njit(cache=True)
+def _force_of_states(code, c, ys, modes, out):
+    work = np.empty(5)
+    for i in range(ys.shape[0]):
+        out[i] = rhs(code, c, ys[i], modes[i], work)
+
+
+@numba.njit(cache=True)
+def _energy_of_states(code, c, ys, out):
+    for i in range(ys.shape[0]):
+        out[i] = energy(code, c, ys[i])
+
+
+def contact_force_of_states(ys, params: Parameters, law, modes) -> np.ndarray:
+    """Contact force (N) at states ``ys`` (shape (n, 5)) in ``modes`` (shape (n,))."""
+    law = as_law(law)
+    ys = np.ascontiguousarray(ys, dtype=float).reshape(-1, 5)
+    out = np.empty(len(ys))
+    _force_of_states(law.code, pack(params, law), ys, np.broadcast_to(np.asarray(modes, dtype=np.int64),
+                                                                          (len(ys),)).copy(), out)
+    return out
+
+
+def energy_of_states(ys, params: Parameters, law) -> np.ndarray:
+    """Mechanical energy (J, REFERENCE §4) at states ``ys`` (shape (n, 5))."""
+    law = as_law(law)
+    ys = np.ascontiguousarray(ys, dtype=float).reshape(-1, 5)
+    out = np.empty(len(ys))
+    _energy_of_states(law.code, pack(params, law), ys, out)
+    return out
