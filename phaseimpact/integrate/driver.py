@@ -298,9 +298,9 @@ def run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count,
     # ---- adaptive DOP853 with events ----
     quiet = DELTA
     event_values(code, c, y, f, force, mode, energy_limit, g_old)
-    for col in range(N_EVENTS):
-        if col == quiet or g_old[col] == 0:
-            g_old[col] = departure_sign(col, y, mode) * _TINY
+    # the event the run starts on leaves its zero with a known sign; another event exactly at zero
+    # (0 is neither side) cannot fire in the first step
+    g_old[quiet] = departure_sign(quiet, y, mode) * _TINY
     h_abs = dop853.initial_step(code, c, mode, y, f, rtol, atol, t_end, max_step, tmp, f_new)
     nfev += 1
 
@@ -454,9 +454,7 @@ def run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count,
                 break
             quiet = restart_col
             event_values(code, c, y, f, force, mode, energy_limit, g_old)
-            for col in range(N_EVENTS):
-                if col == quiet or g_old[col] == 0:
-                    g_old[col] = departure_sign(col, y, mode) * _TINY
+            g_old[quiet] = departure_sign(quiet, y, mode) * _TINY
             h_abs = max(h_next, h_r)
             continue
         # the whole step stands
