@@ -1,40 +1,177 @@
-"""Write a file so that readers only ever see the old or the complete new version."""
+"""Write a file so that readers only ever see the old or the complete new version, one writer at a time.
+
+Two pieces, used together by :func:`atomic_path`:
+
+* :func:`exclusive` holds an advisory lock (``fcntl.flock`` on a sidecar ``PATH.lock``) for as
+  long as a writer owns ``PATH``. It never waits: a second writer gets :class:`PathLockedError`
+  (a ``ValueError``) naming the holder's process id. It is re-entrant within one process, so a
+  command can hold it for a whole sweep while each checkpoint's :func:`atomic_path` takes it again.
+* :func:`atomic_path` writes to a temporary file beside ``PATH`` (named with the writer's process
+  id), fsyncs it and renames it over ``PATH``. Temporary files of earlier writers are removed only
+  when their process is dead, and only by the lock holder, so a live writer's file is never touched.
+"""
 
 from __future__ import annotations
 
 import contextlib
+import errno
+import fcntl
 import glob
 import os
+import re
 import tempfile
+
+__all__ = ["PathLockedError", "atomic_path", "exclusive", "check_target"]
+
+
+class PathLockedError(ValueError):
+    """Another process is writing the same path."""
+
+
+#: Locks held by this process: absolute path -> [file descriptor, depth].
+_HELD: dict[str, list] = {}
+
+
+def _lock_path(path: str) -> str:
+    return path + ".lock"
+
+
+def _holder(lock_file: str) -> str:
+    try:
+        with open(lock_file, encoding="ascii") as handle:
+            pid = handle.read().strip()
+    except OSError:
+        pid = ""
+    return pid if pid.isdigit() else "unknown"
+
+
+def check_target(path, name: str = "out") -> str:
+    """Check, without writing anything, that ``path`` can become a file; return it as ``str``.
+
+    Raises ``ValueError`` naming ``name`` for an empty path, an existing folder, a path below a
+    regular file, or a folder this process may not write in.
+    """
+    path = os.fspath(path)
+    if not isinstance(path, str) or not path.strip():
+        raise ValueError(f"{name} = {path!r} is out of range; allowed: a file path such as results.h5")
+    if os.path.isdir(path):
+        raise ValueError(f"{name} = {path!r} is a folder; allowed: a file path (e.g. {os.path.join(path, 'sweep.h5')})")
+    folder = os.path.dirname(os.path.abspath(path))
+    existing = folder
+    while not os.path.exists(existing):
+        existing = os.path.dirname(existing)
+    if not os.path.isdir(existing):
+        raise ValueError(f"{name} = {path!r} is out of range: {existing!r} is a file, not a folder")
+    if not os.access(existing, os.W_OK | os.X_OK):
+        raise ValueError(f"{name} = {path!r} is out of range: the folder {existing!r} is not writable")
+    return path
 
 
 @contextlib.contextmanager
-def atomic_path(path):
+def exclusive(path, name: str = "out"):
+    """Hold the write lock of ``path`` (sidecar ``PATH.lock``) for the ``with`` block; never wait.
+
+    Raises :class:`PathLockedError` if another process holds it, ``ValueError`` if the lock
+    file cannot be created (read-only folder, a path below a file...). Missing folders are created.
+    """
+    path = check_target(path, name)
+    key = os.path.abspath(path)
+    if key in _HELD:
+        _HELD[key][1] += 1
+        try:
+            yield path
+        finally:
+            _HELD[key][1] -= 1
+        return
+    lock_file = _lock_path(key)
+    try:
+        os.makedirs(os.path.dirname(key), exist_ok=True)
+    except OSError as error:
+        raise ValueError(f"{name} = {path!r}: cannot create its folder: {error.strerror or error}") from None
+    while True:
+        try:
+            fd = os.open(lock_file, os.O_RDWR | os.O_CREAT, 0o666)
+        except OSError as error:
+            raise ValueError(f"{name} = {path!r} cannot be written: {error.strerror or error} "
+                             f"({lock_file!r})") from None
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except OSError as error:
+            os.close(fd)
+            if error.errno in (errno.EWOULDBLOCK, errno.EAGAIN, errno.EACCES):
+                raise PathLockedError(f"{path} is being written by another phaseimpact process "
+                                      f"(pid {_holder(lock_file)})") from None
+            raise ValueError(f"{name} = {path!r}: cannot lock {lock_file!r}: {error.strerror or error}") from None
+        # The previous holder unlinks the lock file before releasing it: make sure we locked the
+        # file that is on disk now, not one that was removed between our open and our flock.
+        try:
+            same = os.path.samestat(os.fstat(fd), os.stat(lock_file))
+        except FileNotFoundError:
+            same = False
+        if same:
+            break
+        os.close(fd)
+    os.ftruncate(fd, 0)
+    os.write(fd, f"{os.getpid()}\n".encode("ascii"))
+    _HELD[key] = [fd, 1]
+    try:
+        yield path
+    finally:
+        _HELD[key][1] -= 1
+        if _HELD[key][1] == 0:
+            del _HELD[key]
+            with contextlib.suppress(OSError):
+                os.remove(lock_file)
+            os.close(fd)  # releases the lock
+
+
+def _alive(pid: int) -> bool:
+    if pid == os.getpid():
+        return True
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:  # exists, owned by someone else
+        return True
+    return True
+
+
+def _remove_dead_writers_temps(folder: str, prefix: str) -> None:
+    """Remove ``prefix<pid>-*.tmp`` files whose writer process is gone (caller holds the lock)."""
+    pattern = re.compile(re.escape(prefix) + r"(\d+)-[^/]*\.tmp\Z")
+    for stale in glob.glob(os.path.join(glob.escape(folder), glob.escape(prefix) + "*.tmp")):
+        match = pattern.match(os.path.basename(stale))
+        if match and not _alive(int(match.group(1))):
+            with contextlib.suppress(FileNotFoundError):
+                os.remove(stale)
+
+
+@contextlib.contextmanager
+def atomic_path(path, name: str = "path"):
     """Yield a temporary path beside ``path``; on success fsync it and rename it over ``path``.
 
-    On any error (or interruption) the temporary file is removed and ``path`` is untouched.
-    The file gets the permissions an ordinary ``open(path, "w")`` would give it. Temporary files
-    left by an earlier writer of the same ``path`` that was killed (SIGKILL skips all clean-up)
-    are removed first.
+    The write lock of ``path`` is held throughout (see :func:`exclusive`; a second writer gets
+    :class:`PathLockedError`). On any error (or interruption) the temporary file is removed and
+    ``path`` is untouched. The file gets the permissions an ordinary ``open(path, "w")`` would
+    give it. Temporary files left by earlier writers of ``path`` that were killed (SIGKILL skips
+    all clean-up) are removed first: only those whose process is dead.
     """
-    path = os.fspath(path)
-    folder = os.path.dirname(os.path.abspath(path))
-    os.makedirs(folder, exist_ok=True)
-    prefix = f".{os.path.basename(path)}."
-    for stale in glob.glob(os.path.join(glob.escape(folder), glob.escape(prefix) + "*.tmp")):
-        with contextlib.suppress(FileNotFoundError):
-            os.remove(stale)
-    fd, tmp = tempfile.mkstemp(prefix=prefix, suffix=".tmp", dir=folder)
-    os.close(fd)
-    try:
-        yield tmp
-        umask = os.umask(0)
-        os.umask(umask)
-        os.chmod(tmp, 0o666 & ~umask)
-        with open(tmp, "rb+") as handle:
-            os.fsync(handle.fileno())
-        os.replace(tmp, path)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.remove(tmp)
-        raise
+    with exclusive(path, name) as path:
+        folder = os.path.dirname(os.path.abspath(path))
+        prefix = f".{os.path.basename(path)}."
+        _remove_dead_writers_temps(folder, prefix)
+        fd, tmp = tempfile.mkstemp(prefix=f"{prefix}{os.getpid()}-", suffix=".tmp", dir=folder)
+        os.close(fd)
+        try:
+            yield tmp
+            umask = os.umask(0)
+            os.umask(umask)
+            os.chmod(tmp, 0o666 & ~umask)
+            with open(tmp, "rb+") as handle:
+                os.fsync(handle.fileno())
+            os.replace(tmp, path)
+        except BaseException:
+            if os.path.exists(tmp):
+                os.remove(tmp)
+            raise
