@@ -1,26 +1,30 @@
-"""HDF5 archive and command line: schema, atomic writes, resume after a kill, bad input."""
+"""HDF5 archive and command line: schema, atomic writes, one writer at a time, resume after a kill."""
 
+import importlib
 import json
 import os
-import signal
+import shlex
 import subprocess
 import sys
+import textwrap
 import time
 
 import h5py
 import numpy as np
 import pytest
 
-from phaseimpact import archive, seed_parameters
+from phaseimpact import _atomic, archive, seed_parameters
 from phaseimpact.cli import main
 from phaseimpact.continuation import sweep
 from phaseimpact.model import ContactLaw
 
 CLI = [sys.executable, "-m", "phaseimpact.cli"]
+SWEEP = ["sweep", "--law", "paper", "--v", "1", "--kappa-min", "1e9", "--kappa-max", "1e14", "--num", "40",
+         "--no-progress"]
 
 
-def run_cli(*args):
-    return subprocess.run([*CLI, *args], capture_output=True, text=True, timeout=600)
+def run_cli(*args, cwd=None, env=None):
+    return subprocess.run([*CLI, *args], capture_output=True, text=True, timeout=600, cwd=cwd, env=env)
 
 
 @pytest.fixture(scope="module")
@@ -28,21 +32,31 @@ def small_sweep():
     return sweep(seed_parameters(), ContactLaw("paper"), np.geomspace(1e9, 1e14, 8))
 
 
+# ------------------------------------------------------------------------------------------------
+# Schema
+# ------------------------------------------------------------------------------------------------
+
 def test_archive_round_trip_and_plain_h5py(tmp_path, small_sweep):
     path = tmp_path / "s.h5"
     archive.save(small_sweep, path)
     with h5py.File(path, "r") as f:  # plain h5py, documented names and units
         assert f.attrs["schema_version"] == archive.SCHEMA_VERSION
         assert f["sweep/kappa"].attrs["units"] == "N s/m^(1+alpha)"
-        offsets = f["sweep/points/offsets"][()]
-        assert np.array_equal(np.diff(offsets), f["sweep/n_asymptotic"][()])
-        assert json.loads(f.attrs["parameters"])["M1"] == small_sweep.params.M1
+        assert f["sweep/max_force"].attrs["units"] == "N"
+        assert json.loads(f.attrs["parameters"])["M1"] == small_sweep.grid.base.M1
+        outcome = f["sweep/outcome"].asstr()[()]  # strings come back as str through .asstr()
+        assert all(isinstance(s, str) for s in outcome)
+        assert list(outcome) == list(small_sweep.outcome_names())
+        points = f["sweep/sticks/point"][()]
+        assert np.array_equal(np.bincount(points, minlength=8), f["sweep/n_stick"][()])
     back = archive.load(path)
     assert np.array_equal(back.kappa, small_sweep.kappa)
-    assert np.array_equal(back.max_force, small_sweep.max_force)
-    assert all(np.array_equal(a, b) for a, b in zip(back.points, small_sweep.points, strict=True))
-    assert list(back.outcome) == list(small_sweep.outcome)
-    assert back.law == small_sweep.law and back.params == small_sweep.params
+    assert np.array_equal(back.status, small_sweep.status) and np.array_equal(back.outcome, small_sweep.outcome)
+    for name, values in small_sweep.values.items():
+        assert np.array_equal(back.values[name], values, equal_nan=values.dtype.kind == "f"), name
+    assert np.array_equal(back.stick_delta, small_sweep.stick_delta)
+    assert back.law == small_sweep.law and back.grid.base == small_sweep.grid.base
+    assert back.t_end is None and back.settings["rtol"] == small_sweep.settings["rtol"]
 
 
 def test_archive_rejects_foreign_truncated_and_newer(tmp_path, small_sweep):
@@ -65,7 +79,79 @@ def test_archive_rejects_foreign_truncated_and_newer(tmp_path, small_sweep):
     text.write_text("hello")
     with pytest.raises(ValueError, match="not a readable HDF5"):
         archive.load(text)
+    with pytest.raises(ValueError, match="not a phaseimpact archive"):  # never replaced without force
+        archive.save(small_sweep, text)
+    assert text.read_text() == "hello"
 
+
+def test_schema_1_archives_still_load(tmp_path):
+    """An archive written by phaseimpact 0.1 (schema 1) loads into today's result."""
+    path = tmp_path / "v1.h5"
+    params = seed_parameters()
+    with h5py.File(path, "w") as f:
+        f.attrs.update({"schema_version": 1, "package_version": "0.1.0", "kind": "sweep", "integrator": "batch",
+                        "law": json.dumps({"name": "paper", "restitution": None, "bilateral": False,
+                                           "clamp": False}),
+                        "parameters": json.dumps({k: v for k, v in params.as_dict().items() if k != "R"}),
+                        "rtol": 1e-10, "min_dwell": -1.0, "t_end": 0.01, "created": "2025-01-01T00:00:00+00:00"})
+        g = f.create_group("sweep")
+        g["kappa"] = [1e9, 1e12, 1e13]
+        g["n_asymptotic"] = np.array([1, 2, -1])
+        g.create_dataset("outcome", data=np.array(["stick", "runaway", ""], dtype=object), dtype=h5py.string_dtype())
+        g.create_dataset("status", data=np.array(["success", "runaway", ""], dtype=object),
+                         dtype=h5py.string_dtype())
+        for name in ("max_force", "max_indentation", "restitution", "dissipated_energy"):
+            g[name] = [1.0, 2.0, np.nan]
+        g["points/offsets"] = np.array([0, 1, 3, 3])
+        g["points/delta"], g["points/deltadot"], g["points/dwell"] = [1e-5, 2e-5, 3e-5], [0.0] * 3, [1.0] * 3
+    back = archive.load(path)
+    assert list(back.outcome_names()) == ["permanent-stick", "runaway", "not computed"]
+    assert list(back.done) == [True, True, False]  # the missing point is computed on resume
+    assert list(back.values["n_stick"]) == [1, 2, -1]
+    assert archive.describe(path)["axes"]["kappa"].tolist() == [1e9, 1e12, 1e13]
+
+
+def test_numpy_scalars_are_stored_as_plain_numbers(tmp_path):
+    """float32 / int64 inputs are accepted and the archive holds plain JSON numbers (defect 7)."""
+    params = seed_parameters(v=np.float32(1.0))
+    result = sweep(params, ContactLaw("hunt-crossley"), np.geomspace(1e9, 1e11, 3), t_end=np.float32(2e-3),
+                   rtol=np.float64(1e-10), n_jobs=np.int64(1))
+    path = tmp_path / "np.h5"
+    archive.save(result, path)
+    with h5py.File(path, "r") as f:
+        stored = json.loads(f.attrs["parameters"])
+        assert type(stored["v"]) is float and stored["v"] == 1.0
+        assert isinstance(f.attrs["t_end"], (float, np.floating))
+    assert archive.load(path).t_end == pytest.approx(2e-3, rel=1e-6)
+    assert json.loads(archive._json({"a": np.float32(0.5), "b": np.int64(3), "c": np.arange(2)})) == \
+        {"a": 0.5, "b": 3, "c": [0, 1]}
+
+
+def test_created_comes_from_source_date_epoch_and_files_are_reproducible(tmp_path, small_sweep, monkeypatch):
+    """With SOURCE_DATE_EPOCH (make reproduce sets it) two saves are byte-identical (defect 15)."""
+    monkeypatch.setenv("SOURCE_DATE_EPOCH", "1700000000")
+    a, b = tmp_path / "a.h5", tmp_path / "b.h5"
+    archive.save(small_sweep, a)
+    time.sleep(1.1)  # a second later: any wall-clock time in the file would now differ
+    archive.save(small_sweep, b)
+    assert a.read_bytes() == b.read_bytes()
+    with h5py.File(a, "r") as f:
+        assert f.attrs["created"] == "2023-11-14T22:13:20+00:00"
+    monkeypatch.setenv("SOURCE_DATE_EPOCH", "yesterday")
+    with pytest.raises(ValueError, match="SOURCE_DATE_EPOCH"):
+        archive.save(small_sweep, tmp_path / "c.h5")
+    assert not (tmp_path / "c.h5").exists()
+
+
+def test_results_do_not_depend_on_jobs(tmp_path, small_sweep):
+    again = sweep(seed_parameters(), ContactLaw("paper"), np.geomspace(1e9, 1e14, 8), n_jobs=2)
+    for name, values in small_sweep.values.items():
+        assert np.array_equal(again.values[name], values, equal_nan=values.dtype.kind == "f"), name
+
+
+# ------------------------------------------------------------------------------------------------
+# Command line: JSON contracts
+# ------------------------------------------------------------------------------------------------
 
 def test_cli_json_contracts(capsys):
     assert main(["params", "--json"]) == 0
@@ -74,84 +160,245 @@ def test_cli_json_contracts(capsys):
     assert main(["simulate", "--law", "paper", "--v", "1", "--kappa", "3e12", "--target", "plate",
                  "--t-end", "0.01", "--json"]) == 0
     out = json.loads(capsys.readouterr().out)
-    expected = {"law", "v", "kappa", "target", "status", "message", "max_force", "max_indentation",
-                "contact_duration", "restitution", "time_equal_displacement", "dissipated_energy", "loop_area",
-                "asymptotic_points", "outcome"}
+    expected = {"law", "contact", "v", "kappa", "target", "status", "stop_reason", "message", "max_force",
+                "max_indentation", "contact_duration", "restitution", "time_equal_displacement",
+                "dissipated_energy", "loop_area", "n_stick", "t_run", "stick_points", "asymptotic_points",
+                "outcome"}
     assert expected <= set(out)
-    assert out["status"] == "runaway" and out["outcome"] == "runaway"
+    assert out["status"] == "success" and out["n_stick"] >= 2
     assert all(set(p) == {"delta", "deltadot", "dwell"} for p in out["asymptotic_points"])
-    assert main(["simulate", "--law", "hunt-crossley", "--restitution", "0.8", "--target", "free",
-                 "--json"]) == 0
+    assert main(["simulate", "--law", "hunt-crossley", "--restitution", "0.8", "--target", "free", "--json"]) == 0
     out = json.loads(capsys.readouterr().out)
     assert abs(out["restitution"] - 0.8) < 1e-8  # exact inverse (REFERENCE §4)
 
 
-@pytest.mark.parametrize("args, name", [
-    (["simulate", "--v", "-1"], "v"),
-    (["simulate", "--v", "nan"], "v"),
-    (["simulate", "--kappa", "-3"], "kappa"),
-    (["simulate", "--t-end", "0"], "t-end"),
-    (["simulate", "--law", "flores", "--restitution", "1.5"], "restitution"),
-    (["simulate", "--law", "nonsense"], "law"),
-    (["simulate", "--target", "wall"], "target"),
-    (["sweep", "--kappa-min", "1e10", "--kappa-max", "1e9", "--out", "x.h5"], "kappa-min"),
-    (["sweep", "--kappa-min", "1e9", "--kappa-max", "1e10", "--num", "0", "--out", "x.h5"], "num"),
-    (["sweep", "--kappa-min", "1e9", "--kappa-max", "1e10", "--jobs", "0", "--out", "x.h5"], "jobs"),
-    (["critical-curve", "--v-min", "5", "--v-max", "1", "--out", "x.h5"], "v-min"),
-])
-def test_cli_bad_input_one_line_exit_2(args, name, tmp_path):
-    result = subprocess.run([*CLI, *args], capture_output=True, text=True, cwd=tmp_path, timeout=60)
-    assert result.returncode == 2
-    assert "Traceback" not in result.stderr
-    message = result.stderr.strip().splitlines()
-    assert len(message) == 1 or message[-1].startswith("phaseimpact")
-    assert name in message[-1]
-    assert not (tmp_path / "x.h5").exists()
+def test_cli_sweep_summary_readable_and_json(tmp_path, capsys):
+    out = tmp_path / "s.h5"
+    assert main([*SWEEP, "--out", str(out)]) == 0
+    text = capsys.readouterr().out
+    assert text.startswith(f"wrote {out}: 40 points") and "{" not in text  # no Python dict
+    assert "first split (1 -> 2 stick phases) between kappa =" in text
+    assert main([*SWEEP, "--out", str(out), "--json"]) == 0  # same work: may be replaced
+    summary = json.loads(capsys.readouterr().out)
+    assert summary["points"] == 40 and summary["failed"] == 0 and summary["computed"] == 40
+    lo, hi = summary["first_split"]
+    assert lo < 1.4994e12 < hi  # kappa_c at 1 m/s (closed form, REFERENCE §5)
+
+
+# ------------------------------------------------------------------------------------------------
+# --out: checked first, never silently replaced, one writer at a time
+# ------------------------------------------------------------------------------------------------
+
+def test_out_refuses_foreign_file_and_other_work_unless_force(tmp_path, capsys):
+    notes = tmp_path / "notes.txt"
+    notes.write_text("my notes")
+    assert main([*SWEEP, "--out", str(notes)]) == 2
+    assert "not a phaseimpact archive" in capsys.readouterr().err
+    assert notes.read_text() == "my notes"
+
+    out = tmp_path / "s.h5"
+    assert main([*SWEEP, "--out", str(out)]) == 0
+    before = out.read_bytes()
+    other = [a if a != "40" else "41" for a in SWEEP]  # a different grid
+    assert main([*other, "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert "holds other work" in err and "--force" in err
+    assert main([*SWEEP, "--law", "hunt-crossley", "--out", str(out)]) == 2
+    assert main([*SWEEP, "--v", "2", "--out", str(out)]) == 2
+    assert main([*SWEEP, "--t-end", "0.01", "--out", str(out)]) == 2
+    assert out.read_bytes() == before
+    assert main([*other, "--out", str(out), "--force"]) == 0
+    assert len(archive.load(out).kappa) == 41
+    assert main([*SWEEP, "--out", str(notes), "--force"]) == 0
+    assert len(archive.load(notes).kappa) == 40
+
+
+def test_resume_onto_wrong_kind_or_other_work_is_refused(tmp_path, capsys):
+    curve = tmp_path / "curve.h5"
+    assert main(["critical-curve", "--v-min", "1", "--v-max", "2", "--num", "2", "--no-progress",
+                 "--out", str(curve)]) == 0
+    before = curve.read_bytes()
+    assert main([*SWEEP, "--out", str(curve), "--resume"]) == 2
+    err = capsys.readouterr().err
+    assert "critical-curve archive, not a sweep" in err and "Traceback" not in err
+    out = tmp_path / "s.h5"
+    assert main([*SWEEP, "--out", str(out)]) == 0
+    assert main([*SWEEP, "--rtol", "1e-9", "--out", str(out), "--resume"]) == 2
+    assert "holds other work" in capsys.readouterr().err
+    assert curve.read_bytes() == before
+
+
+LOCK_HOLDER = textwrap.dedent("""
+    import sys
+    from phaseimpact._atomic import exclusive
+    with exclusive(sys.argv[1]):
+        print("locked", flush=True)
+        sys.stdin.read()  # hold the lock until the test closes stdin
+""")
+
+
+@pytest.fixture
+def lock_holder(tmp_path):
+    """A second process holding the write lock of a path (no timing: it says when it holds it)."""
+    procs = []
+
+    def hold(path):
+        proc = subprocess.Popen([sys.executable, "-c", LOCK_HOLDER, str(path)], stdin=subprocess.PIPE,
+                                stdout=subprocess.PIPE, text=True)
+        procs.append(proc)
+        assert proc.stdout.readline().strip() == "locked"
+        return proc
+
+    yield hold
+    for proc in procs:
+        proc.stdin.close()
+        proc.wait(timeout=60)
+
+
+def test_second_writer_gets_exit_2_and_the_live_temp_file_survives(tmp_path, lock_holder):
+    out = tmp_path / "s.h5"
+    holder = lock_holder(out)
+    live_temp = tmp_path / f".s.h5.{holder.pid}-abcdef.tmp"  # the holder's temporary file, mid-write
+    live_temp.write_bytes(b"partial")
+    result = run_cli(*SWEEP, "--out", str(out))
+    assert result.returncode == 2 and "Traceback" not in result.stderr
+    assert f"is being written by another phaseimpact process (pid {holder.pid})" in result.stderr
+    assert live_temp.read_bytes() == b"partial"
+    assert not out.exists()
+    with pytest.raises(_atomic.PathLockedError, match=str(holder.pid)):
+        with _atomic.atomic_path(out):
+            pass
+
+
+def test_stale_temporaries_of_dead_writers_only_are_removed(tmp_path, small_sweep):
+    dead = subprocess.run([sys.executable, "-c", "import os; print(os.getpid())"], capture_output=True, text=True)
+    dead_pid = int(dead.stdout)  # that process has exited
+    alive = subprocess.Popen([sys.executable, "-c", "import sys; sys.stdin.read()"], stdin=subprocess.PIPE)
+    try:
+        stale = tmp_path / f".s.h5.{dead_pid}-x1.tmp"
+        live = tmp_path / f".s.h5.{alive.pid}-x2.tmp"
+        foreign = tmp_path / ".s.h5.notours.tmp"
+        for p in (stale, live, foreign):
+            p.write_bytes(b"x")
+        archive.save(small_sweep, tmp_path / "s.h5")
+        assert not stale.exists() and live.exists() and foreign.exists()
+        assert not (tmp_path / "s.h5.lock").exists()  # released and removed
+    finally:
+        alive.stdin.close()
+        alive.wait(timeout=60)
+
+
+def test_lock_is_reentrant_in_one_process_and_released(tmp_path):
+    path = tmp_path / "x.h5"
+    with _atomic.exclusive(path):
+        with _atomic.atomic_path(path) as tmp:  # a checkpoint inside a held lock
+            open(tmp, "wb").write(b"1")
+        assert path.read_bytes() == b"1"
+    with _atomic.atomic_path(path) as tmp:  # free again
+        open(tmp, "wb").write(b"2")
+    assert path.read_bytes() == b"2"
+
+
+# ------------------------------------------------------------------------------------------------
+# Interruptions: a kill after a known number of checkpoints; Ctrl-C says how to resume
+# ------------------------------------------------------------------------------------------------
+
+KILL_AFTER = textwrap.dedent("""
+    import os, signal, sys
+    import phaseimpact.archive as archive
+    import importlib
+    from phaseimpact.cli import main
+
+    sweep_module = importlib.import_module("phaseimpact.continuation.sweep")  # the module, not the function
+
+    sweep_module.CHUNK_THREADS = 16  # small chunks: several checkpoints
+    save, saves = archive.save, [0]
+
+    def save_then_die(*args, **kwargs):
+        save(*args, **kwargs)
+        saves[0] += 1
+        if saves[0] == int(os.environ["KILL_AFTER"]):
+            os.kill(os.getpid(), signal.SIGKILL)  # no clean-up at all, like a kill -9
+
+    archive.save = save_then_die
+    sys.exit(main(sys.argv[1:]))
+""")
 
 
 @pytest.mark.slow
-def test_sweep_killed_then_resumed_equals_uninterrupted(tmp_path):
-    """SIGKILL mid-sweep leaves a valid partial archive; --resume completes it without recomputing
-    finished points and gives the numbers of an uninterrupted run."""
-    args = ["sweep", "--law", "paper", "--v", "1", "--kappa-min", "1e9", "--kappa-max", "1e14", "--num", "64",
-            "--no-progress"]
+def test_sweep_killed_after_two_checkpoints_then_resumed_equals_uninterrupted(tmp_path):
+    """SIGKILL after the 2nd checkpoint leaves a valid partial archive; --resume completes it without
+    recomputing finished points and gives the numbers of an uninterrupted run."""
+    args = [*SWEEP[:-2], "64", "--no-progress"]
     partial = tmp_path / "partial.h5"
-    proc = subprocess.Popen([*CLI, *args, "--out", str(partial)], stdout=subprocess.PIPE, stderr=subprocess.PIPE)
-    deadline = time.time() + 300
-    while time.time() < deadline and not partial.exists():
-        time.sleep(0.05)
-    time.sleep(0.3)
-    proc.send_signal(signal.SIGKILL)
-    proc.wait()
-    half = archive.load(partial)  # valid, whatever the moment of the kill
-    done_before = half.done.copy()
-    assert 0 < done_before.sum() <= 64
-    finished = {i: half.max_force[i] for i in np.flatnonzero(done_before)}
+    env = {**os.environ, "KILL_AFTER": "2"}
+    killed = subprocess.run([sys.executable, "-c", KILL_AFTER, *args, "--out", str(partial)], env=env,
+                            capture_output=True, text=True, timeout=600)
+    assert killed.returncode == -9
+    half = archive.load(partial)
+    assert half.done.sum() == 32  # two chunks of 16
+    finished = {i: half.max_force[i] for i in np.flatnonzero(half.done)}
 
     assert run_cli(*args, "--out", str(partial), "--resume").returncode == 0
     resumed = archive.load(partial)
     assert resumed.done.all()
     assert all(resumed.max_force[i] == value for i, value in finished.items())
-
     full = tmp_path / "full.h5"
     assert run_cli(*args, "--out", str(full)).returncode == 0
     reference = archive.load(full)
-    assert np.array_equal(reference.n_asymptotic, resumed.n_asymptotic)
+    assert np.array_equal(reference.values["n_stick"], resumed.values["n_stick"])
     assert np.array_equal(reference.max_force, resumed.max_force)
-    assert not [p for p in os.listdir(tmp_path) if p.endswith(".tmp")]
+    assert not [p for p in os.listdir(tmp_path) if p.endswith((".tmp", ".lock"))]
 
 
-def test_two_runs_identical_archives_except_creation_time(tmp_path, small_sweep):
-    a, b = tmp_path / "a.h5", tmp_path / "b.h5"
-    archive.save(small_sweep, a)
-    again = sweep(seed_parameters(), ContactLaw("paper"), np.geomspace(1e9, 1e14, 8), n_jobs=2)
-    archive.save(again, b)
-    with h5py.File(a, "r") as fa, h5py.File(b, "r") as fb:
-        assert {k: str(v) for k, v in fa.attrs.items() if k != "created"} == \
-               {k: str(v) for k, v in fb.attrs.items() if k != "created"}
-        names = []
-        fa.visit(names.append)
-        for name in names:
-            if isinstance(fa[name], h5py.Dataset):
-                x, y = fa[name][()], fb[name][()]
-                assert np.array_equal(x, y, equal_nan=x.dtype.kind == "f"), name
+def test_ctrl_c_during_a_sweep_prints_the_resume_command(tmp_path, monkeypatch, capsys):
+    sweep_module = importlib.import_module("phaseimpact.continuation.sweep")
+    monkeypatch.setattr(sweep_module, "CHUNK_THREADS", 8)
+    save, saves = archive.save, []
+
+    def save_then_interrupt(*args, **kwargs):
+        save(*args, **kwargs)
+        saves.append(1)
+        if len(saves) == 1:
+            raise KeyboardInterrupt
+
+    monkeypatch.setattr(archive, "save", save_then_interrupt)
+    out = tmp_path / "s.h5"
+    assert main([*SWEEP, "--out", str(out)]) == 130
+    err = capsys.readouterr().err
+    assert "8 of 40 points are saved" in err
+    command = err.strip().splitlines()[-1].strip()
+    words = shlex.split(command)
+    assert words[0] == "phaseimpact" and words[-1] == "--resume"
+    monkeypatch.setattr(archive, "save", save)
+    assert main(words[1:]) == 0  # the printed command completes the sweep
+    assert archive.load(out).done.all()
+
+
+# ------------------------------------------------------------------------------------------------
+# Failures are reported, never "done"
+# ------------------------------------------------------------------------------------------------
+
+def test_failed_points_exit_1_with_a_message_and_are_recomputed_on_resume(tmp_path, monkeypatch, capsys):
+    """A point whose run failed numerically makes the sweep exit 1, says so, and --resume redoes it."""
+    from phaseimpact.integrate import driver
+
+    sweep_module = importlib.import_module("phaseimpact.continuation.sweep")
+
+    out = tmp_path / "s.h5"
+    real = sweep_module.run_chunks
+
+    def one_failure(*args, **kwargs):
+        for columns in real(*args, **kwargs):
+            columns.status[0] = driver.STEP_SIZE_COLLAPSE  # as the engine reports a failed run
+            yield columns
+
+    monkeypatch.setattr(sweep_module, "run_chunks", one_failure)
+    assert main([*SWEEP, "--out", str(out)]) == 1
+    err = capsys.readouterr().err
+    assert "1 of 40 points failed numerically (step-size-collapse: 1)" in err and "--resume" in err
+    stored = archive.load(out)
+    assert stored.status_names()[0] == "step-size-collapse" and not stored.done[0]
+    monkeypatch.setattr(sweep_module, "run_chunks", real)
+    assert main([*SWEEP, "--out", str(out), "--resume"]) == 0
+    assert archive.load(out).done.all()
