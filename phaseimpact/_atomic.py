@@ -28,6 +28,7 @@ class PathLockedError(ValueError):
     """Another process is writing the same path."""
 
 
+_WRITABLE = "allowed: a file path in a folder this process can write"
 #: Locks held by this process: absolute path -> [file descriptor, depth].
 _HELD: dict[str, list] = {}
 
@@ -61,9 +62,9 @@ def check_target(path, name: str = "out") -> str:
     while not os.path.exists(existing):
         existing = os.path.dirname(existing)
     if not os.path.isdir(existing):
-        raise ValueError(f"{name} = {path!r} is out of range: {existing!r} is a file, not a folder")
+        raise ValueError(f"{name} = {path!r} is out of range: {existing!r} is a file, not a folder; {_WRITABLE}")
     if not os.access(existing, os.W_OK | os.X_OK):
-        raise ValueError(f"{name} = {path!r} is out of range: the folder {existing!r} is not writable")
+        raise ValueError(f"{name} = {path!r} is out of range: the folder {existing!r} is not writable; {_WRITABLE}")
     return path
 
 
@@ -87,13 +88,14 @@ def exclusive(path, name: str = "out"):
     try:
         os.makedirs(os.path.dirname(key), exist_ok=True)
     except OSError as error:
-        raise ValueError(f"{name} = {path!r}: cannot create its folder: {error.strerror or error}") from None
+        raise ValueError(f"{name} = {path!r} cannot be written: cannot create its folder: "
+                         f"{error.strerror or error}; {_WRITABLE}") from None
     while True:
         try:
             fd = os.open(lock_file, os.O_RDWR | os.O_CREAT, 0o666)
         except OSError as error:
             raise ValueError(f"{name} = {path!r} cannot be written: {error.strerror or error} "
-                             f"({lock_file!r})") from None
+                             f"({lock_file!r}); {_WRITABLE}") from None
         try:
             fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
         except OSError as error:

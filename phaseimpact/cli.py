@@ -14,6 +14,7 @@ import asyncio
 import json
 import math
 import os
+import re
 import shlex
 import sys
 
@@ -49,6 +50,10 @@ CRITICAL_ANSWERS = ("success", "not-found", "unconfirmed")
 
 class _Parser(argparse.ArgumentParser):
     def error(self, message):
+        choice = re.fullmatch(r"(argument (\S+)): invalid choice: (.*) \(choose from (.*)\)", message)
+        if choice:  # the same wording as every other range message
+            label, option, value, allowed = choice.groups()
+            message = f"{label}: {option.lstrip('-')} = {value} is out of range; allowed: one of {allowed}"
         self.exit(EXIT_USAGE, f"{self.prog}: error: {message}\n")
 
 
@@ -170,24 +175,32 @@ def _fmt(value, unit="", spec=".6g"):
 # ------------------------------------------------------------------------------------------------
 
 def _law(args):
-    from .model import ContactLaw
+    from .model import REGISTRY, ContactLaw
+
+    RESTITUTION_LAWS = [name for name, entry in REGISTRY.items() if entry.damping == "restitution"]
 
     restitution = getattr(args, "restitution", None)
     if restitution is not None and args.law == "abrate":
         raise ValueError(f"restitution = {restitution!r} is not read by law 'abrate' (undamped Hertz contact); "
                          "allowed: --restitution with hunt-crossley or a restitution law")
+    if restitution is None and args.law in RESTITUTION_LAWS:
+        lo, hi = RESTITUTION_RANGE
+        raise ValueError(f"restitution = None is out of range for law {args.law!r} (its only damping); allowed: "
+                         f"--restitution E with {lo:g} <= E <= {hi:g}")
     law = ContactLaw(args.law, restitution=restitution, contact=getattr(args, "contact", None) or "printed")
     kappa = getattr(args, "kappa", None)
     if kappa is not None and not law.reads("kappa"):
         source = "its damping comes from the restitution" if law.damping_source == "restitution" else "it is undamped"
-        raise ValueError(f"kappa = {kappa!r} is not read by law {law.label()!r} ({source}); "
-                         "drop --kappa" + (" or --restitution" if restitution is not None else ""))
+        raise ValueError(f"kappa = {kappa!r} is not read by law {law.label()!r} ({source}); allowed: "
+                         + ("--kappa or --restitution, not both" if restitution is not None
+                            else "--kappa with paper or hunt-crossley"))
     return law
 
 
 def _contact_given(args):
     if getattr(args, "contact", None) is not None and args.law != "paper":
-        raise ValueError(f"contact = {args.contact!r} is only read by law 'paper', not {args.law!r}")
+        raise ValueError(f"contact = {args.contact!r} is not read by law {args.law!r}; allowed: --contact with "
+                         "law paper")
 
 
 def _params(args, **overrides):
@@ -361,7 +374,8 @@ def cmd_sweep(args) -> int:
     from .continuation import Axis, Grid, sweep
 
     if args.scheduler is not None and args.backend != "dask":
-        raise ValueError(f"scheduler = {args.scheduler!r} is only read with --backend dask, not {args.backend!r}")
+        raise ValueError(f"scheduler = {args.scheduler!r} is not read by backend {args.backend!r}; allowed: "
+                         "--scheduler together with --backend dask")
     if args.resume and args.force:
         raise ValueError("--resume and --force contradict each other: --resume completes the archive, "
                          "--force replaces it; give one")
