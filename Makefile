@@ -12,16 +12,20 @@ $(BIN)/python:
 	$(PYTHON) -m venv $(VENV)
 
 $(STAMP): pyproject.toml | $(BIN)/python
+	@echo "installing phaseimpact into $(VENV) (first run ~1-2 min; later runs skip this)"
 	$(BIN)/python -m pip install --quiet --upgrade pip
-	$(BIN)/python -m pip install --quiet -e ".[test]"
+	$(BIN)/python -m pip install --progress-bar on -e ".[test]"
 	touch $(STAMP)
 
 test: $(STAMP)
 	$(BIN)/ruff check .
 	$(BIN)/python -m pytest -q
 
+# Time stamps in archives come from the last commit (SOURCE_DATE_EPOCH), so regenerating unchanged
+# results leaves git clean; QUICK=1 previews go to figures/preview/ (git-ignored), never over figures/.
 reproduce: $(STAMP)
-	$(BIN)/python studies/run_all.py $(if $(QUICK),--quick) --jobs $(JOBS)
+	SOURCE_DATE_EPOCH=$${SOURCE_DATE_EPOCH:-$$(git log -1 --format=%ct 2>/dev/null)} \
+		$(BIN)/python studies/run_all.py $(if $(QUICK),--quick) --jobs $(JOBS)
 
 lint: $(STAMP)
 	$(BIN)/ruff check .

@@ -105,11 +105,21 @@ def plot_phase(ax, trajectory, plane=("delta", "deltadot"), *, mark_events=True,
 
 
 def save(fig, path, dpi=110):
-    """Write ``fig`` as PNG to ``path`` (directories created) and close it."""
+    """Write ``fig`` to ``path`` (PNG unless the suffix says otherwise; directories created) and close it.
+
+    Written atomically (temporary file, then rename) and without the matplotlib version or a
+    creation date in its metadata, so the same figure gives the same bytes on every run.
+    """
     path = os.fspath(path)
-    os.makedirs(os.path.dirname(path) or ".", exist_ok=True)
-    fig.savefig(path, dpi=dpi)
-    plt.close(fig)
+    fmt = os.path.splitext(path)[1].lstrip(".").lower() or "png"
+    metadata = {"Software": None}
+    if fmt in ("pdf", "svg", "eps", "ps"):
+        metadata["CreationDate"] = None
+    try:
+        with atomic_path(path) as tmp:
+            fig.savefig(tmp, dpi=dpi, format=fmt, metadata=metadata)
+    finally:
+        plt.close(fig)
     return path
 
 

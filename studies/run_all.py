@@ -1,6 +1,8 @@
-"""Run every study: regenerate all figures, data archives and the claims table (``make reproduce``)."""
+"""Run every study: regenerate all figures, data archives and the claims table (``make reproduce``).
 
-import argparse
+Full runs write into ``figures/``; ``--quick`` previews into ``figures/preview/`` (git-ignored).
+"""
+
 import importlib.util
 import sys
 import time
@@ -9,6 +11,10 @@ from pathlib import Path
 from tqdm import tqdm
 
 HERE = Path(__file__).resolve().parent
+sys.path.insert(0, str(HERE))
+
+import _cli  # noqa: E402
+
 STUDIES = (
     "fig02_03_abrate_displacements",
     "fig04_force_indentation",
@@ -30,17 +36,18 @@ def load(name):
 
 
 def main() -> int:
-    parser = argparse.ArgumentParser(description=__doc__)
-    parser.add_argument("--quick", action="store_true", help="fewer points, for a fast preview")
-    parser.add_argument("--jobs", type=int, default=2, help="joblib workers for sweeps")
-    args = parser.parse_args()
-    sys.path.insert(0, str(HERE))
+    args = _cli.parser(__doc__.splitlines()[0], default_jobs=2).parse_args()
+    _cli.set_source_date_epoch()
+    folder = _cli.output_folder(args.quick)
+    print(f"writing {'previews' if args.quick else 'figures'} to {folder.relative_to(HERE.parent)}/", flush=True)
     start = time.perf_counter()
     bar = tqdm(STUDIES, desc="studies", unit="study")
     for name in bar:
         bar.set_postfix_str(name)
         t0 = time.perf_counter()
-        out = load(name).main(quick=args.quick, jobs=args.jobs)
+        module = load(name)
+        _cli.redirect(vars(module), args.quick)
+        out = module.main(quick=args.quick, jobs=args.jobs)
         tqdm.write(f"{name:32s} {time.perf_counter() - t0:6.1f} s  -> {Path(out).relative_to(HERE.parent)}")
     print(f"all studies done in {time.perf_counter() - start:.1f} s")
     return 0
