@@ -1,6 +1,7 @@
 """HDF5 archive and command line: schema, atomic writes, one writer at a time, resume after a kill."""
 
 import importlib
+import importlib.util
 import json
 import os
 import shlex
@@ -402,3 +403,42 @@ def test_failed_points_exit_1_with_a_message_and_are_recomputed_on_resume(tmp_pa
     monkeypatch.setattr(sweep_module, "run_chunks", real)
     assert main([*SWEEP, "--out", str(out), "--resume"]) == 0
     assert archive.load(out).done.all()
+
+
+# ------------------------------------------------------------------------------------------------
+# make reproduce: identical bytes for identical results; previews never over committed files
+# ------------------------------------------------------------------------------------------------
+
+def test_figures_are_written_atomically_without_version_metadata(tmp_path):
+    import matplotlib.pyplot as plt
+
+    from phaseimpact.plotting import save
+
+    paths = []
+    for name in ("a.png", "b.png"):
+        fig, ax = plt.subplots()
+        ax.plot([0, 1], [1, 0])
+        paths.append(save(fig, tmp_path / name))
+        time.sleep(1.1)  # a second apart: a time stamp in the file would differ
+    a, b = (open(p, "rb").read() for p in paths)
+    assert a == b and b"Matplotlib" not in a
+    assert sorted(os.listdir(tmp_path)) == ["a.png", "b.png"]  # no temporaries, no lock files left
+
+
+def test_quick_previews_go_to_the_preview_folder():
+    spec = importlib.util.spec_from_file_location("studies_cli", os.path.join(os.path.dirname(__file__), "..",
+                                                                             "studies", "_cli.py"))
+    study_cli = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(study_cli)
+    figures = study_cli.FIGURES
+    study = {"FIGURES": figures, "NAME": "x"}
+    study_cli.redirect(study, quick=False)
+    assert study["FIGURES"] == figures
+    study_cli.redirect(study, quick=True)
+    assert study["FIGURES"] == figures / "preview" and study_cli.output_folder(True) == figures / "preview"
+    other = {"ROOT": figures}
+    study_cli.redirect(other, quick=True)
+    assert other["ROOT"] == figures / "preview"
+    ignored = subprocess.run(["git", "check-ignore", "-q", "figures/preview/x.png"],
+                             cwd=study_cli.ROOT)
+    assert ignored.returncode == 0  # previews never show up in git status
