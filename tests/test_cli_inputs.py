@@ -270,3 +270,18 @@ def test_random_argument_lists_exit_0_1_or_2_never_a_traceback(argv):
     assert "Traceback" not in err, argv
     if code == 1:  # only a reported numerical failure
         assert "fail" in err or "incomplete" in err, (argv, err)
+
+
+def test_a_failed_trajectory_is_reported_with_exit_1(monkeypatch):
+    import dataclasses
+
+    real = integrate.simulate
+
+    def failing(*args, **kwargs):
+        return dataclasses.replace(real(*args, **kwargs), status="step-size-collapse", message="collapsed")
+
+    monkeypatch.setattr(integrate, "simulate", failing)
+    code, out, err = run(["simulate", "--json"])
+    assert code == 1
+    assert json.loads(out)["status"] == "step-size-collapse"  # the result is still printed
+    assert "numerical failure: step-size-collapse" in err and "Traceback" not in err
