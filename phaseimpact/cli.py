@@ -394,6 +394,7 @@ def cmd_sweep(args) -> int:
     kappas = np.geomspace(args.kappa_min, args.kappa_max, args.num)
     Grid(params, law, (Axis.make("kappa", kappas),))  # every check of the grid, before any work
     out = args.out
+    archive.created_timestamp()  # a bad SOURCE_DATE_EPOCH is refused now, not at the first checkpoint
     if args.backend == "dask" and args.scheduler is not None:
         _check_scheduler(args.scheduler)
     axes = {"kappa": kappas}
@@ -457,6 +458,7 @@ def cmd_critical_curve(args) -> int:
     _params(args, v=args.v_max)  # both ends valid, checked before any work
     speeds = np.geomspace(args.v_min, args.v_max, args.num)
     out = args.out
+    archive.created_timestamp()
     with exclusive(out, "out"):
         if os.path.exists(out):
             archive.check_overwrite(out, "critical-curve", law, params, {"v": speeds}, None, args.kappa_rtol,
