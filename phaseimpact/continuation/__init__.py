@@ -13,7 +13,7 @@ from .transition import (
     closed_form_kappa_c,
     critical_damping,
     first_stick_margin,
-    flight_maximum,
+    delta_extremum,
     grazing_transitions,
     locate_kappa_2,
     stick_count,
@@ -23,6 +23,6 @@ from .transition import (
 __all__ = [
     "BACKENDS", "CURVE_QUANTITIES", "Axis", "CriticalCurve", "CriticalDamping", "Grid", "SweepResult",
     "Transition", "adding_sliding_exponents", "atlas", "closed_form_kappa_c", "critical_curve",
-    "critical_damping", "first_stick_margin", "flight_maximum", "grazing_transitions", "locate_kappa_2",
+    "critical_damping", "first_stick_margin", "delta_extremum", "grazing_transitions", "locate_kappa_2",
     "parse_axis", "stick_count", "sweep", "transitions",
 ]

@@ -19,7 +19,7 @@ from tqdm.auto import tqdm
 from ..case import Case
 from ..model.laws import ContactLaw, as_law
 from ..parameters import Parameters
-from .transition import closed_form_kappa_c, critical_damping, first_stick_margin, flight_maximum, locate_kappa_2
+from .transition import closed_form_kappa_c, critical_damping, first_stick_margin, delta_extremum, locate_kappa_2
 
 __all__ = ["CriticalCurve", "critical_curve", "CURVE_QUANTITIES"]
 
@@ -99,7 +99,7 @@ def critical_curve(base: Parameters | Case, law: ContactLaw | str, param: str, v
     def defining(p: Parameters, quantity: str):
         """The smooth function whose root in log(kappa) is the quantity (kappa_2 rides on kappa_c)."""
         if quantity == "grazing":
-            return lambda x: flight_maximum(p.replace(kappa=math.exp(x)), law, contact_index, rtol=integrator_rtol)
+            return lambda x: delta_extremum(p.replace(kappa=math.exp(x)), law, contact_index, rtol=integrator_rtol)
         return lambda x: first_stick_margin(p.replace(kappa=math.exp(x)), law, rtol=integrator_rtol)
 
     def correct(p: Parameters, guess: float, width: float) -> float | None:

@@ -20,19 +20,21 @@ from dataclasses import asdict, dataclass, field
 import numpy as np
 from scipy.optimize import brentq, minimize_scalar
 
-from ..integrate import simulate
+from ..integrate import scales, simulate
 from ..integrate.events import EVENT_KINDS
 from ..model.laws import ContactLaw, as_law
 from ..parameters import Parameters
 
 __all__ = [
     "closed_form_kappa_c", "first_stick_margin", "critical_damping", "CriticalDamping", "locate_kappa_2",
-    "stick_count", "adding_sliding_exponents", "flight_maximum", "grazing_transitions", "transitions",
+    "stick_count", "adding_sliding_exponents", "delta_extremum", "extrema", "grazing_transitions", "transitions",
     "Transition", "check_kappa_range",
 ]
 
 _REVERSAL = EVENT_KINDS.index("reversal")
-_SEPARATION = EVENT_KINDS.index("separation")
+#: Horizon of an extremum search, in plate periods: every contact of an impact happens within a
+#: few periods; an extremum beyond that is not a grazing candidate.
+EXTREMA_PERIODS = 50
 #: Default search range of the damping number ``a = kappa v / K``.
 A_RANGE = (1e-8, 1e8)
 
@@ -289,31 +291,37 @@ def adding_sliding_exponents(params: Parameters, law: ContactLaw | str, kappa_c:
 # Grazing of unilateral laws
 # ---------------------------------------------------------------------------------------------
 
-def flight_maximum(params: Parameters, law: ContactLaw | str, k: int, *, rtol: float = 1e-10) -> float:
-    """Largest ``delta`` of the contact-free flight after the ``k``-th separation (m): its root in
-    ``kappa`` is a grazing value. ``-inf`` if there is no ``k``-th separation or the flight has
-    no maximum before the projectile is out of reach."""
-    law = as_law(law)
-    to_separation = simulate(params, law, None, rtol=rtol, stop_on=("separation", k))
-    if to_separation.stop_reason != "asked":
+def delta_extremum(params: Parameters, law: ContactLaw | str, j: int, *, rtol: float = 1e-10) -> float:
+    """``delta`` at the ``j``-th extremum (``deltadot = 0``) of the trajectory, m; ``-inf`` if the
+    outcome settles first.
+
+    The contact force of a unilateral law is ``~ delta^alpha`` near ``delta = 0`` (``C^1`` for
+    ``alpha > 1``), so each extremum is a smooth function of ``kappa`` across zero: a maximum
+    crossing zero from below is a new contact just touching, a minimum crossing zero from above a
+    flight phase just vanishing. Its roots are the grazing values (REFERENCE §5).
+    """
+    # no stop when out of reach: the extrema go on (below zero), so each stays defined across
+    # the kappa where the projectile stops getting out of reach
+    horizon = EXTREMA_PERIODS * scales(params).plate_period if params.target == "plate" else None
+    trajectory = simulate(params, law, horizon, rtol=rtol, stop_on=("reversal", j), stop_when_settled=False)
+    if trajectory.stop_reason != "asked":
         return -math.inf
-    # the contact switched off (a Hertz stiffness 30 decades down), tolerances of the real case
-    free = params.replace(K=params.K * 1e-30)
-    flight = simulate(free, "abrate", None, rtol=rtol, atol=rtol * params.hertz_indentation,
-                      initial=to_separation.final_state[:4])
-    # the first local maximum of delta: a reversal where deltadot goes from + to -
-    for t, kind, y in zip(flight.event_t, flight.event_kind, flight.event_y, strict=True):
-        if kind == _REVERSAL and t > 0:
-            accel_sign = _relative_acceleration(free, y)
-            if accel_sign < 0:
-                return float(y[0] - y[1])
-    return -math.inf
+    y = trajectory.final_state
+    return float(y[0] - y[1])
 
 
-def _relative_acceleration(params: Parameters, y) -> float:
-    # free flight: the projectile coasts, the plate feels only its springs
-    x2 = y[1]
-    return (params.Kb * x2 + params.Km * x2**3) / params.M2 if params.target == "plate" else 0.0
+def extrema(params: Parameters, law: ContactLaw | str, *, rtol: float = 1e-10) -> np.ndarray:
+    """``delta`` at every extremum of the trajectory until its outcome settles, and the next two
+    after the projectile is out of reach (so that a grazing return is seen from both sides), m."""
+    trajectory = simulate(params, law, None, rtol=rtol)
+    y = trajectory.event_y[trajectory.event_kind == _REVERSAL]
+    values = list(y[:, 0] - y[:, 1])
+    if trajectory.stop_reason == "settled" and trajectory.final_mode != 0:
+        after = simulate(params, law, EXTREMA_PERIODS * scales(params).plate_period, rtol=rtol,
+                         initial=trajectory.final_state[:4], stop_when_settled=False, stop_on=("reversal", 2))
+        y = after.event_y[after.event_kind == _REVERSAL]
+        values += list(y[:, 0] - y[:, 1])
+    return np.asarray(values)
 
 
 def contact_count(params: Parameters, law: ContactLaw | str, *, rtol: float = 1e-10) -> int:
@@ -328,6 +336,7 @@ class Transition:
     kappa: float
     count_below: int | None
     count_above: int | None
+    extremum: int | None = None  # grazing: which extremum of delta touches zero
 
     def as_dict(self) -> dict:
         return asdict(self)
@@ -337,9 +346,10 @@ def grazing_transitions(params: Parameters, law: ContactLaw | str, kappa_min: fl
                         num: int = 96, rtol: float = 1e-9, integrator_rtol: float = 1e-10) -> list[Transition]:
     """Every grazing value of a unilateral law in ``[kappa_min, kappa_max]``, in order.
 
-    The contact count is sampled on a log grid; wherever it changes, or a flight maximum comes
-    close to zero without crossing it (a window narrower than the grid), the flight maximum's
-    root is located by Brent's method to ``rtol`` (relative).
+    The extrema of ``delta`` are sampled on a log grid of ``kappa``; wherever the ``j``-th changes
+    sign between neighbours, or comes close to zero at a local extreme in ``kappa`` without
+    crossing on the grid (a window narrower than the grid), its root is located by Brent's
+    method to ``rtol`` (relative): :func:`delta_extremum` is the smooth defining function.
     """
     law = as_law(law)
     if law.is_filippov and law.contact == "printed":
@@ -347,53 +357,58 @@ def grazing_transitions(params: Parameters, law: ContactLaw | str, kappa_min: fl
                          "contact='unilateral')")
     kappa_min, kappa_max = check_kappa_range(kappa_min, kappa_max)
     logk = np.linspace(math.log(kappa_min), math.log(kappa_max), num)
-    counts = [contact_count(params.replace(kappa=math.exp(x)), law, rtol=integrator_rtol) for x in logk]
-    k_max = max(counts)
-    found = []
-
-    def g(x, k):
-        return flight_maximum(params.replace(kappa=math.exp(x)), law, k, rtol=integrator_rtol)
-
+    samples = [extrema(params.replace(kappa=math.exp(x)), law, rtol=integrator_rtol) for x in logk]
+    depth = max(len(e) for e in samples)
+    table = np.full((num, depth), -np.inf)
+    for i, e in enumerate(samples):
+        table[i, :len(e)] = e
     scale = params.hertz_indentation
-    for k in range(1, k_max + 1):
-        values = np.array([g(x, k) for x in logk])
-        finite = np.where(np.isfinite(values), values, -np.inf)
+    eps = 4 * np.finfo(float).eps
+
+    def g(x, j):
+        return delta_extremum(params.replace(kappa=math.exp(x)), law, j, rtol=integrator_rtol)
+
+    found = []
+    for j in range(1, depth + 1):
+        column = table[:, j - 1]
         for i in range(num - 1):
-            a, b = finite[i], finite[i + 1]
-            if (a > 0) != (b > 0) and np.isfinite(a) and np.isfinite(b):
-                root = brentq(g, logk[i], logk[i + 1], args=(k,), xtol=rtol / 4, rtol=4 * np.finfo(float).eps)
-                found.append(math.exp(root))
-            elif (a > 0) != (b > 0):
-                found.append(_bisect_count(params, law, logk[i], logk[i + 1], rtol, integrator_rtol))
-        # windows narrower than the grid: a negative local maximum close to zero
+            a, b = column[i], column[i + 1]
+            if (a > 0) == (b > 0) or not (np.isfinite(a) or np.isfinite(b)):
+                continue
+            lo, hi, g_lo, g_hi = logk[i], logk[i + 1], a, b
+            for _ in range(40):  # an extremum born (or gone) in between: move to where both exist
+                if np.isfinite(g_lo) and np.isfinite(g_hi):
+                    break
+                mid = 0.5 * (lo + hi)
+                g_mid = g(mid, j)
+                if np.isfinite(g_mid) == np.isfinite(g_lo) and (g_mid > 0) == (g_lo > 0):
+                    lo, g_lo = mid, g_mid
+                else:
+                    hi, g_hi = mid, g_mid
+            if np.isfinite(g_lo) and np.isfinite(g_hi) and (g_lo > 0) != (g_hi > 0):
+                found.append((math.exp(brentq(g, lo, hi, args=(j,), xtol=rtol / 4, rtol=eps)), j))
+        # windows narrower than the grid: an extreme in kappa of this extremum close to zero
         for i in range(1, num - 1):
-            if finite[i] < 0 and finite[i] >= finite[i - 1] and finite[i] >= finite[i + 1] \
-                    and finite[i] > -0.05 * scale:
-                best = minimize_scalar(lambda x, k=k: -g(x, k), bounds=(logk[i - 1], logk[i + 1]), method="bounded",
-                                       options={"xatol": 1e-12})
-                if -best.fun > 0:
-                    for lo, hi in ((logk[i - 1], best.x), (best.x, logk[i + 1])):
-                        root = brentq(g, lo, hi, args=(k,), xtol=rtol / 4, rtol=4 * np.finfo(float).eps)
-                        found.append(math.exp(root))
-    found = sorted(set(found))
+            a, m, b = column[i - 1], column[i], column[i + 1]
+            if not (np.isfinite(a) and np.isfinite(m) and np.isfinite(b)) or abs(m) > 0.05 * scale:
+                continue
+            sign = 1.0 if m < 0 else -1.0  # look for a maximum of a negative run, a minimum of a positive one
+            if not (sign * m >= sign * a and sign * m >= sign * b) or (a > 0) != (m > 0) or (b > 0) != (m > 0):
+                continue
+            best = minimize_scalar(lambda x, j=j, s=sign: -s * g(x, j), bounds=(logk[i - 1], logk[i + 1]),
+                                   method="bounded", options={"xatol": 1e-12})
+            if (-sign * best.fun > 0) != (m > 0):
+                for lo, hi in ((logk[i - 1], best.x), (best.x, logk[i + 1])):
+                    found.append((math.exp(brentq(g, lo, hi, args=(j,), xtol=rtol / 4, rtol=eps)), j))
+    found.sort()
     transitions = []
-    for kappa in found:
-        below = contact_count(params.replace(kappa=kappa * (1 - 1e-7)), law, rtol=integrator_rtol)
-        above = contact_count(params.replace(kappa=kappa * (1 + 1e-7)), law, rtol=integrator_rtol)
-        transitions.append(Transition("grazing", kappa, below, above))
+    for kappa, j in found:
+        if transitions and abs(kappa - transitions[-1].kappa) <= 10 * rtol * kappa:
+            continue  # the same grazing seen by two extrema (a pair created or removed at it)
+        below = contact_count(params.replace(kappa=kappa * (1 - 1e-6)), law, rtol=integrator_rtol)
+        above = contact_count(params.replace(kappa=kappa * (1 + 1e-6)), law, rtol=integrator_rtol)
+        transitions.append(Transition("grazing", kappa, below, above, j))
     return transitions
-
-
-def _bisect_count(params, law, lo, hi, rtol, integrator_rtol) -> float:
-    """Fallback where a flight maximum is undefined on one side: bisection on the count."""
-    n_lo = contact_count(params.replace(kappa=math.exp(lo)), law, rtol=integrator_rtol)
-    while hi - lo > rtol:
-        mid = 0.5 * (lo + hi)
-        if contact_count(params.replace(kappa=math.exp(mid)), law, rtol=integrator_rtol) == n_lo:
-            lo = mid
-        else:
-            hi = mid
-    return math.exp(0.5 * (lo + hi))
 
 
 def transitions(params: Parameters, law: ContactLaw | str, kappa_min: float, kappa_max: float, *,

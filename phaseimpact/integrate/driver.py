@@ -148,7 +148,7 @@ def _locate(code, c, mode, energy_limit, column, F, y0, t0, h, t1, g_start, g_en
                 break
             prev = s
         if not found_away:
-            return t0  # the excursion is below what the step resolves
+            return -math.inf  # the excursion is below what the step resolves: the caller shrinks it
     if gb == 0 or ga * gb > 0:
         return b
     return _brent(code, c, mode, energy_limit, column, F, y0, t0, h, a, b, ga, gb, ys, fs, gs)
@@ -345,16 +345,26 @@ def run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count,
             fired[col] = crossed(col, g_old, g_new)
             any_fired = any_fired or fired[col]
         have_dense = False
+        stop_record = -1.0
         restart_col = -1
         t_restart = math.inf
         if any_fired:
             dop853.dense_coefficients(code, c, mode, y, f, y_new, f_new, h, K, F, tmp)
             nfev += 3
             have_dense = True
+            unresolved = False
             for col in range(N_EVENTS):
                 if fired[col]:
                     roots[col] = _locate(code, c, mode, energy_limit, col, F, y, t, h, t_new, g_old[col],
                                          g_new[col], ys, fs, gs)
+                    if roots[col] == -math.inf:
+                        if h > 1e3 * (np.nextafter(t, np.inf) - t):
+                            unresolved = True
+                        else:  # nothing smaller to try: the excursion did not happen
+                            fired[col] = False
+            if unresolved:
+                h_abs = h / 32.0  # an event left and re-crossed zero inside the step: resolve it
+                continue
             if fired[DELTADOT] and not fired[DELTA]:
                 # an extreme of delta inside the step on the other side of zero: a contact (or
                 # separation) and its return both fell inside the step
@@ -393,6 +403,18 @@ def run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count,
                 counts[kind] += 1
                 max_force = max(max_force, f_ev)
                 max_indentation = max(max_indentation, ys[X1] - ys[X2])
+                if kind == stop_kind and counts[kind] >= stop_count:
+                    stop_record = roots[best]
+                    break
+        if stop_record >= 0:
+            # stopped at a recorded event: the state there from a fresh step that ends at it
+            if stop_record > t:
+                dop853.step(code, c, mode, y, f, stop_record - t, K, y_r, f_r, tmp)
+                nfev += 12
+                y[:] = y_r
+                t = stop_record
+            reason = ASKED_STOP
+            break
         t_seg = t_restart if restart_col >= 0 else t_new
         if save_kind == SAVE_TIMES:
             while i_time < times.shape[0] and times[i_time] <= t_seg:
