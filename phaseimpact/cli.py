@@ -1,16 +1,24 @@
-"""Command line: ``phaseimpact {params, simulate, critical, sweep, critical-curve}``.
+"""Command line: ``phaseimpact {cases, params, simulate, critical, transitions, sweep, atlas, critical-curve,
+plot, portrait}``.
 
 A contract other tools rely on: SI units; ``--json`` prints one JSON object whose numbers are
 finite or ``null``. Every argument is checked before any work: bad input prints one line naming
 the parameter, its value and the allowed range, and exits with code 2 (no traceback). A run that
-ends in a numerical failure (a sweep point, a trajectory) is reported and exits with code 1.
-Ctrl-C exits with code 130 (a sweep says how to resume).
+ends in a numerical failure (a trajectory, a sweep point, a lost curve) is reported and exits with
+code 1. Ctrl-C exits with code 130 (a sweep or an atlas says how to resume).
+
+Every computing command takes a case (``--case NAME|FILE.toml``, default ``seed``) and
+``--set NAME=VALUE`` settings. What is used, from weakest to strongest: the built-in defaults,
+the case's ``[impact]`` table, ``--set``, then the explicit options (``--v``, ``--kappa``,
+``--law``, ``--contact``, ``--target``, ``--restitution``). Results and archives record the case
+as it was used.
 """
 
 from __future__ import annotations
 
 import argparse
 import asyncio
+import dataclasses
 import json
 import math
 import os
@@ -22,6 +30,7 @@ import numpy as np
 
 from . import __version__
 from ._atomic import check_target, exclusive
+from .case import SETTABLE
 from .integrate import RTOL_RANGE
 from .model import LAWS
 from .parameters import TARGETS
@@ -32,20 +41,33 @@ EXIT_OK, EXIT_FAILURE, EXIT_USAGE, EXIT_INTERRUPTED = 0, 1, 2, 130
 V_RANGE = (1e-6, 1e4)
 #: Largest damping coefficient, N s/m^2.5 (the seed's kappa_c is about 1.5e12).
 KAPPA_MAX = 1e18
-#: Relative width of kappa_c's bracket (critical, critical-curve).
+#: Relative width of kappa_c's bracket (critical, critical-curve), or of a transition's location.
 KAPPA_RTOL_RANGE = (1e-14, 1e-2)
 #: Coefficient of restitution.
 RESTITUTION_RANGE = (1e-6, 1.0)
-#: Points of one sweep: its columns (about 200 bytes a point) stay in memory.
+#: Points of one sweep or atlas: its columns (about 200 bytes a point) stay in memory.
 MAX_SWEEP_POINTS = 10_000_000
-#: Speeds of one critical curve (each is a kappa_c search).
+#: Values of one critical curve (each is a root search).
 MAX_CURVE_POINTS = 1000
+#: kappa samples of a transition search (each is one run), and the default.
+SAMPLES_RANGE = (8, 10_000)
+DEFAULT_SAMPLES = 96
+#: Panels of one phase portrait.
+MAX_PANELS = 12
 MAX_JOBS = 4 * (os.cpu_count() or 1)
 BACKENDS = ("threads", "loky", "dask")
 #: Seconds to wait for a Dask scheduler before giving up.
 SCHEDULER_TIMEOUT = 5.0
 #: Statuses of critical_damping that are answers (anything else is a failure: exit 1).
 CRITICAL_ANSWERS = ("success", "not-found", "unconfirmed")
+#: What a critical curve continues.
+CURVE_WHATS = ("kappa_c", "kappa_2", "grazing")
+#: Parameters a critical curve can run over (besides the settable names of a case).
+CURVE_PARAMETERS = ("v", "M1", "M2", "K", "Kb", "Km", "alpha")
+PLANES = ("delta,deltadot", "x1,x1dot", "x2,x2dot")
+#: Figure formats ``plot`` and ``portrait`` write, with the first bytes of such a file.
+FIGURE_FORMATS = {".png": (b"\x89PNG",), ".pdf": (b"%PDF",), ".svg": (b"<?xml", b"<svg")}
+KAPPA_UNIT = "N s/m^2.5"
 
 
 class _Parser(argparse.ArgumentParser):
@@ -127,8 +149,82 @@ def _path(name):
     return parse
 
 
+def _figure_path(text):
+    """A figure to write: a writable path ending in .png, .pdf or .svg."""
+    suffix = os.path.splitext(text)[1].lower()
+    if suffix not in FIGURE_FORMATS:
+        raise _out_of_range("out", text, "a figure path ending in " + ", ".join(FIGURE_FORMATS) + " (e.g. fig.png)")
+    return _path("out")(text)
+
+
+def _case(text):
+    """argparse type: a shipped case name or a case file, loaded and validated now."""
+    from .case import list_cases, load_case
+
+    try:
+        return load_case(text)
+    except ValueError as error:
+        if "unknown case" in str(error):
+            names = ", ".join(c["name"] for c in list_cases())
+            raise _out_of_range("case", text, f"a shipped case ({names}; see 'phaseimpact cases') or a .toml "
+                                              "case file") from None
+        raise argparse.ArgumentTypeError(f"case = {text!r}: {error}") from None
+    except (OSError, UnicodeError) as error:  # a path the system refuses outright (NUL bytes...)
+        raise _out_of_range("case", text, f"a shipped case name or a readable .toml file ({error})") from None
+
+
+_case.__name__ = "case"
+
+
+def _setting(text):
+    """argparse type: ``NAME=VALUE`` with a settable name and a number (its range is checked with the case)."""
+    from .case import parse_setting
+
+    try:
+        parse_setting(text)
+    except ValueError as error:
+        raise argparse.ArgumentTypeError(f"set: {error}") from None
+    return text
+
+
+_setting.__name__ = "set"
+
+
+def _axis(text):
+    """argparse type: ``NAME=START:STOP:NUM[:log]`` or ``NAME=V1,V2,...``."""
+    from .continuation import parse_axis
+
+    try:
+        return parse_axis(text)
+    except ValueError as error:
+        raise argparse.ArgumentTypeError(str(error)) from None
+
+
+_axis.__name__ = "axis"
+
+
+def _kappa_list(text):
+    """argparse type: ``K1,K2,...``, 1 to :data:`MAX_PANELS` values in [0, KAPPA_MAX]."""
+    allowed = f"1 to {MAX_PANELS} comma-separated numbers 0 <= kappa <= {KAPPA_MAX:g} ({KAPPA_UNIT})"
+    parts = [p.strip() for p in str(text).split(",")]
+    if not 1 <= len(parts) <= MAX_PANELS:
+        raise _out_of_range("kappa", text, allowed)
+    values = []
+    for part in parts:
+        try:
+            value = float(part)
+        except ValueError:
+            value = math.nan
+        if not (math.isfinite(value) and 0 <= value <= KAPPA_MAX):
+            raise _out_of_range("kappa", text, allowed)
+        values.append(value)
+    return values
+
+
+_kappa_list.__name__ = "kappa"
+
 _V = _real("v", *V_RANGE, unit="m/s")
-_KAPPA = _real("kappa", 0.0, KAPPA_MAX, unit="N s/m^2.5")
+_KAPPA = _real("kappa", 0.0, KAPPA_MAX, unit=KAPPA_UNIT)
 _T_END = _real("t-end", 0.0, low_open=True, unit="s")
 _RTOL = _real("rtol", *RTOL_RANGE)
 _KAPPA_RTOL = _real("kappa-rtol", *KAPPA_RTOL_RANGE)
@@ -171,47 +267,109 @@ def _fmt(value, unit="", spec=".6g"):
 
 
 # ------------------------------------------------------------------------------------------------
-# Checks shared by the commands (all before any work)
+# The case, the law and the parameters (all checks before any work)
 # ------------------------------------------------------------------------------------------------
 
-def _law(args):
+@dataclasses.dataclass(frozen=True)
+class Setup:
+    """What a command computes with: the case as used (its ``[impact]`` table holds the resolved
+    speed, damping, target, law, reading and restitution), the law and the parameters."""
+
+    case: object
+    law: object
+    params: object
+
+
+def _given(args, name):
+    return getattr(args, name, None) is not None
+
+
+def _setting_names(args) -> list[str]:
+    return [text.partition("=")[0].strip() for text in (getattr(args, "set", None) or [])]
+
+
+def _check_in_range(name, value, low, high, unit, source):
+    if not (math.isfinite(value) and low <= value <= high):
+        raise ValueError(f"{name} = {value!r} ({source}) is out of range; allowed: {low:g} <= {name} <= {high:g} "
+                         f"({unit})")
+
+
+def _resolve_law(args, impact: dict):
+    """The contact law from the options, else from the case; refuse options the law would ignore."""
     from .model import REGISTRY, ContactLaw
 
-    RESTITUTION_LAWS = [name for name, entry in REGISTRY.items() if entry.damping == "restitution"]
-
+    name = args.law if _given(args, "law") else impact["law"]
+    restitution_laws = [n for n, entry in REGISTRY.items() if entry.damping == "restitution"]
+    if _given(args, "contact") and name != "paper":
+        raise ValueError(f"contact = {args.contact!r} is not read by law {name!r}; allowed: --contact with law paper")
+    contact = args.contact if _given(args, "contact") else (impact["contact"] if name == "paper" else "printed")
     restitution = getattr(args, "restitution", None)
-    if restitution is not None and args.law == "abrate":
+    if restitution is not None and name == "abrate":
         raise ValueError(f"restitution = {restitution!r} is not read by law 'abrate' (undamped Hertz contact); "
                          "allowed: --restitution with hunt-crossley or a restitution law")
-    if restitution is None and args.law in RESTITUTION_LAWS:
+    if restitution is None and impact["restitution"] is not None and not _given(args, "kappa") and (
+            name in restitution_laws or name == "hunt-crossley"):
+        restitution = impact["restitution"]  # the case's: its law reads it
+    if restitution is None and name in restitution_laws:
         lo, hi = RESTITUTION_RANGE
-        raise ValueError(f"restitution = None is out of range for law {args.law!r} (its only damping); allowed: "
+        raise ValueError(f"restitution = None is out of range for law {name!r} (its only damping); allowed: "
                          f"--restitution E with {lo:g} <= E <= {hi:g}")
-    law = ContactLaw(args.law, restitution=restitution, contact=getattr(args, "contact", None) or "printed")
-    kappa = getattr(args, "kappa", None)
-    if kappa is not None and not law.reads("kappa"):
+    law = ContactLaw(name, restitution=restitution, contact=contact)
+    if _given(args, "kappa") and not law.reads("kappa"):
         source = "its damping comes from the restitution" if law.damping_source == "restitution" else "it is undamped"
-        raise ValueError(f"kappa = {kappa!r} is not read by law {law.label()!r} ({source}); allowed: "
+        raise ValueError(f"kappa = {args.kappa!r} is not read by law {law.label()!r} ({source}); allowed: "
                          + ("--kappa or --restitution, not both" if restitution is not None
                             else "--kappa with paper or hunt-crossley"))
     return law
 
 
-def _contact_given(args):
-    if getattr(args, "contact", None) is not None and args.law != "paper":
-        raise ValueError(f"contact = {args.contact!r} is not read by law {args.law!r}; allowed: --contact with "
-                         "law paper")
+def _setup(args, *, law=True) -> Setup:
+    """Resolve the case (``--case``, ``--set``), the explicit options and the law; check every value.
+
+    Raises ``ValueError`` (exit 2) naming the parameter, its value and the allowed range.
+    """
+    from .case import load_case
+
+    case = args.case if getattr(args, "case", None) is not None else load_case("seed")
+    settings = getattr(args, "set", None) or []
+    names = _setting_names(args)
+    if "v" in names and _given(args, "v"):
+        raise ValueError(f"v is given twice (--v {args.v!r} and --set v=...); allowed: one of them")
+    if settings:
+        case = case.with_settings(settings)
+    impact = dict(case.impact)
+    for key in ("v", "kappa", "target"):
+        if _given(args, key):
+            impact[key] = getattr(args, key)
+    source = "from --v" if _given(args, "v") else ("from --set" if "v" in names else f"from case {case.name!r}")
+    _check_in_range("v", impact["v"], *V_RANGE, "m/s", source)
+    _check_in_range("kappa", impact["kappa"], 0.0, KAPPA_MAX, KAPPA_UNIT, f"from case {case.name!r}")
+    contact_law = None
+    if law:
+        contact_law = _resolve_law(args, impact)
+        impact.update(law=contact_law.name, contact=contact_law.contact, restitution=contact_law.restitution)
+    case = dataclasses.replace(case, impact=impact)  # validated again: the case as used
+    return Setup(case, contact_law, case.parameters())
 
 
-def _params(args, **overrides):
-    from .parameters import seed_parameters
+def _check_critical_law(law) -> None:
+    if not law.is_filippov:
+        raise ValueError(f"law = {law.name!r} is out of range for the critical damping; allowed: paper "
+                         "(the other laws have no stick phases to split: see 'phaseimpact transitions')")
 
-    kappa = getattr(args, "kappa", None)
-    settings = {"v": getattr(args, "v", 1.0), "kappa": 0.0 if kappa is None else kappa}
-    if getattr(args, "target", None) is not None:
-        settings["target"] = args.target
-    settings.update(overrides)
-    return seed_parameters(**settings)
+
+def _check_reads_kappa(law, what: str) -> None:
+    if not law.reads("kappa"):
+        source = (f"its damping comes from restitution = {law.restitution:g}" if law.damping_source == "restitution"
+                  else "it has no damping")
+        raise ValueError(f"law {law.label()!r} does not read kappa ({source}): every {what} would be the same "
+                         "run; allowed: a law that reads kappa (paper, hunt-crossley) without --restitution")
+
+
+def _check_kappa_range(args) -> None:
+    if args.kappa_min is not None and args.kappa_max is not None and not args.kappa_min < args.kappa_max:
+        raise ValueError(f"kappa-min = {args.kappa_min!r}, kappa-max = {args.kappa_max!r} are out of range; "
+                         "allowed: kappa-min < kappa-max")
 
 
 def _check_scheduler(address: str) -> None:
@@ -238,54 +396,124 @@ def _check_scheduler(address: str) -> None:
         raise ValueError(f"scheduler = {address!r} is out of range: it answers, but is not a Dask scheduler")
 
 
+def _check_figure_target(path: str, force: bool) -> None:
+    """Refuse to replace an existing file that is not a figure of the format asked for, unless ``force``."""
+    if force or not os.path.isfile(path):
+        return
+    magic = FIGURE_FORMATS[os.path.splitext(path)[1].lower()]
+    try:
+        with open(path, "rb") as handle:
+            head = handle.read(64).lstrip()
+    except OSError:
+        head = b""
+    if not head.startswith(magic):
+        raise ValueError(f"out = {path!r} exists and is not a {os.path.splitext(path)[1]} figure; refusing to "
+                         "overwrite it (choose another path, or add --force to replace it)")
+
+
+def _law_fields(setup: Setup) -> dict:
+    law = setup.law
+    return {"law": law.name, "law_label": law.label(), "contact": law.contact if law.is_filippov else None,
+            "restitution": law.restitution}
+
+
 # ------------------------------------------------------------------------------------------------
 # Commands
 # ------------------------------------------------------------------------------------------------
 
+def cmd_cases(args) -> int:
+    from .case import list_cases
+
+    cases = list_cases()
+    if args.json:
+        _print_json({"cases": cases})
+    else:
+        width = max(len(c["name"]) for c in cases)
+        for c in cases:
+            print(f"{c['name']:<{width}}  {c['description']}")
+        print("(phaseimpact COMMAND --case NAME; 'phaseimpact cases --json' also gives each case's sources)")
+    return EXIT_OK
+
+
+PARAM_UNITS = {"M1": "kg", "M2": "kg", "K": "N/m^1.5", "Kb": "N/m", "Km": "N/m^3", "alpha": "", "kappa": KAPPA_UNIT,
+               "v": "m/s", "R": "m", "contact_time": "s", "plate_period": "s", "indentation": "m", "peak_force": "N",
+               "contact_radius": "m", "peak_pressure": "Pa", "first_yield_pressure": "Pa",
+               "pressure_to_first_yield": ""}
+
+
 def cmd_params(args) -> int:
-    p = _params(args)
-    out = {k: getattr(p, k) for k in ("M1", "M2", "K", "Kb", "Km", "alpha", "kappa", "v")}
+    from .case import hertz_scales, validity
+
+    setup = _setup(args, law=False)
+    p, case = setup.params, setup.case
+    out = {k: getattr(p, k) for k in ("M1", "M2", "K", "Kb", "Km", "alpha", "kappa", "v", "target", "R")}
+    out.update(hertz_scales(p, case.plate))
+    out["validity"] = validity(p, case.plate, case.projectile)
+    out["case"] = case.as_dict()
     if args.json:
         _print_json(out)
     else:
-        units = {"M1": "kg", "M2": "kg", "K": "N/m^1.5", "Kb": "N/m", "Km": "N/m^3", "alpha": "",
-                 "kappa": "N s/m^2.5", "v": "m/s"}
+        print(f"case {case.name}: {case.description}" if case.description else f"case {case.name}")
         for k, value in out.items():
-            print(f"{k:>6} = {value:.6g} {units[k]}".rstrip())
+            if k in ("case", "validity", "target"):
+                continue
+            print(f"  {k:>23} = {_fmt(value, PARAM_UNITS.get(k, ''))}".rstrip())
+        print(f"  {'target':>23} = {p.target}")
+        print(f"  validity: {out['validity']}")
     return EXIT_OK
+
+
+def _contact_reading(trajectory, setup: Setup) -> dict:
+    """Hertz contact radius and peak pressure at the run's largest force, and whether elastic Hertz
+    contact holds there (null when the run has no finite force)."""
+    from .case import hertz_contact, validity_for_force
+
+    force = trajectory.max_force
+    if not (isinstance(force, float) and math.isfinite(force)) or setup.params.R is None:
+        return {"peak_pressure": None, "contact_radius": None, "validity": "unknown: the run has no finite peak force"}
+    force = max(force, 0.0)
+    case = setup.case
+    return {**hertz_contact(force, setup.params),
+            "validity": validity_for_force(force, setup.params, case.plate, case.projectile)}
 
 
 def cmd_simulate(args) -> int:
     from .integrate import simulate
     from .quantities import impact_quantities
 
-    _contact_given(args)
-    law = _law(args)
-    p = _params(args)
+    setup = _setup(args)
+    law, p = setup.law, setup.params
     horizon = "until the outcome settles" if args.t_end is None else f"to t = {args.t_end:g} s"
     _note(f"integrating {law.label()} at v = {p.v:g} m/s {horizon} (the first run compiles the engine)")
     trajectory = simulate(p, law, args.t_end, rtol=args.rtol)
     q = impact_quantities(trajectory)
     t_stick, delta_stick, dwell = trajectory.stick_points()
-    out = {"law": law.name, "contact": law.contact, "v": p.v, "kappa": law.kappa(p), "target": p.target,
+    out = {**_law_fields(setup), "v": p.v, "kappa": law.kappa(p), "target": p.target,
            "status": trajectory.status, "stop_reason": trajectory.stop_reason, "message": trajectory.message,
            "t_end": trajectory.t_end, "t_stop": trajectory.t_stop, **q.as_dict(),
-           "n_stick": trajectory.n_stick, "t_run": trajectory.t_run, "cut": trajectory.cut,
+           **_contact_reading(trajectory, setup),
+           "n_stick": trajectory.n_stick, "n_contacts": trajectory.n_contacts, "t_run": trajectory.t_run,
+           "cut": trajectory.cut, "outcome": trajectory.outcome,
            "stick_points": [{"t": t, "delta": d, "dwell": w}
                             for t, d, w in zip(t_stick, delta_stick, dwell, strict=True)],
            "asymptotic_points": [{"delta": d, "deltadot": 0.0, "dwell": w}
                                  for d, w in zip(delta_stick, dwell, strict=True)],
-           "outcome": trajectory.outcome}
+           "case": setup.case.as_dict()}
     if args.json:
         _print_json(out)
     else:
-        print(f"{law.label()} on a {p.target} target, v = {p.v:g} m/s, kappa = {out['kappa']:.4g} N s/m^2.5")
+        print(f"{law.label()} on a {p.target} target ({setup.case.name}), v = {p.v:g} m/s, "
+              f"kappa = {out['kappa']:.4g} {KAPPA_UNIT}")
         print(f"  status: {trajectory.status} ({trajectory.message})")
         units = {"max_force": "N", "max_indentation": "m", "contact_duration": "s", "restitution": "",
-                 "time_equal_displacement": "s", "dissipated_energy": "J", "loop_area": "J"}
+                 "time_equal_displacement": "s", "dissipated_energy": "J", "loop_area": "J",
+                 "peak_pressure": "Pa", "contact_radius": "m"}
         for k, u in units.items():
             print(f"  {k:<24} {_fmt(out[k], u)}")
-        print(f"  outcome: {trajectory.outcome}; {trajectory.n_stick} stick phase(s)"
+        print(f"  validity: {out['validity']}")
+        lower = " (at least: the horizon cut the run)" if trajectory.cut else ""
+        print(f"  outcome: {trajectory.outcome}; {trajectory.n_stick} stick phase(s){lower}, "
+              f"{trajectory.n_contacts} contact(s)"
               + ("" if trajectory.t_run is None else f", escape at t = {trajectory.t_run:.6g} s"))
         for t, d, w in zip(t_stick, delta_stick, dwell, strict=True):
             lasting = "permanent" if math.isinf(w) else f"{w:.4g} s"
@@ -296,41 +524,78 @@ def cmd_simulate(args) -> int:
     return EXIT_OK
 
 
-def _check_critical_law(law) -> None:
-    if not law.is_filippov:
-        raise ValueError(f"law = {law.name!r} is out of range for the critical damping; allowed: paper "
-                         "(the other laws have no stick phases to split)")
-
-
 def cmd_critical(args) -> int:
     from .continuation import critical_damping
 
-    law = _law(args)
+    setup = _setup(args)
+    law, params = setup.law, setup.params
     _check_critical_law(law)
-    params = _params(args)
-    if args.kappa_min is not None and args.kappa_max is not None and not args.kappa_min < args.kappa_max:
-        raise ValueError(f"kappa-min = {args.kappa_min!r}, kappa-max = {args.kappa_max!r} are out of range; "
-                         "allowed: kappa-min < kappa-max")
-    _note(f"locating kappa_c of {law.label()} at v = {params.v:g} m/s (a few seconds)")
+    _check_kappa_range(args)
+    _note(f"locating kappa_c and kappa_2 of {law.label()} at v = {params.v:g} m/s"
+          + (" and measuring the exponents (about 15 s)" if args.exponents else ""))
     result = critical_damping(params, law, kappa_min=args.kappa_min, kappa_max=args.kappa_max,
-                              rtol=args.kappa_rtol, integrator_rtol=args.rtol)
-    out = {"law": result.law, "contact": result.contact, "v": result.v, "kappa_c": result.kappa_c,
-           "bracket": list(result.bracket), "kappa_rtol": result.rtol, "rtol": args.rtol,
-           "closed_form": result.closed_form, "kappa_2": result.kappa_2, "classification": result.classification,
-           "status": result.status, "message": result.message, "evaluations": result.evaluations}
+                              rtol=args.kappa_rtol, integrator_rtol=args.rtol, with_kappa_2=True,
+                              with_exponents=args.exponents)
+    out = {**_law_fields(setup), "v": result.v, "kappa_c": result.kappa_c, "kappa_2": result.kappa_2,
+           "closed_form": result.closed_form, "classification": result.classification,
+           "status": result.status, "message": result.message, "bracket": list(result.bracket),
+           "margins": list(result.margins), "kappa_rtol": result.rtol, "rtol": args.rtol,
+           "n_staircase": result.n_staircase, "evaluations": result.evaluations, "case": setup.case.as_dict()}
+    if args.exponents:
+        out["exponents"] = result.exponents
     if args.json:
         _print_json(out)
     else:
-        kc = "not found" if result.kappa_c is None else f"{result.kappa_c:.10g} N s/m^2.5"
-        print(f"critical damping of {law.label()} at v = {params.v:g} m/s: {kc}")
-        print(f"  bracket {result.bracket[0]:.10g} .. {result.bracket[1]:.10g} N s/m^2.5; closed form "
-              f"{_fmt(result.closed_form, 'N s/m^2.5', '.6g')}")
+        kc = "not found" if result.kappa_c is None else f"{result.kappa_c:.10g} {KAPPA_UNIT}"
+        print(f"critical damping of {law.label()} ({setup.case.name}) at v = {params.v:g} m/s: {kc}")
+        print(f"  closed form {_fmt(result.closed_form, KAPPA_UNIT)}; kappa_2 (N = 2 from here on) "
+              f"{_fmt(result.kappa_2, KAPPA_UNIT, '.10g')}; classification {result.classification or 'none'}")
+        if result.n_staircase:
+            steps = [f"{s['n_stick']}{'+' if s['cut'] else ''}" for s in result.n_staircase]
+            print(f"  stick phases from kappa_c (1 + 1e-6) to 1.5 kappa_2: {' '.join(steps)}")
+        if args.exponents and result.exponents:
+            e = result.exponents
+            print(f"  exponents: slip speed {_fmt(e.get('slip_speed_exponent'), '', '.3g')} (expected 1.5), "
+                  f"stick offset {_fmt(e.get('stick_offset_exponent'), '', '.3g')} (expected 2), "
+                  f"eps in {e['fit_range'][0]:g}..{e['fit_range'][1]:g}")
         print(f"  {result.status}: {result.message}")
     if result.status not in CRITICAL_ANSWERS:
         print(f"phaseimpact: kappa_c search failed: {result.status}: {result.message}", file=sys.stderr)
         return EXIT_FAILURE
     return EXIT_OK
 
+
+def cmd_transitions(args) -> int:
+    from .continuation import transitions
+
+    setup = _setup(args)
+    law, params = setup.law, setup.params
+    _check_reads_kappa(law, "kappa")
+    _check_kappa_range(args)
+    _note(f"locating the transitions of {law.label()} at v = {params.v:g} m/s for kappa in "
+          f"[{args.kappa_min:g}, {args.kappa_max:g}]")
+    found = transitions(params, law, args.kappa_min, args.kappa_max, rtol=args.kappa_rtol,
+                        integrator_rtol=args.rtol, num=args.samples)
+    count = "stick phases" if law.is_filippov else "contacts"
+    out = {**_law_fields(setup), "v": params.v, "kappa_min": args.kappa_min, "kappa_max": args.kappa_max,
+           "count": count, "transitions": [t.as_dict() for t in found], "kappa_rtol": args.kappa_rtol,
+           "rtol": args.rtol, "samples": args.samples, "case": setup.case.as_dict()}
+    if args.json:
+        _print_json(out)
+    else:
+        print(f"transitions of {law.label()} ({setup.case.name}) at v = {params.v:g} m/s, kappa in "
+              f"[{args.kappa_min:g}, {args.kappa_max:g}] {KAPPA_UNIT} (counts: {count})")
+        for t in found:
+            above = "unbounded" if t.count_above is None else str(t.count_above)
+            print(f"  {t.kind:<15} kappa = {t.kappa:.10g}   {t.count_below} -> {above}")
+        if not found:
+            print("  none in this range")
+    return EXIT_OK
+
+
+# ------------------------------------------------------------------------------------------------
+# Grids (sweep, atlas): one runner with checkpoints, the lock, resume, failures and Ctrl-C
+# ------------------------------------------------------------------------------------------------
 
 def _resume_command(argv) -> str:
     words = ["phaseimpact", *argv]
@@ -339,86 +604,53 @@ def _resume_command(argv) -> str:
     return shlex.join(words)
 
 
-def _sweep_summary(result, out_path) -> dict:
-    n_stick = np.asarray(result.values["n_stick"])
-    computed = result.status >= 0
-    kappas = result.kappa
-    split = np.flatnonzero(computed[:-1] & computed[1:] & (n_stick[:-1] == 1) & (n_stick[1:] >= 2))
-    counts = np.unique(n_stick[computed], return_counts=True)
-    failed = result.failed
-    failures = {}
-    for name in result.status_names()[failed]:
-        failures[str(name)] = failures.get(str(name), 0) + 1
-    return {"out": out_path, "law": result.law.label(), "points": int(result.grid.size),
-            "computed": int(np.count_nonzero(computed)), "failed": int(np.count_nonzero(failed)),
-            "failures": failures, "cut_by_horizon": int(np.count_nonzero(result.cut)),
-            "outcomes": result.summary()["outcomes"],
-            "n_stick": {int(k): int(n) for k, n in zip(*counts, strict=True)},
-            "first_split": None if not split.size else [float(kappas[split[0]]), float(kappas[split[0] + 1])]}
-
-
-def _print_sweep_summary(s: dict) -> None:
-    print(f"wrote {s['out']}: {s['points']} points of {s['law']}, {s['computed']} computed, {s['failed']} failed"
-          + (f", {s['cut_by_horizon']} cut by the horizon (counts are lower bounds)" if s["cut_by_horizon"] else ""))
-    print("  outcomes:      " + ", ".join(f"{k} {v}" for k, v in s["outcomes"].items()))
-    print("  stick phases:  " + ", ".join(f"{k}: {v} points" for k, v in s["n_stick"].items()))
-    if s["first_split"] is None:
-        print("  the count of stick phases never goes from 1 to 2 on this grid")
-    else:
-        lo, hi = s["first_split"]
-        print(f"  first split (1 -> 2 stick phases) between kappa = {lo:.6g} and {hi:.6g} N s/m^2.5")
-
-
-def cmd_sweep(args) -> int:
-    from . import archive
-    from .continuation import Axis, Grid, sweep
-
+def _check_grid_options(args) -> None:
     if args.scheduler is not None and args.backend != "dask":
         raise ValueError(f"scheduler = {args.scheduler!r} is not read by backend {args.backend!r}; allowed: "
                          "--scheduler together with --backend dask")
     if args.resume and args.force:
         raise ValueError("--resume and --force contradict each other: --resume completes the archive, "
                          "--force replaces it; give one")
-    if not args.kappa_min < args.kappa_max:
-        raise ValueError(f"kappa-min = {args.kappa_min!r}, kappa-max = {args.kappa_max!r} are out of range; "
-                         "allowed: kappa-min < kappa-max")
-    _contact_given(args)
-    law = _law(args)
-    if not law.reads("kappa"):
-        source = (f"its damping comes from restitution = {law.restitution:g}" if law.damping_source == "restitution"
-                  else "it has no damping")
-        raise ValueError(f"law {law.label()!r} does not read kappa ({source}): every point "
-                         "of a kappa sweep would be the same run; allowed: a law that reads kappa (paper, "
-                         "hunt-crossley) without --restitution")
-    params = _params(args)
-    kappas = np.geomspace(args.kappa_min, args.kappa_max, args.num)
-    Grid(params, law, (Axis.make("kappa", kappas),))  # every check of the grid, before any work
+
+
+def _run_grid(args, setup: Setup, axes: list):
+    """Evaluate the grid ``axes`` over the case into ``args.out``, checkpointed after every chunk.
+
+    Every check (the grid, the archive at ``--out``, the scheduler) comes before any work. Returns
+    the result, or None when interrupted (the resume command is printed).
+    """
+    from . import archive
+    from .continuation import Grid, atlas
+
+    Grid(setup.case, setup.law, tuple(axes))  # every check of the grid, before any work
     out = args.out
     archive.created_timestamp()  # a bad SOURCE_DATE_EPOCH is refused now, not at the first checkpoint
     if args.backend == "dask" and args.scheduler is not None:
         _check_scheduler(args.scheduler)
-    axes = {"kappa": kappas}
+    named = {axis.name: axis.values for axis in axes}
+    size = int(np.prod([len(axis.values) for axis in axes]))
     with exclusive(out, "out"):
         previous = None
         if os.path.exists(out) and args.resume:
             held = archive.describe(out)
             if held["kind"] != "sweep":
-                raise ValueError(f"out = {out!r} is a {held['kind']} archive, not a sweep: --resume cannot "
+                raise ValueError(f"out = {out!r} is a {held['kind']} archive, not a sweep or atlas: --resume cannot "
                                  "complete it (choose another --out, or drop --resume and add --force)")
-            differences = archive.same_work(held, "sweep", law, params, axes, args.t_end, args.rtol)
+            differences = archive.same_work(held, "sweep", setup.law, setup.params, named, args.t_end, args.rtol)
             if differences:
                 raise ValueError(f"resume: out = {out!r} holds other work ({'; '.join(differences)}); "
                                  "give the options it was computed with, or drop --resume")
             previous = archive.load(out)
-            _note(f"resuming {out}: {int(np.count_nonzero(previous.done))} of {len(kappas)} points done")
+            _note(f"resuming {out}: {int(np.count_nonzero(previous.done))} of {size} points done")
         elif os.path.exists(out):
-            archive.check_overwrite(out, "sweep", law, params, axes, args.t_end, args.rtol, force=args.force)
+            archive.check_overwrite(out, "sweep", setup.law, setup.params, named, args.t_end, args.rtol,
+                                    force=args.force)
 
         def checkpoint(result):
             archive.save(result, out, force=args.force)
 
         try:
-            result = sweep(params, law, kappas, t_end=args.t_end, n_jobs=args.jobs, backend=args.backend,
+            result = atlas(setup.case, setup.law, axes, t_end=args.t_end, n_jobs=args.jobs, backend=args.backend,
                            scheduler=args.scheduler, rtol=args.rtol, progress=not args.no_progress,
                            previous=previous, on_chunk=checkpoint)
         except KeyboardInterrupt:
@@ -426,58 +658,356 @@ def cmd_sweep(args) -> int:
             if os.path.exists(out):
                 try:
                     done = int(np.count_nonzero(archive.load(out).done))
-                    saved = f"; {done} of {len(kappas)} points are saved in {out}"
+                    saved = f"; {done} of {size} points are saved in {out}"
                 except ValueError:
                     saved = ""
             print(f"phaseimpact: interrupted{saved}. Resume with:\n  {_resume_command(args.argv)}", file=sys.stderr)
-            return EXIT_INTERRUPTED
+            return None
         archive.save(result, out, force=args.force)
-    summary = _sweep_summary(result, out)
+    return result
+
+
+def _histogram(values, computed) -> dict:
+    counts = np.unique(np.asarray(values)[computed], return_counts=True)
+    return {int(k): int(n) for k, n in zip(*counts, strict=True)}
+
+
+def _grid_summary(result, out_path, setup: Setup) -> dict:
+    computed = result.status >= 0
+    failed = result.failed
+    failures = {}
+    for name in result.status_names()[failed]:
+        failures[str(name)] = failures.get(str(name), 0) + 1
+    axes = [{"name": a.name, "num": len(a.values), "start": float(a.values[0]), "stop": float(a.values[-1]),
+             "log": bool(a.log)} for a in result.grid.axes]
+    summary = {"out": out_path, **_law_fields(setup), "points": int(result.grid.size),
+               "computed": int(np.count_nonzero(computed)), "failed": int(np.count_nonzero(failed)),
+               "failures": failures, "cut_by_horizon": int(np.count_nonzero(result.cut)),
+               "outcomes": result.summary()["outcomes"], "axes": axes,
+               "n_stick": _histogram(result.values["n_stick"], computed),
+               "n_contacts": _histogram(result.values["n_contacts"], computed)}
+    if result.grid.names == ("kappa",) and result.law.is_filippov:
+        n_stick = np.asarray(result.values["n_stick"])
+        kappas = result.kappa
+        split = np.flatnonzero(computed[:-1] & computed[1:] & (n_stick[:-1] == 1) & (n_stick[1:] >= 2))
+        summary["first_split"] = (None if not split.size
+                                  else [float(kappas[split[0]]), float(kappas[split[0] + 1])])
+    summary["case"] = setup.case.as_dict()
+    return summary
+
+
+def _print_grid_summary(s: dict) -> None:
+    shape = " x ".join(f"{a['num']} {a['name']}" for a in s["axes"])
+    print(f"wrote {s['out']}: {s['points']} points ({shape}) of {s['law_label']}, {s['computed']} computed, "
+          f"{s['failed']} failed"
+          + (f", {s['cut_by_horizon']} cut by the horizon (counts are lower bounds)" if s["cut_by_horizon"] else ""))
+    print("  outcomes:      " + ", ".join(f"{k} {v}" for k, v in s["outcomes"].items()))
+    if s["contact"] is not None:  # paper: stick phases
+        print("  stick phases:  " + ", ".join(f"{k}: {v} points" for k, v in s["n_stick"].items()))
+    print("  contacts:      " + ", ".join(f"{k}: {v} points" for k, v in s["n_contacts"].items()))
+    if "first_split" in s:
+        if s["first_split"] is None:
+            print("  the count of stick phases never goes from 1 to 2 on this grid")
+        else:
+            lo, hi = s["first_split"]
+            print(f"  first split (1 -> 2 stick phases) between kappa = {lo:.6g} and {hi:.6g} {KAPPA_UNIT}")
+
+
+def _finish_grid(args, result, setup: Setup) -> int:
+    if result is None:
+        return EXIT_INTERRUPTED
+    summary = _grid_summary(result, args.out, setup)
     if args.json:
         _print_json(summary)
     else:
-        _print_sweep_summary(summary)
+        _print_grid_summary(summary)
     if summary["failed"]:
         kinds = ", ".join(f"{k}: {v}" for k, v in summary["failures"].items())
         print(f"phaseimpact: {summary['failed']} of {summary['points']} points failed numerically ({kinds}); "
-              f"they are stored with their status in {out}, and --resume recomputes them", file=sys.stderr)
+              f"they are stored with their status in {args.out}, and --resume recomputes them", file=sys.stderr)
         return EXIT_FAILURE
     return EXIT_OK
 
 
+def cmd_sweep(args) -> int:
+    from .continuation import Axis
+
+    _check_grid_options(args)
+    _check_kappa_range(args)
+    setup = _setup(args)
+    _check_reads_kappa(setup.law, "point of a kappa sweep")
+    axis = Axis("kappa", np.geomspace(args.kappa_min, args.kappa_max, args.num), log=True)
+    return _finish_grid(args, _run_grid(args, setup, [axis]), setup)
+
+
+def cmd_atlas(args) -> int:
+    _check_grid_options(args)
+    setup = _setup(args)
+    names = [axis.name for axis in args.axis]
+    for name in names:
+        if name in _setting_names(args) or (name in ("v", "kappa", "target") and _given(args, name)):
+            option = f"--{name}" if _given(args, name) else f"--set {name}=..."
+            raise ValueError(f"axis {name!r} is also given as {option}, which the axis would override; allowed: "
+                             "one of them")
+    for axis in args.axis:  # the command line's ranges (the grid checks each corner as a case)
+        if axis.name == "v":
+            _check_in_range("v", float(np.min(axis.values)), *V_RANGE, "m/s", "axis v")
+            _check_in_range("v", float(np.max(axis.values)), *V_RANGE, "m/s", "axis v")
+        elif axis.name == "kappa":
+            _check_in_range("kappa", float(np.min(axis.values)), 0.0, KAPPA_MAX, KAPPA_UNIT, "axis kappa")
+            _check_in_range("kappa", float(np.max(axis.values)), 0.0, KAPPA_MAX, KAPPA_UNIT, "axis kappa")
+    size = int(np.prod([len(a.values) for a in args.axis]))
+    if size > MAX_SWEEP_POINTS:
+        raise ValueError(f"axis: the grid has {size} points; allowed: at most {MAX_SWEEP_POINTS}")
+    return _finish_grid(args, _run_grid(args, setup, list(args.axis)), setup)
+
+
+# ------------------------------------------------------------------------------------------------
+# Critical curves
+# ------------------------------------------------------------------------------------------------
+
+def _curve_values(args, setup: Setup):
+    """``(param, values)`` of a critical curve, checked (both ends valid cases) before any work."""
+    shorthand = args.v_min is not None or args.v_max is not None
+    if shorthand and (args.param is not None or args.from_ is not None or args.to is not None):
+        raise ValueError("--v-min/--v-max and --param/--from/--to contradict each other: --v-min A --v-max B is "
+                         "short for --param v --from A --to B --log; give one form")
+    if shorthand:
+        if args.v_min is None or args.v_max is None:
+            raise ValueError("v-min, v-max: allowed: both, or --param v --from A --to B")
+        param, start, stop, log = "v", args.v_min, args.v_max, True
+        label = ("v-min", "v-max")
+    else:
+        if args.param is None or args.from_ is None or args.to is None:
+            missing = [o for o, v in (("--param", args.param), ("--from", args.from_), ("--to", args.to)) if v is None]
+            raise ValueError(f"{', '.join(m.lstrip('-') for m in missing)} missing; allowed: --param NAME --from A "
+                             "--to B (or --v-min A --v-max B)")
+        param, start, stop, log = args.param, args.from_, args.to, args.log
+        label = ("from", "to")
+    allowed = [*CURVE_PARAMETERS, *(n for n in SETTABLE if n not in CURVE_PARAMETERS and n != "plate.yield_strength")]
+    if param not in allowed:
+        raise ValueError(f"param = {param!r} is out of range; allowed: one of {', '.join(allowed)}"
+                         + (" (kappa is what the curve continues)" if param == "kappa" else ""))
+    if param == "v" and _given(args, "v"):
+        raise ValueError("param = 'v' and --v contradict each other: the curve runs over v; give one")
+    if param in _setting_names(args):
+        raise ValueError(f"param = {param!r} is also given as --set {param}=...: the curve runs over it; give one")
+    if not start < stop:
+        raise ValueError(f"{label[0]} = {start!r}, {label[1]} = {stop!r} are out of range; allowed: "
+                         f"{label[0]} < {label[1]}")
+    if log and start <= 0:
+        raise ValueError(f"{label[0]} = {start!r} is out of range with --log; allowed: {label[0]} > 0")
+    for name, value in zip(label, (start, stop), strict=True):
+        if param == "v":
+            _check_in_range("v", value, *V_RANGE, "m/s", f"--{name}")
+        try:
+            setup.case.parameters(**{param: value})
+        except ValueError as error:
+            raise ValueError(f"{name} = {value!r} is out of range for param {param!r}: {error}") from None
+    values = np.geomspace(start, stop, args.num) if log else np.linspace(start, stop, args.num)
+    return param, values
+
+
+def _check_curve_overwrite(out, args, setup: Setup, param, values, what) -> None:
+    """Like ``archive.check_overwrite``, comparing the values asked for (a curve also stores the
+    intermediate steps of its continuation) and what it continues."""
+    from . import archive
+
+    if args.force or not os.path.exists(out):
+        return
+    try:
+        held = archive.describe(out)
+        curve = archive.load(out) if held["kind"] == "critical-curve" else None
+    except ValueError:
+        raise ValueError(f"out = {out!r} exists and is not a phaseimpact archive; refusing to overwrite it "
+                         "(choose another path, or add --force to replace it)") from None
+    differences = []
+    if curve is not None:
+        held["axes"] = {curve.param: np.asarray(curve.values)[np.asarray(curve.requested, dtype=bool)]}
+        if curve.what != what:
+            differences.append(f"what {curve.what!r}, not {what!r}")
+    differences += archive.same_work(held, "critical-curve", setup.law, setup.params, {param: values}, None,
+                                     args.kappa_rtol)
+    if differences:
+        raise ValueError(f"out = {out!r} holds other work ({'; '.join(differences)}); refusing to overwrite it "
+                         "(choose another path, or add --force to replace it)")
+
+
 def cmd_critical_curve(args) -> int:
     from . import archive
-    from .continuation import critical_curve
+    from .continuation import critical_curve, transitions
 
-    if not args.v_min < args.v_max:
-        raise ValueError(f"v-min = {args.v_min!r}, v-max = {args.v_max!r} are out of range; "
-                         "allowed: v-min < v-max")
-    law = _law(args)
-    _check_critical_law(law)
-    params = _params(args, v=args.v_min)
-    _params(args, v=args.v_max)  # both ends valid, checked before any work
-    speeds = np.geomspace(args.v_min, args.v_max, args.num)
+    setup = _setup(args)
+    law = setup.law
+    what = args.what
+    if what in ("kappa_c", "kappa_2"):
+        if not law.is_filippov:
+            raise ValueError(f"what = {what!r} is out of range for law {law.name!r}; allowed: what kappa_c or "
+                             "kappa_2 with law paper, what grazing with a unilateral law")
+        for name in ("kappa_min", "kappa_max"):
+            if getattr(args, name) is not None:
+                raise ValueError(f"{name.replace('_', '-')} = {getattr(args, name)!r} is not read by what = "
+                                 f"{what!r}; allowed: --kappa-min/--kappa-max with --what grazing")
+        if args.samples is not None:
+            raise ValueError(f"samples = {args.samples!r} is not read by what = {what!r}; allowed: --samples with "
+                             "--what grazing")
+    else:
+        if not law.is_unilateral:
+            raise ValueError(f"what = 'grazing' is out of range for law {law.label()!r} (it acts in tension too: no "
+                             "grazing); allowed: a unilateral law (abrate, the Hunt-Crossley family, or paper "
+                             "with --contact unilateral)")
+        _check_reads_kappa(law, "point of a grazing curve")
+        if args.kappa_min is None or args.kappa_max is None:
+            raise ValueError("kappa-min, kappa-max are required by what = 'grazing' (the range in which the first "
+                             "grazing value is looked for); allowed: --kappa-min A --kappa-max B")
+        _check_kappa_range(args)
+    param, values = _curve_values(args, setup)
     out = args.out
     archive.created_timestamp()
+    samples = args.samples or DEFAULT_SAMPLES
     with exclusive(out, "out"):
-        if os.path.exists(out):
-            archive.check_overwrite(out, "critical-curve", law, params, {"v": speeds}, None, args.kappa_rtol,
-                                    force=args.force)
-        _note(f"continuing kappa_c of {law.label()} over {args.num} speeds")
-        curve = critical_curve(params, law, "v", speeds, rtol=args.kappa_rtol, integrator_rtol=args.rtol,
-                               progress=not args.no_progress)
+        _check_curve_overwrite(out, args, setup, param, values, what)
+        start, index = None, 1
+        if what == "grazing":
+            first = setup.case.parameters(**{param: float(values[0])})
+            _note(f"looking for the first grazing of {law.label()} at {param} = {values[0]:g}")
+            found = [t for t in transitions(first, law, args.kappa_min, args.kappa_max, rtol=args.kappa_rtol,
+                                            integrator_rtol=args.rtol, num=samples) if t.kind == "grazing"]
+            if not found:
+                print(f"phaseimpact: the curve failed to start: no grazing value of {law.label()} for kappa in "
+                      f"[{args.kappa_min:g}, {args.kappa_max:g}] at {param} = {values[0]:g} (with {samples} samples); "
+                      "nothing written", file=sys.stderr)
+                return EXIT_FAILURE
+            start, index = found[0].kappa, int(found[0].extremum)
+        _note(f"continuing {what} of {law.label()} over {len(values)} values of {param}")
+        try:
+            curve = critical_curve(setup.case, law, param, values, what=what, rtol=args.kappa_rtol,
+                                   integrator_rtol=args.rtol, contact_index=index, kappa_start=start,
+                                   progress=not args.no_progress)
+        except ValueError as error:  # every input was checked: this is the curve's own failure
+            print(f"phaseimpact: the curve failed to start: {error}; nothing written", file=sys.stderr)
+            return EXIT_FAILURE
         archive.save(curve, out, force=args.force)
     asked = np.asarray(curve.requested, dtype=bool)
+    values_out, kappa_out = curve.values[asked].tolist(), curve.kappa[asked].tolist()
+    result = {"out": out, **_law_fields(setup), "param": param, "what": what, "values": values_out,
+              "kappa": kappa_out, param: values_out, what: kappa_out,
+              "closed_form": curve.closed_form[asked].tolist(), "contact_index": curve.contact_index,
+              "steps": int(len(curve.values)), "message": curve.message, "kappa_rtol": args.kappa_rtol,
+              "rtol": args.rtol, "case": setup.case.as_dict()}
     if args.json:
-        _print_json({"out": out, "v": curve.values[asked].tolist(), "kappa_c": curve.kappa[asked].tolist(),
-                     "closed_form": curve.closed_form[asked].tolist(), "message": curve.message})
+        _print_json(result)
     else:
-        for v, kc, closed in zip(curve.values[asked], curve.kappa[asked], curve.closed_form[asked], strict=True):
-            print(f"v = {v:8.4g} m/s   kappa_c = {_fmt(kc, '', '.10g'):>16}   closed form {_fmt(closed, '', '.6g')}")
-        print(f"wrote {out}" + (f" ({curve.message})" if curve.message else ""))
+        unit = SETTABLE.get(param, (PARAM_UNITS.get(param, ""),))[0]
+        for x, k, closed in zip(curve.values[asked], curve.kappa[asked], curve.closed_form[asked], strict=True):
+            line = f"{param} = {x:10.6g} {unit}   {what} = {_fmt(k, '', '.10g'):>16}"
+            print(line + (f"   closed-form kappa_c {_fmt(closed, '', '.6g')}" if np.isfinite(closed) else ""))
+        note = f"; {curve.message}" if curve.message else ""
+        print(f"wrote {out} ({len(curve.values)} continuation steps{note})")
     if curve.message or not np.all(np.isfinite(curve.kappa[asked])):
-        print(f"phaseimpact: the curve is incomplete: {curve.message or 'kappa_c lost at some speeds'}",
+        print(f"phaseimpact: the curve is incomplete: {curve.message or what + ' lost at some values'}",
               file=sys.stderr)
+        return EXIT_FAILURE
+    return EXIT_OK
+
+
+# ------------------------------------------------------------------------------------------------
+# Figures
+# ------------------------------------------------------------------------------------------------
+
+def cmd_plot(args) -> int:
+    from . import archive
+
+    _check_figure_target(args.out, args.force)
+    if os.path.abspath(args.out) == os.path.abspath(args.archive):
+        raise ValueError(f"out = {args.out!r} is the archive itself; allowed: another path")
+    result = archive.load(args.archive)
+    curves = [archive.load(path) for path in (args.curve or [])]
+    from . import plotting
+    from .continuation import CriticalCurve
+
+    if isinstance(result, CriticalCurve):
+        if args.contours != "none" or curves:
+            raise ValueError(f"archive = {args.archive!r} is a critical curve: --contours and --curve are read only "
+                             "for an atlas; allowed: an atlas archive with them")
+        fig = plotting.plot_curve(result)
+        kind = "curve"
+    else:
+        ndim = len(result.grid.axes)
+        for curve in curves:
+            if not isinstance(curve, CriticalCurve):
+                raise ValueError("curve: allowed: a critical-curve archive (phaseimpact critical-curve --out ...)")
+        if ndim == 1:
+            if args.contours != "none" or curves:
+                raise ValueError(f"archive = {args.archive!r} is a sweep (one axis): --contours and --curve are read "
+                                 "only for an atlas; allowed: an atlas archive with them")
+            fig = plotting.plot_sweep(result)
+            kind = "sweep"
+        elif ndim == 2:
+            names = result.grid.names
+            for curve in curves:
+                if set(names) != {"kappa", curve.param}:
+                    raise ValueError(f"curve over {curve.param!r} cannot be drawn on an atlas over "
+                                     f"{', '.join(names)}; allowed: an atlas with axes kappa and {curve.param}")
+            fig = plotting.plot_atlas(result, contours=None if args.contours == "none" else args.contours,
+                                      curves=curves)
+            kind = "atlas"
+        else:
+            raise ValueError(f"archive = {args.archive!r} has {ndim} axes ({', '.join(result.grid.names)}); "
+                             "allowed: 1 (a sweep) or 2 (an atlas)")
+    plotting.save(fig, args.out)
+    if args.json:
+        _print_json({"out": args.out, "archive": args.archive, "kind": kind})
+    else:
+        print(f"wrote {args.out} ({kind} of {args.archive})")
+    return EXIT_OK
+
+
+#: Samples drawn along each portrait's trajectory.
+PORTRAIT_SAMPLES = 4001
+
+
+def cmd_portrait(args) -> int:
+    from . import plotting
+    from .integrate import scales, simulate
+
+    _check_figure_target(args.out, args.force)
+    setup = _setup(args)
+    _check_reads_kappa(setup.law, "panel")
+    plane = tuple(args.plane.split(","))
+    _note(f"integrating {len(args.kappas)} trajectories of {setup.law.label()}")
+    summaries, drawn = [], []
+    period = scales(setup.params).plate_period
+    for kappa in args.kappas:
+        p = setup.params.replace(kappa=kappa)
+        summary = simulate(p, setup.law, args.t_end, rtol=args.rtol)
+        end = summary.t_stop
+        if args.t_end is None and summary.outcome == "permanent-stick" and math.isfinite(period):
+            end += 2 * period  # show the stuck pair's orbit on the plate springs for two periods
+        if not end > 0:
+            end = summary.t_end
+        times = np.linspace(0.0, end, PORTRAIT_SAMPLES)
+        drawn.append(simulate(p, setup.law, end, rtol=args.rtol, save=times, stop_when_settled=False))
+        summaries.append(summary)
+    title = f"{setup.law.label()}, {setup.case.name}, v = {setup.params.v:g} m/s, {setup.params.target} target"
+    fig = plotting.plot_portraits(drawn, plane, summaries=summaries, title=title)
+    plotting.save(fig, args.out)
+    panels = [{"kappa": float(k), "outcome": tr.outcome, "status": tr.status, "stop_reason": tr.stop_reason,
+               "n_stick": tr.n_stick, "n_contacts": tr.n_contacts, "cut": tr.cut, "t_stop": tr.t_stop}
+              for k, tr in zip(args.kappas, summaries, strict=True)]
+    if args.json:
+        _print_json({"out": args.out, **_law_fields(setup), "v": setup.params.v, "plane": list(plane),
+                     "panels": panels, "case": setup.case.as_dict()})
+    else:
+        print(f"wrote {args.out}: {len(panels)} panel(s) in the ({', '.join(plane)}) plane")
+        for p in panels:
+            print(f"  kappa = {p['kappa']:.6g}: {p['outcome']}, {p['n_stick']} stick phase(s), "
+                  f"{p['n_contacts']} contact(s)")
+    failed = [p for p in panels if p["status"] != "success"]
+    if failed:
+        print("phaseimpact: numerical failure in " + ", ".join(f"kappa = {p['kappa']:g} ({p['status']})"
+                                                               for p in failed)
+              + "; drawn up to where it stopped", file=sys.stderr)
         return EXIT_FAILURE
     return EXIT_OK
 
@@ -486,40 +1016,92 @@ def cmd_critical_curve(args) -> int:
 # Parser
 # ------------------------------------------------------------------------------------------------
 
+def _settable_help() -> str:
+    return ", ".join(f"{name} ({unit})" for name, (unit, _) in SETTABLE.items())
+
+
 def build_parser() -> argparse.ArgumentParser:
-    parser = _Parser(prog="phaseimpact", description=__doc__.splitlines()[0],
+    parser = _Parser(prog="phaseimpact", description=__doc__.split("\n\n")[0].replace("\n", " "),
                      epilog="SI units throughout. Exit codes: 0 done, 1 numerical failure (reported), "
                             "2 bad input (nothing computed), 130 interrupted.")
     parser.add_argument("--version", action="version", version=f"phaseimpact {__version__}")
     sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
     v_lo, v_hi = V_RANGE
 
+    def case_options(p):
+        p.add_argument("--case", type=_case, default=None, metavar="NAME|FILE.toml",
+                       help="a shipped case (see 'phaseimpact cases') or a TOML case file; its [impact] values "
+                            "are used unless an option overrides them (default: seed)")
+        p.add_argument("--set", type=_setting, action="append", default=None, metavar="NAME=VALUE",
+                       help="change one quantity of the case, SI units; repeatable, later ones win; names: "
+                            f"{_settable_help()} (default: none)")
+
     def law_options(p, *, restitution=True, contact=True):
-        p.add_argument("--law", choices=LAWS, default="paper", help="contact law (default: %(default)s)")
+        p.add_argument("--law", choices=LAWS, default=None,
+                       help="contact law (default: the case's, else paper)")
         if contact:
             p.add_argument("--contact", choices=("printed", "unilateral"), default=None,
                            help="law 'paper' only: read |delta|^alpha as printed (also in tension) or "
-                                "unilaterally (P = 0 for delta <= 0) (default: printed)")
+                                "unilaterally (P = 0 for delta <= 0) (default: the case's, else printed)")
         if restitution:
             lo, hi = RESTITUTION_RANGE
             p.add_argument("--restitution", type=_RESTITUTION, default=None, metavar="E",
                            help=f"coefficient of restitution, {lo:g} <= E <= {hi:g}: required by the restitution "
-                                "laws; replaces --kappa for hunt-crossley (exact inverse) (default: none)")
+                                "laws; replaces --kappa for hunt-crossley (exact inverse) (default: the case's, "
+                                "else none)")
 
     def speed(p):
-        p.add_argument("--v", type=_V, default=1.0, metavar="V",
-                       help=f"impact speed, m/s, {v_lo:g} <= V <= {v_hi:g} (default: %(default)s)")
+        p.add_argument("--v", type=_V, default=None, metavar="V",
+                       help=f"impact speed, m/s, {v_lo:g} <= V <= {v_hi:g} (default: the case's, 1 for seed)")
+
+    def damping(p, read_by="read by paper and hunt-crossley only"):
+        p.add_argument("--kappa", type=_KAPPA, default=None,
+                       help=f"damping coefficient, {KAPPA_UNIT}, 0 <= KAPPA <= {KAPPA_MAX:g}; {read_by} "
+                            "(default: the case's, else 0)")
+
+    def target(p):
+        p.add_argument("--target", choices=TARGETS, default=None,
+                       help="what is hit (default: the case's, else plate)")
 
     def tolerance(p):
         lo, hi = RTOL_RANGE
         p.add_argument("--rtol", type=_RTOL, default=1e-10,
                        help=f"integrator tolerance (relative), {lo:g} <= RTOL <= {hi:g} (default: %(default)s)")
 
-    def kappa_tolerance(p):
+    def kappa_tolerance(p, what="width of kappa_c's final bracket"):
         lo, hi = KAPPA_RTOL_RANGE
         p.add_argument("--kappa-rtol", type=_KAPPA_RTOL, default=1e-10,
-                       help=f"relative width of kappa_c's final bracket, {lo:g} <= KAPPA_RTOL <= {hi:g} "
+                       help=f"relative {what}, {lo:g} <= KAPPA_RTOL <= {hi:g} (default: %(default)s)")
+
+    def horizon(p, what="horizon of every run"):
+        p.add_argument("--t-end", type=_T_END, default=None,
+                       help=f"{what}, s, a finite number > 0 (default: each run until its outcome settles, "
+                            "capped by the case's own time scales)")
+
+    def kappa_range(p, required, default_text=""):
+        kmin = _real("kappa-min", 0.0, KAPPA_MAX, low_open=True, unit=KAPPA_UNIT)
+        kmax = _real("kappa-max", 0.0, KAPPA_MAX, low_open=True, unit=KAPPA_UNIT)
+        p.add_argument("--kappa-min", type=kmin, default=None, required=required,
+                       help=f"lower end of kappa, {KAPPA_UNIT}, 0 < KAPPA_MIN <= {KAPPA_MAX:g}{default_text}")
+        p.add_argument("--kappa-max", type=kmax, default=None, required=required,
+                       help=f"upper end of kappa, {KAPPA_UNIT}, KAPPA_MIN < KAPPA_MAX <= {KAPPA_MAX:g}"
+                            + default_text.replace("1e-8", "1e8"))
+
+    def samples(p, default):
+        lo, hi = SAMPLES_RANGE
+        p.add_argument("--samples", type=_integer("samples", lo, hi), default=default,
+                       help=f"log-spaced kappa values sampled to find where a count changes (a window narrower "
+                            f"than the sampling can be missed), {lo} <= SAMPLES <= {hi} (default: {DEFAULT_SAMPLES})")
+
+    def parallel(p):
+        p.add_argument("--jobs", type=_jobs, default=1,
+                       help=f"parallel workers, 1..{MAX_JOBS}, or -1 for all cores (default: %(default)s)")
+        p.add_argument("--backend", choices=BACKENDS, default="threads",
+                       help="threads of this process, joblib processes (loky) or a Dask cluster "
                             "(default: %(default)s)")
+        p.add_argument("--scheduler", default=None, metavar="ADDRESS",
+                       help="Dask scheduler address, e.g. tcp://host:8786 (only with --backend dask; default: a "
+                            "local in-process cluster)")
 
     def out_options(p, resume):
         p.add_argument("--out", type=_path("out"), required=True, metavar="FILE.h5",
@@ -533,85 +1115,184 @@ def build_parser() -> argparse.ArgumentParser:
                                 "finished points; failed points are recomputed")
         p.add_argument("--no-progress", action="store_true", help="no progress bar on stderr")
 
+    def figure_out(p):
+        p.add_argument("--out", type=_figure_path, required=True, metavar="FIG.png",
+                       help="figure to write, .png, .pdf or .svg (written atomically; an existing file that is "
+                            "not such a figure is refused unless --force)")
+        p.add_argument("--force", action="store_true",
+                       help="replace --out even if it is not a figure (default: refuse)")
+
     def json_option(p):
         p.add_argument("--json", action="store_true", help="print one JSON object (numbers finite or null)")
 
-    p = sub.add_parser("params", help="the seed's derived parameters",
-                       description="The seed's derived parameters (eq. 3-5, steel) at one speed.")
+    settable = "Settable with --set NAME=VALUE (SI units): " + "; ".join(
+        f"{name} ({unit}): {text}" for name, (unit, text) in SETTABLE.items()) + "."
+
+    def add(name, help_, description):
+        return sub.add_parser(name, help=help_, description=description, epilog=settable)
+
+    p = sub.add_parser("cases", help="the shipped cases (name, description, sources)",
+                       description="The named cases shipped with phaseimpact, for --case NAME.")
+    json_option(p)
+    p.set_defaults(func=cmd_cases)
+
+    p = add("params", "a case's derived parameters, Hertz scales and validity",
+            "The derived parameters (seed eq. 3-5) of a case, its Hertz scales (contact time, plate period, "
+            "indentation, peak force, contact radius, peak pressure) and whether elastic Hertz contact holds.")
+    case_options(p)
     speed(p)
-    p.add_argument("--kappa", type=_KAPPA, default=None,
-                   help=f"damping coefficient, N s/m^2.5, 0 <= KAPPA <= {KAPPA_MAX:g} (default: 0)")
+    damping(p, "not read by the scales")
+    target(p)
     json_option(p)
     p.set_defaults(func=cmd_params)
 
-    p = sub.add_parser("simulate", help="one impact: summary quantities, stick points, outcome",
-                       description="One impact from seed eq. 6, integrated exactly (event-driven).")
+    p = add("simulate", "one impact: summary quantities, stick points, outcome",
+            "One impact from seed eq. 6, integrated exactly (event-driven).")
+    case_options(p)
     law_options(p)
     speed(p)
-    p.add_argument("--kappa", type=_KAPPA, default=None,
-                   help=f"damping coefficient, N s/m^2.5, 0 <= KAPPA <= {KAPPA_MAX:g}; read by paper and "
-                        "hunt-crossley only (default: 0)")
-    p.add_argument("--target", choices=TARGETS, default="plate", help="what is hit (default: %(default)s)")
-    p.add_argument("--t-end", type=_T_END, default=None,
-                   help="horizon, s, a finite number > 0 (default: run until the outcome settles, capped by "
-                        "the case's own time scales)")
+    damping(p)
+    target(p)
+    horizon(p, "horizon")
     tolerance(p)
     json_option(p)
     p.set_defaults(func=cmd_simulate)
 
-    p = sub.add_parser("critical", help="the critical damping kappa_c at one speed (law paper)",
-                       description="The critical damping kappa_c of eq. 8 (law paper) at one speed: where the "
-                                   "first stick stops being permanent.")
+    p = add("critical", "the critical damping kappa_c and kappa_2 at one speed (law paper)",
+            "The critical damping kappa_c of eq. 8 (law paper): where the first stick stops being permanent "
+            "(an adding-sliding bifurcation), and kappa_2, from which the run makes exactly two stick phases.")
+    case_options(p)
     law_options(p, restitution=False)
     speed(p)
+    target(p)
     kappa_tolerance(p)
     tolerance(p)
-    p.add_argument("--kappa-min", type=_real("kappa-min", 0.0, KAPPA_MAX, low_open=True, unit="N s/m^2.5"),
-                   default=None, help="lower end of the search, N s/m^2.5 (default: 1e-8 K/v)")
-    p.add_argument("--kappa-max", type=_real("kappa-max", 0.0, KAPPA_MAX, low_open=True, unit="N s/m^2.5"),
-                   default=None, help="upper end of the search, N s/m^2.5 (default: 1e8 K/v)")
+    kappa_range(p, False, " (default: 1e-8 K/v)")
+    p.add_argument("--exponents", action="store_true",
+                   help="also measure the adding-sliding exponents (slip speed ~ eps^1.5, stick offset ~ eps^2; "
+                        "about 15 s)")
     json_option(p)
     p.set_defaults(func=cmd_critical)
 
-    p = sub.add_parser("sweep", help="a kappa sweep archived to HDF5",
-                       description="Every kappa of a log grid, each run until its outcome settles (or to "
-                                   "--t-end), archived to HDF5 and checkpointed after every chunk.")
+    p = add("transitions", "every change of the long-time count in a kappa range",
+            "Every kappa in [KAPPA_MIN, KAPPA_MAX] where the long-time count changes, in order: the adding-sliding "
+            "at kappa_c and the end of the staircase at kappa_2 for paper (counts: stick phases), grazing values "
+            "for unilateral laws (counts: contacts before the projectile is out of reach).")
+    case_options(p)
+    law_options(p, restitution=False)
+    speed(p)
+    target(p)
+    kappa_range(p, True)
+    samples(p, DEFAULT_SAMPLES)
+    kappa_tolerance(p, "width of each transition's final bracket")
+    tolerance(p)
+    json_option(p)
+    p.set_defaults(func=cmd_transitions)
+
+    p = add("sweep", "a kappa sweep archived to HDF5",
+            "Every kappa of a log grid, each run until its outcome settles (or to --t-end), archived to HDF5 and "
+            "checkpointed after every chunk.")
+    case_options(p)
     law_options(p)
     speed(p)
-    p.add_argument("--kappa-min", type=_real("kappa-min", 0.0, KAPPA_MAX, low_open=True, unit="N s/m^2.5"),
-                   required=True, help=f"first kappa, N s/m^2.5, 0 < KAPPA_MIN <= {KAPPA_MAX:g}")
-    p.add_argument("--kappa-max", type=_real("kappa-max", 0.0, KAPPA_MAX, low_open=True, unit="N s/m^2.5"),
-                   required=True, help=f"last kappa, N s/m^2.5, KAPPA_MIN < KAPPA_MAX <= {KAPPA_MAX:g}")
+    target(p)
+    kappa_range(p, True)
     p.add_argument("--num", type=_integer("num", 2, MAX_SWEEP_POINTS), default=50,
                    help=f"number of kappa values (log spaced), 2 <= NUM <= {MAX_SWEEP_POINTS} (default: %(default)s)")
-    p.add_argument("--t-end", type=_T_END, default=None,
-                   help="horizon of every run, s (default: each run until its outcome settles, capped)")
+    horizon(p)
     tolerance(p)
-    p.add_argument("--jobs", type=_jobs, default=1,
-                   help=f"parallel workers, 1..{MAX_JOBS}, or -1 for all cores (default: %(default)s)")
-    p.add_argument("--backend", choices=BACKENDS, default="threads",
-                   help="threads of this process, joblib processes (loky) or a Dask cluster (default: %(default)s)")
-    p.add_argument("--scheduler", default=None, metavar="ADDRESS",
-                   help="Dask scheduler address, e.g. tcp://host:8786 (only with --backend dask; default: a "
-                        "local in-process cluster)")
+    parallel(p)
     out_options(p, resume=True)
     json_option(p)
     p.set_defaults(func=cmd_sweep)
 
-    p = sub.add_parser("critical-curve", help="kappa_c against the impact speed, archived to HDF5",
-                       description="kappa_c(v) of law paper over log-spaced speeds, by continuation.")
+    p = add("atlas", "outcomes over a grid of any parameters, archived to HDF5",
+            "Every point of a grid over named parameters (kappa, v, M1, ..., and every settable quantity of the "
+            "case), each run until its outcome settles (or to --t-end): outcome class, stick phases, contacts, "
+            "T_run, max force... Archived to HDF5 and checkpointed after every chunk.")
+    case_options(p)
+    law_options(p)
+    speed(p)
+    damping(p)
+    target(p)
+    p.add_argument("--axis", type=_axis, action="append", required=True, metavar="NAME=START:STOP:NUM[:log]",
+                   help="one axis of the grid (repeat for each): NAME=START:STOP:NUM (linear), with :log for log "
+                        "spacing, or NAME=V1,V2,...; names: kappa, v, M1, M2, K, Kb, Km, alpha and the --set names; "
+                        f"at most {MAX_SWEEP_POINTS} points in all; an axis the law does not read is refused")
+    horizon(p)
+    tolerance(p)
+    parallel(p)
+    out_options(p, resume=True)
+    json_option(p)
+    p.set_defaults(func=cmd_atlas)
+
+    p = add("critical-curve", "kappa_c, kappa_2 or a grazing value against a parameter, archived to HDF5",
+            "A transition continued over a second parameter (v, a material or a geometry quantity): kappa_c or "
+            "kappa_2 of law paper, or a grazing value of a unilateral law; each point predicted from the previous "
+            "ones and corrected, with step control.")
+    case_options(p)
     law_options(p, restitution=False)
-    p.add_argument("--v-min", type=_real("v-min", *V_RANGE, unit="m/s"), required=True,
-                   help=f"lowest speed, m/s, {v_lo:g} <= V_MIN <= {v_hi:g}")
-    p.add_argument("--v-max", type=_real("v-max", *V_RANGE, unit="m/s"), required=True,
-                   help=f"highest speed, m/s, V_MIN < V_MAX <= {v_hi:g}")
+    speed(p)
+    target(p)
+    curve_params = ", ".join([*CURVE_PARAMETERS, *(n for n in SETTABLE if n not in CURVE_PARAMETERS
+                                                   and n != "plate.yield_strength")])
+    p.add_argument("--param", default=None, metavar="NAME",
+                   help=f"the parameter the curve runs over: {curve_params} (default: none; --v-min/--v-max "
+                        "imply v)")
+    p.add_argument("--from", dest="from_", type=_real("from"), default=None, metavar="A",
+                   help="first value of --param, in its SI unit (default: none)")
+    p.add_argument("--to", type=_real("to"), default=None, metavar="B",
+                   help="last value of --param, in its SI unit, B > A (default: none)")
+    p.add_argument("--log", action="store_true", help="log-spaced values (default: linear spacing)")
+    p.add_argument("--v-min", type=_real("v-min", *V_RANGE, unit="m/s"), default=None,
+                   help=f"short for --param v --from V_MIN --log, m/s, {v_lo:g} <= V_MIN <= {v_hi:g} (default: none)")
+    p.add_argument("--v-max", type=_real("v-max", *V_RANGE, unit="m/s"), default=None,
+                   help=f"short for --to V_MAX with --v-min, m/s, V_MIN < V_MAX <= {v_hi:g} (default: none)")
     p.add_argument("--num", type=_integer("num", 1, MAX_CURVE_POINTS), default=5,
-                   help=f"number of speeds (log spaced), 1 <= NUM <= {MAX_CURVE_POINTS} (default: %(default)s)")
-    kappa_tolerance(p)
+                   help=f"number of values, 1 <= NUM <= {MAX_CURVE_POINTS} (default: %(default)s)")
+    p.add_argument("--what", choices=CURVE_WHATS, default="kappa_c",
+                   help="what is continued: kappa_c or kappa_2 (law paper), or grazing (a unilateral law: the first "
+                        "grazing value in [KAPPA_MIN, KAPPA_MAX] at the first value) (default: %(default)s)")
+    kappa_range(p, False, " (--what grazing only; default: none)")
+    samples(p, None)
+    kappa_tolerance(p, "width of kappa_c's (kappa_2's, the grazing value's) final bracket at each point")
     tolerance(p)
     out_options(p, resume=False)
     json_option(p)
     p.set_defaults(func=cmd_critical_curve)
+
+    p = sub.add_parser("plot", help="draw an archive: an atlas, a sweep or a curve",
+                       description="Draw an archive: an atlas (two axes: outcome classes as a colour map, log axes "
+                                   "where the axis is log), a sweep (one axis: counts and max force), or a critical "
+                                   "curve (kappa against the parameter, the closed form dashed).")
+    p.add_argument("archive", metavar="FILE.h5", help="archive written by sweep, atlas or critical-curve")
+    figure_out(p)
+    p.add_argument("--contours", choices=("none", "n_stick", "n_contacts"), default="none",
+                   help="atlas only: overlay the level lines of this count (default: %(default)s)")
+    p.add_argument("--curve", action="append", default=None, metavar="CURVE.h5",
+                   help="atlas only: overlay a critical curve over the atlas's second axis; repeatable "
+                        "(default: none)")
+    json_option(p)
+    p.set_defaults(func=cmd_plot)
+
+    p = add("portrait", "phase portraits, one panel per kappa, events marked",
+            "Phase portraits: one panel per kappa, the trajectory in a phase plane with its events marked "
+            "(contacts, separations, slips, stick phases; permanent sticks as asymptotic points) and its outcome "
+            "in the panel's title.")
+    case_options(p)
+    law_options(p, restitution=False)
+    speed(p)
+    target(p)
+    p.add_argument("--kappa", dest="kappas", type=_kappa_list, required=True, metavar="K1,K2,...",
+                   help=f"damping coefficients, {KAPPA_UNIT}, 1 to {MAX_PANELS} values in [0, {KAPPA_MAX:g}], "
+                        "one panel each")
+    p.add_argument("--plane", choices=PLANES, default=PLANES[0],
+                   help="phase plane: relative motion, projectile or target (default: %(default)s)")
+    horizon(p)
+    tolerance(p)
+    figure_out(p)
+    json_option(p)
+    p.set_defaults(func=cmd_portrait)
     return parser
 
 
@@ -628,6 +1309,12 @@ def main(argv=None) -> int:
     except KeyboardInterrupt:
         print("phaseimpact: interrupted", file=sys.stderr)
         return EXIT_INTERRUPTED
+    except BrokenPipeError:  # the reader of stdout went away (| head): nothing more to say
+        try:
+            os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        except (OSError, ValueError, AttributeError):
+            pass
+        return EXIT_FAILURE
     except OSError as error:  # the disk, not the input: full, gone, permissions changed under us
         print(f"phaseimpact: error: {error}", file=sys.stderr)
         return EXIT_FAILURE
