@@ -154,6 +154,68 @@ def _locate(code, c, mode, energy_limit, column, F, y0, t0, h, t1, g_start, g_en
     return _brent(code, c, mode, energy_limit, column, F, y0, t0, h, a, b, ga, gb, ys, fs, gs)
 
 
+_ADV_END, _ADV_STEP, _ADV_COLLAPSE, _ADV_LIMIT = range(4)
+
+
+@numba.njit(cache=True)
+def _advance(code, c, mode, t, t_end, y, f, force, h_abs, rtol, atol, max_step, energy_limit, next_sample,
+             steps_left, g_old, g_new, fired, K, y_new, f_new, tmp, stats):
+    """Take DOP853 steps from ``(t, y)`` while nothing happens: no event crosses and no sample
+    falls inside. Accepted steps update ``y, f, g_old`` and the running extremes ``stats``.
+
+    Returns ``(result, t, h, h_abs, h_next, force, force_new, steps, evaluations)``: ``_ADV_STEP``
+    leaves the last step (``h``, ``y_new``, ``f_new``, ``g_new``, ``fired``) for the caller to look
+    at; ``_ADV_END`` means ``t_end`` was reached. The hot loop is kept small on purpose: the
+    compiler optimises it as a whole.
+    """
+    steps = 0
+    evaluations = 0
+    h = 0.0
+    h_next = h_abs
+    force_new = force
+    while t < t_end:
+        if steps >= steps_left:
+            return _ADV_LIMIT, t, h, h_abs, h_next, force, force_new, steps, evaluations
+        h_abs = min(h_abs, max_step)
+        rejected = False
+        while True:
+            if h_abs < 10.0 * (np.nextafter(t, np.inf) - t):
+                return _ADV_COLLAPSE, t, h, h_abs, h_next, force, force_new, steps, evaluations
+            t_new = min(t + h_abs, t_end)
+            h = t_new - t
+            force_new = dop853.step(code, c, mode, y, f, h, K, y_new, f_new, tmp)
+            evaluations += 12
+            err = dop853.error_norm(K, h, y, y_new, rtol, atol)
+            if err < 1.0:
+                factor = dop853.MAX_FACTOR if err == 0 else min(dop853.MAX_FACTOR,
+                                                               dop853.SAFETY * err**dop853.ERROR_EXPONENT)
+                if rejected:
+                    factor = min(1.0, factor)
+                h_next = h * factor
+                break
+            h_abs = h * max(dop853.MIN_FACTOR, dop853.SAFETY * err**dop853.ERROR_EXPONENT)
+            rejected = True
+        steps += 1
+        event_values(code, c, y_new, f_new, force_new, mode, energy_limit, g_new)
+        any_fired = False
+        for col in range(N_EVENTS):
+            fired[col] = crossed(col, g_old, g_new)
+            any_fired = any_fired or fired[col]
+        if any_fired or t + h >= next_sample:
+            return _ADV_STEP, t, h, h_abs, h_next, force, force_new, steps, evaluations
+        t = t + h
+        for j in range(5):
+            y[j] = y_new[j]
+            f[j] = f_new[j]
+        for col in range(N_EVENTS):
+            g_old[col] = g_new[col]
+        force = force_new
+        h_abs = h_next
+        stats[0] = max(stats[0], force)
+        stats[1] = max(stats[1], y[X1] - y[X2])
+    return _ADV_END, t, h, h_abs, h_next, force, force_new, steps, evaluations
+
+
 @numba.njit(cache=True)
 def run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count, save_kind, times,
         max_steps, max_events, rk4_step, rk4_every):
@@ -304,45 +366,32 @@ def run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count,
     h_abs = dop853.initial_step(code, c, mode, y, f, rtol, atol, t_end, max_step, tmp, f_new)
     nfev += 1
 
+    stats = np.empty(2)
     while t < t_end:
         if nsteps >= max_steps or n_ev >= max_events:
             status, reason = TOO_MANY_STEPS, FAILED_STOP
             break
-        h_abs = min(h_abs, max_step)
-        rejected = False
-        h = 0.0
-        h_next = 0.0
-        force_new = 0.0
-        while True:
-            min_step = 10.0 * (np.nextafter(t, np.inf) - t)
-            if h_abs < min_step:
-                status, reason = STEP_SIZE_COLLAPSE, FAILED_STOP
-                break
-            h = h_abs
-            t_new = t + h
-            if t_new > t_end:
-                t_new = t_end
-            h = t_new - t
-            force_new = dop853.step(code, c, mode, y, f, h, K, y_new, f_new, tmp)
-            nfev += 12
-            err = dop853.error_norm(K, h, y, y_new, rtol, atol)
-            if err < 1.0:
-                factor = dop853.MAX_FACTOR if err == 0 else min(dop853.MAX_FACTOR,
-                                                               dop853.SAFETY * err**dop853.ERROR_EXPONENT)
-                if rejected:
-                    factor = min(1.0, factor)
-                h_next = h * factor
-                break
-            h_abs = h * max(dop853.MIN_FACTOR, dop853.SAFETY * err**dop853.ERROR_EXPONENT)
-            rejected = True
-        if status != SUCCESS:
+        next_sample = t if save_kind == SAVE_STEPS else (
+            times[i_time] if save_kind == SAVE_TIMES and i_time < times.shape[0] else math.inf)
+        stats[0], stats[1] = max_force, max_indentation
+        result, t, h, h_abs, h_next, force, force_new, d_steps, d_fev = _advance(
+            code, c, mode, t, t_end, y, f, force, h_abs, rtol, atol, max_step, energy_limit, next_sample,
+            max_steps - nsteps, g_old, g_new, fired, K, y_new, f_new, tmp, stats)
+        max_force, max_indentation = stats[0], stats[1]
+        nsteps += d_steps
+        nfev += d_fev
+        if result == _ADV_END:
             break
-        nsteps += 1
+        if result == _ADV_COLLAPSE:
+            status, reason = STEP_SIZE_COLLAPSE, FAILED_STOP
+            break
+        if result == _ADV_LIMIT:
+            status, reason = TOO_MANY_STEPS, FAILED_STOP
+            break
+        # a step to look at (an event fired in it, or a sample falls in it); not accepted yet
         t_new = t + h
-        event_values(code, c, y_new, f_new, force_new, mode, energy_limit, g_new)
         any_fired = False
         for col in range(N_EVENTS):
-            fired[col] = crossed(col, g_old, g_new)
             any_fired = any_fired or fired[col]
         have_dense = False
         stop_record = -1.0

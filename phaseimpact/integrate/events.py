@@ -50,8 +50,6 @@ from ..model.rhs import (
 
 DELTA, DELTADOT, FORCE_RATE, STICK_BREAK, ENERGY, REACH = range(6)
 N_EVENTS = 6
-#: +1 fires on an increase through zero, -1 on a decrease, 0 on both.
-DIRECTIONS = np.array([0, 0, -1, -1, -1, 1], dtype=np.int64)
 
 # Event kinds in the log.
 CONTACT, SEPARATION, REVERSAL, STICK, SLIP, FORCE_PEAK, SETTLED, RUNAWAY = range(8)
@@ -101,17 +99,24 @@ def event_values(code, c, y, f, force, mode, energy_limit, g):
 
 
 @numba.njit(cache=True)
+def direction(column):
+    """+1: the event fires on an increase through zero, -1: on a decrease, 0: on both (the table above).
+    A branch, not a lookup in a global array: that costs an array per call in the hot loop."""
+    if column == DELTA or column == DELTADOT:
+        return 0
+    if column == REACH:
+        return 1
+    return -1
+
+
+@numba.njit(cache=True)
 def crossed(column, g_old, g_new):
     """Whether event ``column`` fires between two evaluations (strict start: a restart at a zero
     is quiet)."""
-    up = g_old[column] < 0 and g_new[column] >= 0
-    down = g_old[column] > 0 and g_new[column] <= 0
-    d = DIRECTIONS[column]
-    if d > 0:
-        return up
-    if d < 0:
-        return down
-    return up or down
+    d = direction(column)
+    if d >= 0 and g_old[column] < 0 and g_new[column] >= 0:
+        return True
+    return d <= 0 and g_old[column] > 0 and g_new[column] <= 0
 
 
 @numba.njit(cache=True)
