@@ -629,21 +629,23 @@ def _run_grid(args, setup: Setup, axes: list):
         _check_scheduler(args.scheduler)
     named = {axis.name: axis.values for axis in axes}
     size = int(np.prod([len(axis.values) for axis in axes]))
+    grid_kinds = [k for k in archive.KINDS if k != "critical-curve"]  # "sweep" (and "atlas": several axes)
+    kind = "atlas" if len(axes) > 1 and "atlas" in grid_kinds else "sweep"
     with exclusive(out, "out"):
         previous = None
         if os.path.exists(out) and args.resume:
             held = archive.describe(out)
-            if held["kind"] != "sweep":
+            if held["kind"] not in grid_kinds:
                 raise ValueError(f"out = {out!r} is a {held['kind']} archive, not a sweep or atlas: --resume cannot "
                                  "complete it (choose another --out, or drop --resume and add --force)")
-            differences = archive.same_work(held, "sweep", setup.law, setup.params, named, args.t_end, args.rtol)
+            differences = archive.same_work(held, kind, setup.law, setup.params, named, args.t_end, args.rtol)
             if differences:
                 raise ValueError(f"resume: out = {out!r} holds other work ({'; '.join(differences)}); "
                                  "give the options it was computed with, or drop --resume")
             previous = archive.load(out)
             _note(f"resuming {out}: {int(np.count_nonzero(previous.done))} of {size} points done")
         elif os.path.exists(out):
-            archive.check_overwrite(out, "sweep", setup.law, setup.params, named, args.t_end, args.rtol,
+            archive.check_overwrite(out, kind, setup.law, setup.params, named, args.t_end, args.rtol,
                                     force=args.force)
 
         def checkpoint(result):
