@@ -111,13 +111,15 @@ KAPPA_C = 1.4994185342868816e12  # v = 1 m/s, printed reading (checked in test_t
 def test_near_kappa_c_engine_and_oracle_agree(contact):
     """N and T_run just above kappa_c from two engines (REFERENCE §5's ratchet and escape)."""
     law = ContactLaw("paper", contact=contact)
-    for eps, n_expected in ((1e-4, 42), (2e-4, 6)):
+    for eps, n_expected in ((3e-5, 510), (1e-4, 42), (2e-4, 6)):
         p = SEED.replace(kappa=KAPPA_C * (1 + eps))
         tr = simulate(p, law, rtol=1e-12)
         ref = oracle(p, law, rtol=1e-12)
         assert tr.n_stick == ref.kinds.count("stick") == n_expected
         t_sep = ref.of("separation")[0][0]
-        assert tr.t_run == pytest.approx(t_sep, rel=1e-8)
+        # T_run is ill-conditioned near kappa_c (relative sensitivity ~ 1/eps to the damping): two
+        # integrators at rtol 1e-12 agree to about 1e-12/eps
+        assert tr.t_run == pytest.approx(t_sep, rel=max(1e-8, 3e-11 / eps))
         assert tr.outcome == "ratchet-escape"
         assert tr.stop_reason == ("runaway" if contact == "printed" else "settled")
 

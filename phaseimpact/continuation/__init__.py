@@ -3,6 +3,7 @@ long-time behaviour (:mod:`.transition`: ``kappa_c``, ``kappa_2``, grazing) and 
 two-parameter continuation (:mod:`.curve`). Only :mod:`._parallel` knows about joblib/Dask."""
 
 from ._parallel import BACKENDS
+from .boundary import Boundaries, refine_boundaries
 from .curve import CURVE_QUANTITIES, CriticalCurve, critical_curve
 from .grid import Axis, Grid, parse_axis
 from .sweep import SweepResult, atlas, sweep
@@ -21,7 +22,7 @@ from .transition import (
 )
 
 __all__ = [
-    "BACKENDS", "CURVE_QUANTITIES", "Axis", "CriticalCurve", "CriticalDamping", "Grid", "SweepResult",
+    "BACKENDS", "CURVE_QUANTITIES", "Axis", "Boundaries", "refine_boundaries", "CriticalCurve", "CriticalDamping", "Grid", "SweepResult",
     "Transition", "adding_sliding_exponents", "atlas", "closed_form_kappa_c", "critical_curve",
     "critical_damping", "first_stick_margin", "delta_extremum", "grazing_transitions", "locate_kappa_2",
     "parse_axis", "stick_count", "sweep", "transitions",

@@ -8,6 +8,7 @@ its chunk and thread, so results are bit-identical whatever the backend and job 
 
 from __future__ import annotations
 
+import asyncio
 import contextlib
 import os
 
@@ -15,12 +16,12 @@ import numpy as np
 
 from ..integrate.api import run_batch
 
-__all__ = ["BACKENDS", "run_chunks", "check_jobs", "connect"]
+__all__ = ["BACKENDS", "run_chunks", "check_jobs", "check_scheduler", "connect"]
 
 BACKENDS = ("threads", "loky", "dask")
 MAX_JOBS = 4 * (os.cpu_count() or 1)
 #: Scheduler connection timeout, s.
-CONNECT_TIMEOUT = 8
+CONNECT_TIMEOUT = 5
 
 
 def check_jobs(n_jobs, backend: str, scheduler) -> int:
@@ -35,19 +36,41 @@ def check_jobs(n_jobs, backend: str, scheduler) -> int:
     return (os.cpu_count() or 1) if n_jobs == -1 else int(n_jobs)
 
 
+def check_scheduler(address: str) -> None:
+    """Refuse an address where no Dask scheduler answers, within :data:`CONNECT_TIMEOUT` s
+    (before any work: a ``Client`` on a dead address would wait, then fail in its clean-up)."""
+    try:
+        from distributed.core import rpc
+    except ImportError:  # pragma: no cover - depends on the install
+        raise ValueError("backend = 'dask' needs dask.distributed: pip install 'phaseimpact[dask]'") from None
+
+    async def identity():
+        remote = rpc(address, timeout=CONNECT_TIMEOUT)
+        try:
+            return await asyncio.wait_for(remote.identity(), CONNECT_TIMEOUT)
+        finally:
+            await remote.close_rpc()
+
+    try:
+        answer = asyncio.run(identity())
+    except Exception as error:  # any failure to talk to it means: not a usable scheduler
+        reason = str(error) or f"no answer within {CONNECT_TIMEOUT:g} s"
+        raise ValueError(f"scheduler = {address!r} is out of reach ({type(error).__name__}: {reason}); "
+                         "allowed: the address of a running Dask scheduler, e.g. tcp://host:8786") from None
+    if not (isinstance(answer, dict) and answer.get("type") == "Scheduler"):
+        raise ValueError(f"scheduler = {address!r} is out of range: it answers, but is not a Dask scheduler")
+
+
 def connect(scheduler: str | None, n_jobs: int):
-    """A ``dask.distributed`` client (local cluster without an address); clear error if unreachable."""
+    """A ``dask.distributed`` client (an in-process local cluster without an address)."""
     try:
         from dask.distributed import Client
     except ImportError as error:  # pragma: no cover - depends on the install
         raise ValueError("backend = 'dask' needs dask.distributed: pip install 'phaseimpact[dask]'") from error
     if scheduler is None:
         return Client(processes=False, n_workers=1, threads_per_worker=n_jobs, dashboard_address=None)
-    try:
-        return Client(scheduler, timeout=CONNECT_TIMEOUT)
-    except (OSError, TimeoutError) as error:
-        raise ValueError(f"scheduler = {scheduler!r} is out of reach ({type(error).__name__}: {error}); "
-                         "allowed: the address of a running dask scheduler, e.g. tcp://host:8786") from None
+    check_scheduler(scheduler)
+    return Client(scheduler, timeout=CONNECT_TIMEOUT)
 
 
 def _run_chunk(batch, rtol, settle, stop_on, threads):

@@ -28,7 +28,7 @@ from ..parameters import Parameters
 __all__ = [
     "closed_form_kappa_c", "first_stick_margin", "critical_damping", "CriticalDamping", "locate_kappa_2",
     "stick_count", "adding_sliding_exponents", "delta_extremum", "extrema", "grazing_transitions", "transitions",
-    "Transition", "check_kappa_range",
+    "Transition", "check_kappa_range", "RunFailed",
 ]
 
 _REVERSAL = EVENT_KINDS.index("reversal")
@@ -81,9 +81,18 @@ def closed_form_kappa_c(params: Parameters) -> float | None:
     return math.exp(brentq(gap, lo, hi, xtol=1e-14, rtol=1e-14)) * K / v
 
 
+class RunFailed(RuntimeError):
+    """A run needed by a search ended in a numerical failure (its status and message)."""
+
+
 def first_stick_margin(params: Parameters, law: ContactLaw | str = "paper", *, rtol: float = 1e-10) -> float:
-    """Margin of the first stick (``>= 0``: it never breaks); -inf if the run never sticks."""
+    """Margin of the first stick (``>= 0``: it never breaks); -inf if the run never sticks.
+
+    Raises :class:`RunFailed` if the run fails numerically (a search must not take that as a value).
+    """
     trajectory = simulate(params, law, None, rtol=rtol, stop_on="stick")
+    if not trajectory.ok:
+        raise RunFailed(f"kappa = {params.kappa:.6g}: {trajectory.status}: {trajectory.message}")
     margin = trajectory.first_stick_margin
     return -math.inf if margin is None else margin
 
@@ -113,7 +122,8 @@ class CriticalDamping:
         ``{"kappa", "n_stick", "t_run", "cut"}`` sampled between ``kappa_c`` and ``kappa_2``.
     classification : str or None
         ``adding-sliding`` with :attr:`exponents` when measured.
-    status : {"success", "not-found", "unconfirmed"}
+    status : {"success", "not-found", "unconfirmed", "failed"}
+        ``failed``: a run of the search failed numerically (the message says which).
     """
 
     law: str
@@ -156,6 +166,16 @@ def critical_damping(params: Parameters, law: ContactLaw | str = "paper", *, kap
     lo_default, hi_default = _default_range(params)
     kappa_min, kappa_max = check_kappa_range(kappa_min or lo_default, kappa_max or hi_default)
     closed = closed_form_kappa_c(params)
+    try:
+        return _critical_damping(params, law, kappa_min, kappa_max, rtol, integrator_rtol, with_kappa_2,
+                                 with_exponents, closed)
+    except RunFailed as error:
+        return CriticalDamping(law.name, law.contact, params.v, None, rtol, closed, (kappa_min, kappa_max),
+                               (math.nan, math.nan), "failed", f"a run of the search failed: {error}", 0)
+
+
+def _critical_damping(params, law, kappa_min, kappa_max, rtol, integrator_rtol, with_kappa_2, with_exponents,
+                      closed) -> CriticalDamping:
     evaluations = 0
 
     def margin(log_kappa):
@@ -255,7 +275,7 @@ def locate_kappa_2(params: Parameters, law: ContactLaw | str, kappa_c: float, *,
 
 
 def adding_sliding_exponents(params: Parameters, law: ContactLaw | str, kappa_c: float, *,
-                             eps=(1e-6, 3e-6, 1e-5, 3e-5, 1e-4, 3e-4), integrator_rtol: float = 1e-12) -> dict:
+                             eps=(1e-7, 3e-7, 1e-6, 3e-6, 1e-5), integrator_rtol: float = 1e-12) -> dict:
     """Local exponents of the adding-sliding at ``kappa_c``: the first slip's largest speed
     ``~ eps^(3/2)`` and the offset between the first two stick depths ``~ eps^2``
     (``eps = kappa/kappa_c - 1``), fitted on log-log over ``eps``."""

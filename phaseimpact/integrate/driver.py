@@ -158,6 +158,20 @@ _ADV_END, _ADV_STEP, _ADV_COLLAPSE, _ADV_LIMIT = range(4)
 
 
 @numba.njit(cache=True)
+def _quiet_start(quiet, y, mode, g):
+    """Event values at a restart: the event the run restarts on, and ``delta`` or ``deltadot``
+    when exactly zero, leave zero with a known sign (that of ``deltadot``, of the slip's mode) and
+    start as that sign times a tiny number, so that a return within the first step is a crossing
+    (a brief slip after a stick break). Any other event exactly at zero has no known side and
+    cannot fire in the first step (a force extremum at a separation is not a peak)."""
+    for col in (DELTA, DELTADOT):
+        if col == quiet or g[col] == 0:
+            g[col] = departure_sign(col, y, mode) * _TINY
+    if quiet != DELTA and quiet != DELTADOT:
+        g[quiet] = departure_sign(quiet, y, mode) * _TINY
+
+
+@numba.njit(cache=True)
 def _advance(code, c, mode, t, t_end, y, f, force, h_abs, rtol, atol, max_step, energy_limit, next_sample,
              steps_left, g_old, g_new, fired, K, y_new, f_new, tmp, stats):
     """Take DOP853 steps from ``(t, y)`` while nothing happens: no event crosses and no sample
@@ -360,9 +374,7 @@ def run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count,
     # ---- adaptive DOP853 with events ----
     quiet = DELTA
     event_values(code, c, y, f, force, mode, energy_limit, g_old)
-    # the event the run starts on leaves its zero with a known sign; another event exactly at zero
-    # (0 is neither side) cannot fire in the first step
-    g_old[quiet] = departure_sign(quiet, y, mode) * _TINY
+    _quiet_start(quiet, y, mode, g_old)
     h_abs = dop853.initial_step(code, c, mode, y, f, rtol, atol, t_end, max_step, tmp, f_new)
     nfev += 1
 
@@ -525,7 +537,7 @@ def run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count,
                 break
             quiet = restart_col
             event_values(code, c, y, f, force, mode, energy_limit, g_old)
-            g_old[quiet] = departure_sign(quiet, y, mode) * _TINY
+            _quiet_start(quiet, y, mode, g_old)
             h_abs = max(h_next, h_r)
             continue
         # the whole step stands

@@ -1,0 +1,102 @@
+"""Class boundaries of an atlas, refined along one axis (issue: atlases).
+
+Where two neighbouring grid points along ``axis`` end in different outcome classes, the
+boundary between them is located by bisection on the class (in log space on a log axis) to a
+stated relative tolerance, all other coordinates held. For ``paper``'s edge between a
+permanent stick and the rest, the class is read from the sign of the first stick's margin, a
+smooth function whose root is ``kappa_c`` (REFERENCE §5): no run needs to reach the (near
+``kappa_c`` unbounded) escape time.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..integrate import driver as drv
+from ..integrate import simulate
+from .sweep import SweepResult
+from .transition import first_stick_margin
+
+__all__ = ["Boundaries", "refine_boundaries"]
+
+
+@dataclass(frozen=True)
+class Boundaries:
+    """Refined boundary points of an atlas.
+
+    Attributes
+    ----------
+    axis : str
+        The axis along which each boundary was refined.
+    points : ndarray, shape (n, ndim)
+        Coordinates of each boundary point (the grid's axes, in order).
+    below, above : ndarray of int8, shape (n,)
+        Outcome class codes on the low and high side along ``axis``.
+    rtol : float
+        Relative width of each refined bracket.
+    """
+
+    axis: str
+    points: np.ndarray
+    below: np.ndarray
+    above: np.ndarray
+    rtol: float
+
+    def __len__(self) -> int:
+        return len(self.below)
+
+
+def refine_boundaries(result: SweepResult, axis: str = "kappa", *, rtol: float = 1e-8,
+                      integrator_rtol: float | None = None) -> Boundaries:
+    """Locate every class change along ``axis`` between neighbouring points of ``result``."""
+    grid = result.grid
+    names = grid.names
+    if axis not in names:
+        raise ValueError(f"axis = {axis!r} is out of range; allowed: one of {', '.join(names)}")
+    if not (isinstance(rtol, float | int) and 1e-14 <= rtol <= 0.1):
+        raise ValueError(f"rtol = {rtol!r} is out of range; allowed: 1e-14 <= rtol <= 0.1")
+    integrator_rtol = integrator_rtol or result.settings.get("rtol", 1e-10)
+    k = names.index(axis)
+    values = grid.axes[k].values
+    log = grid.axes[k].log and np.all(values > 0)
+    outcome = result.outcome.reshape(grid.shape)
+    law = grid.law
+    stuck = drv.PERMANENT_STICK
+
+    def classify(point: dict) -> int:
+        params = grid.parameters_at(point)
+        if law.is_filippov and stuck in pair:
+            return stuck if first_stick_margin(params, law, rtol=integrator_rtol) >= 0 else -2
+        tr = simulate(params, law, result.t_end, rtol=integrator_rtol)
+        return drv.OUTCOMES.index(tr.outcome) if tr.ok else drv.FAILED
+
+    points, below, above = [], [], []
+    moved = np.moveaxis(outcome, k, -1)
+    for index in np.ndindex(*moved.shape[:-1]):
+        line = moved[index]
+        for i in range(len(line) - 1):
+            a, b = int(line[i]), int(line[i + 1])
+            if a == b or a < 0 or b < 0 or drv.FAILED in (a, b):
+                continue
+            pair = (a, b)
+            others = {grid.axes[j].name: grid.axes[j].values[index[j - (j > k)]] for j in range(len(names)) if j != k}
+            lo, hi = values[i], values[i + 1]
+            side_lo = classify({**others, axis: lo})
+            while abs(hi - lo) > rtol * max(abs(lo), abs(hi)):
+                mid = math.sqrt(lo * hi) if log else 0.5 * (lo + hi)
+                if mid in (lo, hi):
+                    break
+                if classify({**others, axis: mid}) == side_lo:
+                    lo = mid
+                else:
+                    hi = mid
+            where = math.sqrt(lo * hi) if log else 0.5 * (lo + hi)
+            coordinates = [others[n] if n != axis else where for n in names]
+            points.append(coordinates)
+            below.append(a)
+            above.append(b)
+    return Boundaries(axis, np.asarray(points, dtype=float).reshape(-1, len(names)),
+                      np.asarray(below, dtype=np.int8), np.asarray(above, dtype=np.int8), float(rtol))
