@@ -111,8 +111,9 @@ def oracle(params, law, t_end=None, *, rtol=1e-12, method="DOP853", settle=True,
                 natural = -1 if start > 0 else 1
             ev.direction = natural
             events.append(ev)
-        sol = solve_ivp(fun, (t, horizon), y, method=method, rtol=rtol, atol=atol, events=events,
-                        dense_output=False)
+        with np.errstate(over="ignore", invalid="ignore"):  # trial steps of a runaway overflow
+            sol = solve_ivp(fun, (t, horizon), y, method=method, rtol=rtol, atol=atol, events=events,
+                            dense_output=False)
         nfev += sol.nfev
         # recorded (non-terminal) events, then the terminal one
         terminal = None

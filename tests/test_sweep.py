@@ -1,0 +1,101 @@
+"""Sweeps and atlases: the same numbers whatever the jobs, backend or chunking; the same numbers
+as single runs; axes the law does not read refused before any work."""
+
+import importlib
+
+import numpy as np
+import pytest
+
+from phaseimpact import ContactLaw, seed_parameters, simulate
+from phaseimpact.case import load_case
+from phaseimpact.continuation import atlas, parse_axis, sweep
+
+sweep_module = importlib.import_module("phaseimpact.continuation.sweep")  # the name is the function
+
+SEED = seed_parameters(v=1.0)
+KAPPA_C = 1.4994185342868816e12
+KAPPAS = np.geomspace(1e9, 1e14, 24)
+
+
+def _same(a, b):
+    assert np.array_equal(a.status, b.status) and np.array_equal(a.outcome, b.outcome)
+    for name, values in a.values.items():
+        assert np.array_equal(values, b.values[name], equal_nan=values.dtype.kind == "f"), name
+    order_a, order_b = np.lexsort((a.stick_t, a.stick_point)), np.lexsort((b.stick_t, b.stick_point))
+    assert np.array_equal(a.stick_delta[order_a], b.stick_delta[order_b])
+
+
+@pytest.fixture(scope="module")
+def reference():
+    return sweep(SEED, "paper", KAPPAS, n_jobs=1)
+
+
+def test_threads_do_not_change_any_number(reference):
+    _same(reference, sweep(SEED, "paper", KAPPAS, n_jobs=2))
+
+
+def test_chunking_does_not_change_any_number(reference, monkeypatch):
+    monkeypatch.setattr(sweep_module, "CHUNK_THREADS", 5)
+    calls = []
+    _same(reference, sweep(SEED, "paper", KAPPAS, on_chunk=lambda r: calls.append(1)))
+    assert len(calls) == 5
+
+
+@pytest.mark.slow
+def test_processes_and_dask_do_not_change_any_number(reference):
+    _same(reference, sweep(SEED, "paper", KAPPAS, n_jobs=2, backend="loky"))
+    _same(reference, sweep(SEED, "paper", KAPPAS, n_jobs=2, backend="dask"))
+
+
+@pytest.mark.parametrize("contact", ["printed", "unilateral"])
+def test_near_kappa_c_window_sweep_equals_simulate(contact):
+    """The window where the old batch loop and simulate disagreed (62/20 against 42/6)."""
+    law = ContactLaw("paper", contact=contact)
+    kappas = KAPPA_C * (1 + np.array([1e-4, 2e-4, 1e-6 * 1.5, 3e-5]))
+    result = sweep(SEED, law, kappas)
+    for i, k in enumerate(kappas):
+        tr = simulate(SEED.replace(kappa=float(k)), law)
+        assert result.n_stick[i] == tr.n_stick
+        assert result.outcome_names()[i] == tr.outcome
+        assert np.array_equal(result.t_run[i], np.float64(tr.t_run if tr.t_run is not None else np.nan),
+                              equal_nan=True)
+    assert list(result.n_stick[:2]) == [42, 6]
+
+
+def test_axes_the_law_does_not_read_are_refused():
+    for law in (ContactLaw("flores", restitution=0.5), ContactLaw("abrate"),
+                ContactLaw("hunt-crossley", restitution=0.5)):
+        with pytest.raises(ValueError, match="not read by law"):
+            sweep(SEED, law, KAPPAS)
+
+
+@pytest.mark.parametrize("kwargs, name", [
+    ({"rtol": 5.0}, "rtol"), ({"t_end": -1.0}, "t_end"), ({"n_jobs": 0}, "jobs"), ({"backend": "mpi"}, "backend"),
+    ({"scheduler": "tcp://x:1"}, "scheduler"),
+])
+def test_bad_sweep_options_are_refused(kwargs, name):
+    with pytest.raises(ValueError, match=name):
+        sweep(SEED, "paper", KAPPAS, **kwargs)
+
+
+def test_atlas_over_a_material_quantity_matches_single_runs():
+    case = load_case("seed")
+    result = atlas(case, "paper", [parse_axis("kappa=1e11:1e13:3:log"), parse_axis("plate.E=1e11:2.1e11:2")])
+    assert result.shape == (3, 2)
+    for flat in range(6):
+        point = result.grid.point_values(flat)
+        tr = simulate(case.parameters(**point), "paper")
+        assert result.n_stick[flat] == tr.n_stick and result.max_force[flat] == tr.max_force
+
+
+@pytest.mark.parametrize("text, message", [
+    ("kappa=1:0:x", "kappa"), ("kappa=1e9:1e12", "kappa"), ("v=0:1:3:log", "v"), ("=1:2:3", "axis"),
+])
+def test_bad_axes_are_refused(text, message):
+    with pytest.raises(ValueError, match=message):
+        parse_axis(text)
+
+
+def test_unknown_axis_is_refused():
+    with pytest.raises(ValueError, match="foo"):
+        atlas(SEED, "paper", [parse_axis("foo=1:2:3")])
