@@ -41,8 +41,8 @@ def no_work(monkeypatch):
     def forbidden(*args, **kwargs):
         raise AssertionError("work started before the input was refused")
 
-    for module, name in ((continuation, "sweep"), (continuation, "critical_damping"),
-                         (continuation, "critical_curve"), (integrate, "simulate")):
+    for module, name in ((continuation, "sweep"), (continuation, "atlas"), (continuation, "critical_damping"),
+                         (continuation, "critical_curve"), (continuation, "transitions"), (integrate, "simulate")):
         monkeypatch.setattr(module, name, forbidden)
 
 
@@ -219,20 +219,39 @@ SUBCOMMANDS = next(a for a in PARSER._actions if isinstance(a, argparse._SubPars
 NASTY = ["0", "-0", "-1", "1", "2", "0.5", "1e-300", "1e-15", "1e-3", "1e308", "-1e308", "1e400", "nan", "NaN",
          "inf", "-inf", "", " ", "abc", "1,5", "0x10", "1e", "--", "3e9", "1e12", "2.5", "1e8", "1e7"]
 #: Values that could start long work are overridden at the end of the list (the random value is still
-#: parsed and checked by the parser, which is what is under test).
+#: parsed and checked by the parser, which is what is under test). Ranges of kappa are narrowed to a
+#: decade, so that a transition search or a grazing curve stays cheap.
 FAST = {"simulate": ["--t-end", "1e-4"], "sweep": ["--t-end", "1e-4", "--num", "3", "--no-progress"],
-        "critical-curve": ["--num", "2", "--no-progress"]}
+        "critical-curve": ["--num", "2", "--samples", "8", "--no-progress"],
+        "transitions": ["--kappa-min", "1e10", "--kappa-max", "1e11", "--samples", "8"],
+        "atlas": ["--t-end", "1e-4", "--no-progress"], "portrait": ["--t-end", "1e-4"]}
 SAFE_NAME = st.text(alphabet="abcxyz019._-", min_size=0, max_size=8)  # relative: stays in the temp folder
 SCHEDULERS = ["nonsense", "tcp://", ""]
+#: Cheap values for the options whose random values could mean long work or files outside the folder.
+CHEAP = {
+    "axis": ["kappa=1e9:1e12:3:log", "v=1:2:2", "R1=0.01,0.02", "kappa=1:0:x", "foo=1:2:3", "v=-1:1:2", "",
+             "kappa=1e9:1e12:100000000:log", "plate.E=1e9:1e11:2:log", "kappa=nan:1:2"],
+    "set": ["R1=0.005", "plate.E=1e9", "v=2", "nope=1", "R1=abc", "R1=-1", "R1", "=", "v=1e308", "plate.nu=0.7",
+            "h=inf"],
+    "case": ["seed", "sand-gelcoat", "hail-laminate", "missing", "", "afile.txt", "x.toml", "sub/", "/"],
+    "kappas": ["1e9", "1e9,3e12", "abc", "", "-1", "1e9," * 13, "nan", "1e300"],
+    "param": ["v", "R1", "plate.E", "kappa", "nope", "", "alpha"],
+    "from_": ["1", "0.01", "-1", "nan", "1e308", "abc"],
+    "to": ["2", "0.02", "0", "inf", "abc"],
+    "curve": ["afile.txt", "missing.h5", ""],
+}
 
 
 def _values(action):
     if action.choices:
         return st.sampled_from([*action.choices, "bogus"])
     if action.dest in ("out",):
-        return st.one_of(SAFE_NAME, st.sampled_from(["", ".", "sub/a.h5", "afile.txt/x.h5", "afile.txt"]))
+        return st.one_of(SAFE_NAME, st.sampled_from(["", ".", "sub/a.h5", "afile.txt/x.h5", "afile.txt", "f.png",
+                                                     "f.h5.png"]))
     if action.dest == "scheduler":
         return st.sampled_from(SCHEDULERS)
+    if action.dest in CHEAP:
+        return st.sampled_from(CHEAP[action.dest])
     return st.one_of(st.sampled_from(NASTY), st.floats(allow_nan=True, allow_infinity=True).map(repr),
                      st.integers(-10**20, 10**20).map(str), st.text(max_size=6))
 
@@ -245,6 +264,8 @@ def argument_lists(draw):
     sub = SUBCOMMANDS[command]
     options = [a for a in sub._actions if a.option_strings and not isinstance(a, argparse._HelpAction)]
     argv = [command]
+    if command == "plot":  # its one positional: the archive to draw
+        argv.append(draw(st.sampled_from(["afile.txt", "missing.h5", "", "."])))
     for action in draw(st.lists(st.sampled_from(options), max_size=8)):
         argv.append(draw(st.sampled_from(action.option_strings)))
         if action.nargs != 0:
