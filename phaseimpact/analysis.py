@@ -1,6 +1,6 @@
 """Phase-space analysis of trajectories: asymptotic points, outcomes, fixed points, portraits.
 
-Definitions follow REFERENCE §5. An *asymptotic point* of a trajectory, in a phase plane, is
+Definitions follow docs/physics.md §5. An *asymptotic point* of a trajectory, in a phase plane, is
 a point where the trajectory comes to rest in that plane for a dwell time that is not
 negligible. Two ways to find them:
 
@@ -91,7 +91,7 @@ class AsymptoticPoints:
 def find_asymptotic_points(trajectory: Trajectory, plane=("delta", "deltadot"), *,
                            method: str | None = None, tol: float = 1e-3,
                            min_dwell: float | None = None) -> AsymptoticPoints:
-    """Find the asymptotic points of ``trajectory`` in ``plane`` (REFERENCE §5).
+    """Find the asymptotic points of ``trajectory`` in ``plane`` (docs/physics.md §5).
 
     Parameters
     ----------

@@ -26,7 +26,7 @@ Unknown keys, missing keys, wrong types and values out of range raise ``ValueErr
 dotted key, its value and the allowed range. Named cases ship in ``phaseimpact/cases/``
 (:func:`list_cases`); :func:`load_case` takes a name or a path.
 
-Hertz scales and validity (REFERENCE §4; Johnson 1985, *Contact Mechanics*, §4.2, §11.4) are
+Hertz scales and validity (docs/physics.md §4; Johnson 1985, *Contact Mechanics*, §4.2, §11.4) are
 pure functions of :class:`~phaseimpact.parameters.Parameters` and the materials:
 :func:`hertz_scales`, :func:`validity`, :func:`hertz_contact`, :func:`validity_for_force`.
 """
@@ -390,7 +390,7 @@ def list_cases() -> list[dict]:
 
 
 def seed_case() -> Case:
-    """The seed's case (eq. 7, steel as REFERENCE §2 fixes it) at 1 m/s, built without a file."""
+    """The seed's case (eq. 7, steel as docs/physics.md §2 fixes it) at 1 m/s, built without a file."""
     return Case(
         name="seed",
         description="The seed paper's case (eq. 7): 2 cm steel ball on a 10 cm steel plate, 5 mm thick, at 1 m/s",
@@ -403,8 +403,8 @@ def seed_case() -> Case:
 
 
 _SEED_SOURCE = ("Seed paper eq. 7 (a = 0.1 m, h = 0.005 m, R1 = 0.02 m, R2 = 2e3 m, E1 = E2 = 2.1e11 Pa); "
-                "nu = 0.3 and rho = 7850 kg/m^3 are not in the seed: steel as fixed by REFERENCE §2; "
-                "v = 1 m/s is REFERENCE §1's default (the seed gives no speed)")
+                "nu = 0.3 and rho = 7850 kg/m^3 are not in the seed: steel as fixed by docs/physics.md §2; "
+                "v = 1 m/s is docs/physics.md §1's default (the seed gives no speed)")
 
 
 # ---------------------------------------------------------------------------------------------
@@ -492,7 +492,7 @@ def apply_settings(case: Case, settings) -> Case:
 
 
 # ---------------------------------------------------------------------------------------------
-# Hertz scales and validity (REFERENCE §4; Johnson 1985)
+# Hertz scales and validity (docs/physics.md §4; Johnson 1985)
 # ---------------------------------------------------------------------------------------------
 
 def _tau(alpha: float) -> float:
@@ -500,14 +500,14 @@ def _tau(alpha: float) -> float:
 
     From energy conservation, ``t(delta_max) = delta_max/v * int_0^1 (1 - x^p)^(-1/2) dx`` with
     ``p = alpha + 1``, i.e. ``sqrt(pi) Gamma(1 + 1/p) / Gamma(1/p + 1/2)``; for Hertz (``p = 5/2``)
-    ``sqrt(pi) Gamma(7/5) / Gamma(9/10) = 1.4716376...`` (REFERENCE §4).
+    ``sqrt(pi) Gamma(7/5) / Gamma(9/10) = 1.4716376...`` (docs/physics.md §4).
     """
     p = alpha + 1.0
     return math.sqrt(math.pi) * float(gamma(1.0 + 1.0 / p)) / float(gamma(1.0 / p + 0.5))
 
 
 def hertz_scales(params: Parameters, plate_material: Material | None = None) -> dict:
-    """Closed-form scales of the undamped impact of the reduced mass (REFERENCE §4, Johnson §11.4).
+    """Closed-form scales of the undamped impact of the reduced mass (docs/physics.md §4, Johnson §11.4).
 
     Parameters
     ----------

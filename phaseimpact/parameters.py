@@ -1,6 +1,6 @@
 """Material, geometry and the derived model parameters (seed eq. 3-5, 7).
 
-The seed's formulas are used as printed except where REFERENCE §2 corrects them:
+The seed's formulas are used as printed except where docs/physics.md §2 corrects them:
 
 * eq. 3 omits the contact compliance ``eta``: ``K = 4 sqrt(R) / (3 eta)`` (Johnson);
 * eq. 5a prints ``h``; the bending stiffness needs ``h**3``:
@@ -137,7 +137,7 @@ class Material:
         _store_floats(self, MATERIAL_FIELDS)
 
 
-#: Steel, as REFERENCE §2 fixes it for the seed (the seed gives only E; no yield strength).
+#: Steel, as docs/physics.md §2 fixes it for the seed (the seed gives only E; no yield strength).
 STEEL = Material(E=2.1e11, nu=0.3, rho=7850.0)
 
 
@@ -168,7 +168,7 @@ class Geometry:
 
     @property
     def effective_radius(self) -> float:
-        """``R = R1 R2 / (R1 + R2)``, m (REFERENCE §2)."""
+        """``R = R1 R2 / (R1 + R2)``, m (docs/physics.md §2)."""
         return self.R1 * self.R2 / (self.R1 + self.R2)
 
 
@@ -244,7 +244,7 @@ class Parameters:
 
     @property
     def hertz_indentation(self) -> float:
-        """Largest indentation of the undamped impact of the reduced mass, m (REFERENCE §4):
+        """Largest indentation of the undamped impact of the reduced mass, m (docs/physics.md §4):
         ``((alpha+1) m v^2 / (2K))^(1/(alpha+1))``, ``(5 m v^2/(4K))^(2/5)`` for Hertz."""
         a = self.alpha
         return ((a + 1) * self.reduced_mass * self.v**2 / (2 * self.K)) ** (1 / (a + 1))
@@ -278,7 +278,7 @@ def derive_parameters(
     v: float = 1.0,
     target: str = "plate",
 ) -> Parameters:
-    """Derive ``M1, M2, K, Kb, Km`` (and ``R``) from materials and geometry (seed eq. 3-5, REFERENCE §2).
+    """Derive ``M1, M2, K, Kb, Km`` (and ``R``) from materials and geometry (seed eq. 3-5, docs/physics.md §2).
 
     Parameters
     ----------
@@ -360,7 +360,7 @@ def parameters_with(
 
 
 def seed_parameters(v: float = 1.0, **overrides) -> Parameters:
-    """The seed's case (eq. 7, steel, REFERENCE §2) at impact speed ``v`` (m/s), with overrides.
+    """The seed's case (eq. 7, steel, docs/physics.md §2) at impact speed ``v`` (m/s), with overrides.
 
     ``overrides`` may name geometry (``a, h, R1, R2``, m), materials (``projectile_E``,
     ``plate_nu``, ... see :data:`MATERIAL_NAMES`), ``membrane="shivakumar"`` or any

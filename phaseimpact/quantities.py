@@ -30,7 +30,7 @@ class ImpactQuantities:
     time_equal_displacement : float or None
         First time after contact begins with ``x1 = x2``, s.
     dissipated_energy : float
-        Initial minus final mechanical energy of the run (REFERENCE §4), J. For ``paper`` the
+        Initial minus final mechanical energy of the run (docs/physics.md §4), J. For ``paper`` the
         elastic term has no potential, so the plastic stick's loss is counted.
     loop_area : float
         ``integral of P d(delta)`` over the run, J: the area of the force-indentation loop
@@ -51,7 +51,7 @@ class ImpactQuantities:
 
 def impact_quantities(trajectory: Trajectory) -> ImpactQuantities:
     """Derive :class:`ImpactQuantities` from ``trajectory`` (its summary; energies from its own
-    initial state, REFERENCE §4)."""
+    initial state, docs/physics.md §4)."""
     duration = trajectory.contact_duration
     t_equal = None
     if duration is not None:

@@ -90,12 +90,12 @@ def oracle(params, law, t_end=None, *, rtol=1e-12, method="DOP853", settle=True,
             return f
 
         def column(col, mode=mode):
-            def ev(_t, yy):
+            def value(_t, yy):
                 f = np.empty(5)
                 force = rhs(code, c, yy, mode, f)
                 event_values(code, c, yy, f, force, mode, limit, g)
                 return g[col]
-            return ev
+            return value
 
         f0 = np.empty(5)
         force0 = rhs(code, c, y, mode, f0)

@@ -1,4 +1,4 @@
-"""The driver: known answers (REFERENCE §4), solver order, compiled vs uncompiled vs oracle,
+"""The driver: known answers (docs/physics.md §4), solver order, compiled vs uncompiled vs oracle,
 statuses instead of NaN, argument checks."""
 
 import json
@@ -20,7 +20,7 @@ TAU = math.sqrt(math.pi) * gamma(7 / 5) / gamma(9 / 10)
 
 
 def test_hertz_closed_forms_on_a_rigid_target():
-    """REFERENCE §4: delta_max = 4.69617e-5 m and T = 1.38221e-4 s for the seed ball at 1 m/s."""
+    """docs/physics.md §4: delta_max = 4.69617e-5 m and T = 1.38221e-4 s for the seed ball at 1 m/s."""
     tr = simulate(SEED.replace(target="rigid"), "abrate", rtol=1e-12)
     assert tr.outcome == "rebound"
     assert tr.max_indentation == pytest.approx(4.69617e-5, rel=1e-5)
@@ -44,14 +44,14 @@ def test_hertz_closed_forms_at_the_sand_scale():
 
 @pytest.mark.parametrize("a", [0.01, 0.3, 2.0, 30.0])
 def test_hunt_crossley_restitution_is_lambert_w(a):
-    """REFERENCE §4: e = (1 + W0(-(1+a) e^-(1+a)))/a on a rigid wall, whatever K and the mass."""
+    """docs/physics.md §4: e = (1 + W0(-(1+a) e^-(1+a)))/a on a rigid wall, whatever K and the mass."""
     p = SEED.replace(target="rigid", kappa=a * SEED.K / SEED.v)
     tr = simulate(p, "hunt-crossley", rtol=1e-12)
     assert tr.restitution == pytest.approx(float(hunt_crossley_restitution(a)), rel=1e-8)
 
 
 def test_paper_loses_the_plastic_energy_at_any_kappa():
-    """REFERENCE §4: below kappa_c the first compression ends in a permanent stick, a perfectly
+    """docs/physics.md §4: below kappa_c the first compression ends in a permanent stick, a perfectly
     plastic impact losing about m v^2/2 (m the reduced mass), for every kappa including 0."""
     plastic = 0.5 * SEED.reduced_mass * SEED.v**2
     for kappa in (0.0, 1e9, 1e11):
@@ -109,7 +109,7 @@ KAPPA_C = 1.4994185342868816e12  # v = 1 m/s, printed reading (checked in test_t
 
 @pytest.mark.parametrize("contact", ["printed", "unilateral"])
 def test_near_kappa_c_engine_and_oracle_agree(contact):
-    """N and T_run just above kappa_c from two engines (REFERENCE §5's ratchet and escape)."""
+    """N and T_run just above kappa_c from two engines (docs/physics.md §5's ratchet and escape)."""
     law = ContactLaw("paper", contact=contact)
     for eps, n_expected in ((3e-5, 510), (1e-4, 42), (2e-4, 6)):
         p = SEED.replace(kappa=KAPPA_C * (1 + eps))

@@ -71,7 +71,7 @@ def test_stuck_jacobian_is_the_pair_on_the_springs():
 
 @pytest.mark.parametrize("law", VARIANTS, ids=IDS)
 def test_work_energy_balance(law):
-    """REFERENCE §4: E_mech(0) - E_mech(t) = W - (U(t) - U(0)), W the integrated contact work
+    """docs/physics.md §4: E_mech(0) - E_mech(t) = W - (U(t) - U(0)), W the integrated contact work
     (a state of its own) and U the contact potential (zero for paper)."""
     tr = simulate(SEED, law, 4e-3, rtol=1e-12)
     c = pack(SEED, law)

@@ -1,4 +1,4 @@
-"""Transitions of the long-time behaviour (REFERENCE §5): kappa_c, kappa_2, grazing, their
+"""Transitions of the long-time behaviour (docs/physics.md §5): kappa_c, kappa_2, grazing, their
 two-parameter continuation and the refined boundaries of an atlas."""
 
 import math
@@ -33,7 +33,7 @@ def critical():
 
 @pytest.mark.parametrize("v", [1.0, 13.0])
 def test_kappa_c_against_the_closed_form(v):
-    """REFERENCE §5: the closed form gives kappa_c to a fraction of a percent."""
+    """docs/physics.md §5: the closed form gives kappa_c to a fraction of a percent."""
     p = seed_parameters(v=v)
     found = critical_damping(p, "paper")
     assert found.status == "success"
@@ -51,7 +51,7 @@ def test_kappa_c_is_the_root_of_the_margin_and_the_count_changes_there(critical)
 
 
 def test_closed_form_is_exact_for_a_slow_plate():
-    """REFERENCE §5: exact in the limit of a slow plate (plate period >> contact time): lowering
+    """docs/physics.md §5: exact in the limit of a slow plate (plate period >> contact time): lowering
     the plate's stiffness a hundredfold brings the located kappa_c to the closed form."""
     gaps = []
     for scale in (1.0, 1e-2, 1e-4):
@@ -102,7 +102,7 @@ def test_kappa_2_from_an_independent_bisection(critical):
 
 
 def test_adding_sliding_exponents(critical):
-    """REFERENCE §5: slip speed ~ eps^(3/2), spacing of the new stick points ~ eps^2."""
+    """docs/physics.md §5: slip speed ~ eps^(3/2), spacing of the new stick points ~ eps^2."""
     from phaseimpact.continuation import adding_sliding_exponents
     ex = adding_sliding_exponents(SEED, "paper", critical.kappa_c)
     assert ex["slip_speed_exponent"] == pytest.approx(1.5, abs=0.1)

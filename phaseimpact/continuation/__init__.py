@@ -13,8 +13,8 @@ from .transition import (
     adding_sliding_exponents,
     closed_form_kappa_c,
     critical_damping,
-    first_stick_margin,
     delta_extremum,
+    first_stick_margin,
     grazing_transitions,
     locate_kappa_2,
     stick_count,
@@ -22,7 +22,8 @@ from .transition import (
 )
 
 __all__ = [
-    "BACKENDS", "CURVE_QUANTITIES", "Axis", "Boundaries", "refine_boundaries", "CriticalCurve", "CriticalDamping", "Grid", "SweepResult",
+    "BACKENDS", "CURVE_QUANTITIES", "Axis", "Boundaries", "refine_boundaries", "CriticalCurve", "CriticalDamping",
+    "Grid", "SweepResult",
     "Transition", "adding_sliding_exponents", "atlas", "closed_form_kappa_c", "critical_curve",
     "critical_damping", "first_stick_margin", "delta_extremum", "grazing_transitions", "locate_kappa_2",
     "parse_axis", "stick_count", "sweep", "transitions",

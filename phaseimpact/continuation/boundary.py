@@ -4,7 +4,7 @@ Where two neighbouring grid points along ``axis`` end in different outcome class
 boundary between them is located by bisection on the class (in log space on a log axis) to a
 stated relative tolerance, all other coordinates held. For ``paper``'s edge between a
 permanent stick and the rest, the class is read from the sign of the first stick's margin, a
-smooth function whose root is ``kappa_c`` (REFERENCE §5): no run needs to reach the (near
+smooth function whose root is ``kappa_c`` (docs/physics.md §5): no run needs to reach the (near
 ``kappa_c`` unbounded) escape time.
 """
 

@@ -19,7 +19,7 @@ from tqdm.auto import tqdm
 from ..case import Case
 from ..model.laws import ContactLaw, as_law
 from ..parameters import Parameters
-from .transition import closed_form_kappa_c, critical_damping, first_stick_margin, delta_extremum, locate_kappa_2
+from .transition import closed_form_kappa_c, critical_damping, delta_extremum, first_stick_margin, locate_kappa_2
 
 __all__ = ["CriticalCurve", "critical_curve", "CURVE_QUANTITIES"]
 
@@ -41,7 +41,7 @@ class CriticalCurve:
     requested : ndarray of bool
         Which values were asked for.
     closed_form : ndarray
-        REFERENCE §5's closed-form ``kappa_c`` (``paper``), NaN otherwise.
+        docs/physics.md §5's closed-form ``kappa_c`` (``paper``), NaN otherwise.
     predicted : ndarray
         The predictor's value at each point (how good the continuation's steps were).
     what : str

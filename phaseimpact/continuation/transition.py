@@ -1,4 +1,4 @@
-"""Where the long-time behaviour changes with ``kappa`` (REFERENCE §5).
+"""Where the long-time behaviour changes with ``kappa`` (docs/physics.md §5).
 
 ``paper`` (a Filippov system): below the critical damping ``kappa_c`` the first stick is
 permanent (one asymptotic point); at ``kappa_c`` the stuck pair's sliding orbit touches the
@@ -56,7 +56,7 @@ def _default_range(params: Parameters) -> tuple[float, float]:
 
 
 def closed_form_kappa_c(params: Parameters) -> float | None:
-    """``kappa_c`` of REFERENCE §5's closed form (two-body Hunt-Crossley approach, momentum
+    """``kappa_c`` of docs/physics.md §5's closed form (two-body Hunt-Crossley approach, momentum
     conserved during the contact, stuck pair on the springs); None without a plate."""
     if params.target != "plate" or params.Kb <= 0:
         return None
@@ -106,14 +106,14 @@ def stick_count(params: Parameters, law: ContactLaw | str = "paper", *, rtol: fl
 
 @dataclass(frozen=True)
 class CriticalDamping:
-    """The critical damping of ``paper`` at one case (REFERENCE §5).
+    """The critical damping of ``paper`` at one case (docs/physics.md §5).
 
     Attributes
     ----------
     kappa_c : float or None
         Root of the first stick's margin, N s/m^(1+alpha); None when not found.
     closed_form : float or None
-        REFERENCE §5's closed-form estimate.
+        docs/physics.md §5's closed-form estimate.
     margins : tuple
         Margin at the search range's ends (or at the final bracket).
     kappa_2 : float or None
@@ -151,7 +151,7 @@ def critical_damping(params: Parameters, law: ContactLaw | str = "paper", *, kap
                      with_kappa_2: bool = False, with_exponents: bool = False) -> CriticalDamping:
     """Locate ``kappa_c``, the root of the first stick's margin, for any case.
 
-    The bracket is seeded by the closed form (REFERENCE §5) and widened geometrically within
+    The bracket is seeded by the closed form (docs/physics.md §5) and widened geometrically within
     ``[kappa_min, kappa_max]`` (default: damping numbers ``kappa v / K`` in 1e-8..1e8); Brent's
     method narrows it to ``rtol`` (relative). Counts either side confirm it: one permanent
     stick just below, two or more stick phases just above. No root in the range gives status
@@ -318,7 +318,7 @@ def delta_extremum(params: Parameters, law: ContactLaw | str, j: int, *, rtol: f
     The contact force of a unilateral law is ``~ delta^alpha`` near ``delta = 0`` (``C^1`` for
     ``alpha > 1``), so each extremum is a smooth function of ``kappa`` across zero: a maximum
     crossing zero from below is a new contact just touching, a minimum crossing zero from above a
-    flight phase just vanishing. Its roots are the grazing values (REFERENCE §5).
+    flight phase just vanishing. Its roots are the grazing values (docs/physics.md §5).
     """
     # no stop when out of reach: the extrema go on (below zero), so each stays defined across
     # the kappa where the projectile stops getting out of reach

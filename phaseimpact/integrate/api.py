@@ -50,7 +50,7 @@ def check_rtol(rtol) -> float:
 
 @dataclass(frozen=True)
 class Scales:
-    """A case's own scales (DESIGN principle 5; REFERENCE §4).
+    """A case's own scales (DESIGN principle 5; docs/physics.md §4).
 
     Attributes
     ----------

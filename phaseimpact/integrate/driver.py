@@ -52,7 +52,7 @@ SUCCESS, STEP_SIZE_COLLAPSE, TOO_MANY_STEPS, NON_FINITE = range(4)
 STATUSES = ("success", "step-size-collapse", "too-many-steps", "non-finite")
 HORIZON, SETTLED_STOP, RUNAWAY_STOP, ASKED_STOP, FAILED_STOP = range(5)
 STOP_REASONS = ("horizon", "settled", "runaway", "asked", "failed")
-# Outcome classes (REFERENCE §5).
+# Outcome classes (docs/physics.md §5).
 FAILED, PERMANENT_STICK, RATCHET_ESCAPE, REBOUND, RUNAWAY_OUTCOME, BOUNDED, UNSETTLED = range(7)
 OUTCOMES = ("failed", "permanent-stick", "ratchet-escape", "rebound", "runaway", "bounded", "unsettled")
 # Save kinds.
@@ -280,7 +280,8 @@ def run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count,
     if save_kind == SAVE_TIMES:
         while i_time < times.shape[0] and times[i_time] <= 0.0:
             if n_s == s_t.shape[0]:
-                s_t, s_y, s_mode, s_force = _grow(s_t, n_s), _grow(s_y, n_s), _grow(s_mode, n_s), _grow(s_force, n_s)
+                s_t, s_y, s_mode, s_force = (_grow(s_t, n_s), _grow(s_y, n_s), _grow(s_mode, n_s),
+                                                  _grow(s_force, n_s))
             s_t[n_s] = times[i_time]
             s_y[n_s] = y
             s_mode[n_s] = mode
@@ -357,7 +358,8 @@ def run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count,
             max_indentation = max(max_indentation, d_new)
             if save_kind == SAVE_STEPS and (nsteps % rk4_every == 0 or t >= t_end):
                 if n_s == s_t.shape[0]:
-                    s_t, s_y, s_mode, s_force = _grow(s_t, n_s), _grow(s_y, n_s), _grow(s_mode, n_s), _grow(s_force, n_s)
+                    s_t, s_y, s_mode, s_force = (_grow(s_t, n_s), _grow(s_y, n_s), _grow(s_mode, n_s),
+                                                  _grow(s_force, n_s))
                 s_t[n_s] = t
                 s_y[n_s] = y
                 s_mode[n_s] = mode
@@ -484,7 +486,8 @@ def run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count,
                     nfev += 3
                     have_dense = True
                 if n_s == s_t.shape[0]:
-                    s_t, s_y, s_mode, s_force = _grow(s_t, n_s), _grow(s_y, n_s), _grow(s_mode, n_s), _grow(s_force, n_s)
+                    s_t, s_y, s_mode, s_force = (_grow(s_t, n_s), _grow(s_y, n_s), _grow(s_mode, n_s),
+                                                  _grow(s_force, n_s))
                 dop853.dense_eval(F, y, t, h, times[i_time], ys)
                 s_t[n_s] = times[i_time]
                 s_y[n_s] = ys
@@ -520,7 +523,8 @@ def run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count,
             max_indentation = max(max_indentation, y[X1] - y[X2])
             if save_kind == SAVE_STEPS:
                 if n_s == s_t.shape[0]:
-                    s_t, s_y, s_mode, s_force = _grow(s_t, n_s), _grow(s_y, n_s), _grow(s_mode, n_s), _grow(s_force, n_s)
+                    s_t, s_y, s_mode, s_force = (_grow(s_t, n_s), _grow(s_y, n_s), _grow(s_mode, n_s),
+                                                  _grow(s_force, n_s))
                 s_t[n_s] = t
                 s_y[n_s] = y
                 s_mode[n_s] = mode
@@ -553,7 +557,8 @@ def run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count,
         max_indentation = max(max_indentation, y[X1] - y[X2])
         if save_kind == SAVE_STEPS:
             if n_s == s_t.shape[0]:
-                s_t, s_y, s_mode, s_force = _grow(s_t, n_s), _grow(s_y, n_s), _grow(s_mode, n_s), _grow(s_force, n_s)
+                s_t, s_y, s_mode, s_force = (_grow(s_t, n_s), _grow(s_y, n_s), _grow(s_mode, n_s),
+                                                  _grow(s_force, n_s))
             s_t[n_s] = t
             s_y[n_s] = y
             s_mode[n_s] = mode

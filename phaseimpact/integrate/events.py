@@ -1,4 +1,4 @@
-"""The event table of the hybrid system, compiled (REFERENCE §3, §5).
+"""The event table of the hybrid system, compiled (docs/physics.md §3, §5).
 
 Each event is a column of :func:`event_values`, with the direction that fires it and what the
 driver does then (:data:`ACTIONS`); :func:`transition` applies an event located at a state.
@@ -24,7 +24,6 @@ from __future__ import annotations
 import math
 
 import numba
-import numpy as np
 
 from ..model.laws import ABRATE_BILATERAL, PAPER_PRINTED, PAPER_UNILATERAL, STUCK, force_partials, hertz_power
 from ..model.rhs import (

@@ -90,7 +90,7 @@ class Trajectory:
     params, law : Parameters, ContactLaw
         What was integrated.
     initial_state, final_state : ndarray, shape (5,)
-        The run's own start and end; energies are taken from these (REFERENCE §4).
+        The run's own start and end; energies are taken from these (docs/physics.md §4).
     t_end, t_stop : float
         Requested horizon and where the run stopped, s.
     status : str
@@ -98,7 +98,7 @@ class Trajectory:
     stop_reason : str
         ``horizon``, ``settled`` (nothing can change any more), ``runaway``, ``asked`` or ``failed``.
     outcome : str
-        One of :data:`OUTCOMES` (REFERENCE §5).
+        One of :data:`OUTCOMES` (docs/physics.md §5).
     message : str
     summary : ndarray
         The summary vector (see :mod:`.driver`, ``S_*``); read it through the properties.
@@ -168,7 +168,7 @@ class Trajectory:
 
     @property
     def dissipated_energy(self) -> float:
-        """Initial minus final mechanical energy of this run (REFERENCE §4), J."""
+        """Initial minus final mechanical energy of this run (docs/physics.md §4), J."""
         return float(self.summary[d.S_DISSIPATED])
 
     @property

@@ -1,4 +1,4 @@
-r"""Contact laws, each defined once (seed eq. 2 and 8; REFERENCE §3).
+r"""Contact laws, each defined once (seed eq. 2 and 8; docs/physics.md §3).
 
 A law is one :class:`LawEntry` in :data:`REGISTRY`: its kernel code, its flags and the
 parameters it reads. The kernels below (compiled with numba, callable from Python too) give
@@ -141,7 +141,7 @@ class LawEntry:
     unilateral : bool
         The law acts only while ``delta > 0`` (before options).
     conservative : bool
-        The elastic term has a potential (REFERENCE §4 energy ledger).
+        The elastic term has a potential (docs/physics.md §4 energy ledger).
     chi : callable or None
         Damping factor ``chi(e)`` of a restitution law, ``kappa = chi(e) K / v``.
     description : str
@@ -201,7 +201,7 @@ class ContactLaw:
     clamp : bool
         Hunt-Crossley family only: ``P >= 0`` (no adhesion at the end of contact).
     contact : {"printed", "unilateral"}
-        ``paper`` only: the reading of ``|delta|^alpha`` (REFERENCE §3).
+        ``paper`` only: the reading of ``|delta|^alpha`` (docs/physics.md §3).
     """
 
     name: str = "paper"

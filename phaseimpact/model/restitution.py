@@ -1,4 +1,4 @@
-"""Coefficient of restitution of Hunt-Crossley contact and its exact inverse (REFERENCE §4)."""
+"""Coefficient of restitution of Hunt-Crossley contact and its exact inverse (docs/physics.md §4)."""
 
 from __future__ import annotations
 
@@ -12,13 +12,13 @@ from ..parameters import Parameters, require
 
 __all__ = ["hunt_crossley_restitution", "kappa_for_restitution"]
 
-#: Taylor coefficients of e(a) at a = 0 (from the implicit equation of REFERENCE §4).
+#: Taylor coefficients of e(a) at a = 0 (from the implicit equation of docs/physics.md §4).
 _RESTITUTION_SERIES = (1.0, -2 / 3, 4 / 9, -44 / 135, 104 / 405, -40 / 189, 7648 / 42525, -2848 / 18225)
 _SERIES_BELOW = 0.02  # the series' truncation error there is ~1e-15; W0's rounding error is ~eps/a^2
 
 
 def hunt_crossley_restitution(a):
-    """Exact restitution of Hunt-Crossley contact, ``a = kappa v0 / K`` (REFERENCE §4).
+    """Exact restitution of Hunt-Crossley contact, ``a = kappa v0 / K`` (docs/physics.md §4).
 
     ``e = (1 + W0(-(1+a) exp(-(1+a)))) / a``. Next to ``a = 0`` the argument of ``W0`` sits on
     its branch point and rounding costs ``eps/a^2``; there the Taylor series is used instead.

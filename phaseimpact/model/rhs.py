@@ -1,4 +1,4 @@
-r"""Equations of motion composed from a law's kernels (seed eq. 1 and 8; REFERENCE §3-§4).
+r"""Equations of motion composed from a law's kernels (seed eq. 1 and 8; docs/physics.md §3-§4).
 
 State ``y = (x1, x2, x1dot, x2dot, W)``: projectile and target-centre displacements (m), their
 velocities (m/s), and ``W = \int P d(delta)``, the work of the contact force on the relative
@@ -79,7 +79,7 @@ def rhs(code, c, y, mode, out):
 
 @numba.njit(cache=True)
 def energy(code, c, y):
-    """Mechanical energy (REFERENCE §4), J: kinetic + target springs + the contact potential
+    """Mechanical energy (docs/physics.md §4), J: kinetic + target springs + the contact potential
     of laws whose elastic term is conservative."""
     x2 = y[X2]
     x2sq = x2 * x2
@@ -110,7 +110,7 @@ def stick_orbit(c, y):
 
     The pair oscillates with conserved energy ``M v^2/2 + Kb x2^2/2 + Km x2^4/4``
     (``M = M1 + M2``); the force it needs, ``M1/M S(x2)``, reaches the bound ``K |delta|^alpha``
-    at ``x_break``, the real root of ``Km x^3 + Kb x = M/M1 * bound`` (Cardano). REFERENCE §5.
+    at ``x_break``, the real root of ``Km x^3 + Kb x = M/M1 * bound`` (Cardano). docs/physics.md §5.
     """
     M = c[M1_] + c[M2_]
     amplitude = _orbit_amplitude(c, y[X2], y[V2], M)
@@ -131,7 +131,7 @@ def stick_margin(c, y):
     """Relative margin of a stick entered at ``y``: ``1 - M1/M S(A) / (K |delta*|^alpha)``.
 
     ``>= 0``: the stick never breaks (permanent); the critical damping is its root
-    (REFERENCE §5). 1 without target springs (nothing pulls the pair apart).
+    (docs/physics.md §5). 1 without target springs (nothing pulls the pair apart).
     """
     if c[SPRINGS_] == 0:
         return 1.0
@@ -215,7 +215,7 @@ def contact_force_of_states(ys, params: Parameters, law, modes) -> np.ndarray:
 
 
 def energy_of_states(ys, params: Parameters, law) -> np.ndarray:
-    """Mechanical energy (J, REFERENCE §4) at states ``ys`` (shape (n, 5))."""
+    """Mechanical energy (J, docs/physics.md §4) at states ``ys`` (shape (n, 5))."""
     law = as_law(law)
     ys = np.ascontiguousarray(ys, dtype=float).reshape(-1, 5)
     out = np.empty(len(ys))
