@@ -366,6 +366,14 @@ def _check_reads_kappa(law, what: str) -> None:
                          "run; allowed: a law that reads kappa (paper, hunt-crossley) without --restitution")
 
 
+def _check_grazing_target(law, params) -> None:
+    """Grazing needs the plate to swing back: without it a unilateral impact has one contact."""
+    if not law.is_filippov and params.target != "plate":
+        raise ValueError(f"target = {params.target!r} is out of range for the grazing transitions of law "
+                         f"{law.label()!r} (without the plate's springs nothing swings back: one contact); "
+                         "allowed: target plate")
+
+
 def _check_kappa_range(args) -> None:
     if args.kappa_min is not None and args.kappa_max is not None and not args.kappa_min < args.kappa_max:
         raise ValueError(f"kappa-min = {args.kappa_min!r}, kappa-max = {args.kappa_max!r} are out of range; "
@@ -552,7 +560,9 @@ def cmd_critical(args) -> int:
               f"{_fmt(result.kappa_2, KAPPA_UNIT, '.10g')}; classification {result.classification or 'none'}")
         if result.n_staircase:
             steps = [f"{s['n_stick']}{'+' if s['cut'] else ''}" for s in result.n_staircase]
-            print(f"  stick phases from kappa_c (1 + 1e-6) to 1.5 kappa_2: {' '.join(steps)}")
+            eps = [s["kappa"] / result.kappa_c - 1 for s in result.n_staircase]
+            print(f"  stick phases at kappa/kappa_c - 1 = {eps[0]:.3g} .. {eps[-1]:.3g} ('+': a lower bound): "
+                  + " ".join(steps))
         if args.exponents and result.exponents:
             e = result.exponents
             print(f"  exponents: slip speed {_fmt(e.get('slip_speed_exponent'), '', '.3g')} (expected 1.5), "
@@ -571,6 +581,7 @@ def cmd_transitions(args) -> int:
     setup = _setup(args)
     law, params = setup.law, setup.params
     _check_reads_kappa(law, "kappa")
+    _check_grazing_target(law, params)
     _check_kappa_range(args)
     _note(f"locating the transitions of {law.label()} at v = {params.v:g} m/s for kappa in "
           f"[{args.kappa_min:g}, {args.kappa_max:g}]")
@@ -859,6 +870,9 @@ def cmd_critical_curve(args) -> int:
                              "grazing); allowed: a unilateral law (abrate, the Hunt-Crossley family, or paper "
                              "with --contact unilateral)")
         _check_reads_kappa(law, "point of a grazing curve")
+        if setup.params.target != "plate":
+            raise ValueError(f"target = {setup.params.target!r} is out of range for what = 'grazing' (without the "
+                             "plate's springs nothing swings back); allowed: target plate")
         if args.kappa_min is None or args.kappa_max is None:
             raise ValueError("kappa-min, kappa-max are required by what = 'grazing' (the range in which the first "
                              "grazing value is looked for); allowed: --kappa-min A --kappa-max B")

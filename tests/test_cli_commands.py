@@ -235,8 +235,8 @@ def test_transitions_paper_starts_at_kappa_c():
     out = run_json(["transitions", "--law", "paper", "--v", "1", "--kappa-min", "1e11", "--kappa-max", "1e13"])
     kinds = [t["kind"] for t in out["transitions"]]
     assert kinds[0] == "adding-sliding" and out["count"] == "stick phases"
-    critical = run_json(["critical", "--law", "paper", "--v", "1"])
-    assert out["transitions"][0]["kappa"] == pytest.approx(critical["kappa_c"], rel=1e-8)
+    assert out["transitions"][0]["kappa"] == pytest.approx(KAPPA_C_V1, rel=1e-4)
+    assert out["transitions"][1]["kind"] == "staircase-end" and out["transitions"][1]["count_above"] == 2
     assert out["transitions"][0]["count_above"] is None  # unbounded just above kappa_c
 
 
@@ -257,9 +257,11 @@ def test_critical_curve_over_v_archive_round_trip_and_independent_searches(tmp_p
     assert np.allclose(curve.kappa[asked], out["kappa"], rtol=0, atol=0)
     with h5py.File(path) as f:
         assert json.loads(f.attrs["case"])["name"] == "seed"
-    for v, kappa in zip(out["values"], out["kappa"], strict=True):  # continuation against independent searches
-        single = run_json(["critical", "--law", "paper", "--v", v])
-        assert kappa == pytest.approx(single["kappa_c"], rel=1e-8)
+    # the last point, reached by continuation from the first, against an independent search there
+    single = run_json(["critical", "--law", "paper", "--v", "3"])
+    assert out["kappa"][-1] == pytest.approx(single["kappa_c"], rel=1e-8)
+    closed = np.asarray(out["closed_form"])
+    assert np.allclose(out["kappa"], closed, rtol=2.5e-3)  # REFERENCE §5 at every speed
     # the old spelling: log-spaced speeds
     short = run_json(["critical-curve", "--v-min", "1", "--v-max", "4", "--num", "3", "--no-progress",
                       "--out", tmp_path / "short.h5"])
@@ -466,6 +468,12 @@ BAD = [
     (["transitions", "--kappa-min", "1e12", "--kappa-max", "1e8"], "kappa-min"),
     (["transitions", "--law", "abrate", "--kappa-min", "1e8", "--kappa-max", "1e12"], "kappa"),
     (["transitions", "--kappa-min", "1e8", "--kappa-max", "1e12", "--samples", "3"], "samples"),
+    (["transitions", "--law", "hunt-crossley", "--target", "free", "--kappa-min", "1e8", "--kappa-max", "1e12"],
+     "target"),
+    ([*CURVE, "--param", "v", "--from", "1", "--to", "2", "--what", "grazing", "--law", "abrate", "--kappa-min",
+      "1e8", "--kappa-max", "1e13"], "kappa"),
+    ([*CURVE, "--param", "v", "--from", "1", "--to", "2", "--what", "grazing", "--law", "hunt-crossley",
+      "--target", "rigid", "--kappa-min", "1e8", "--kappa-max", "1e13"], "target"),
     (["critical", "--law", "hunt-crossley"], "law"),
     (["portrait", "--kappa", "1e9,abc", "--out", "p.png"], "kappa"),
     (["portrait", "--kappa", ",".join(["1e9"] * 13), "--out", "p.png"], "kappa"),
