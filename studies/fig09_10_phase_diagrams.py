@@ -1,57 +1,113 @@
 """Seed Figs. 9-10: phase diagrams of the relative motion (delta, deltadot) across the critical damping.
 
-Claim (seed conclusion 7, REFERENCE §5): for lower damping there is one asymptotic point, for higher
-damping two, split at a critical damping. Resolved exactly (stick and slip as events), eq. 8 as printed
-sticks at its first maximum compression below kappa_c; above kappa_c the first stick breaks at the
-plate's turning point and the relative motion sticks again, deeper: two (or more) stick points, which
-separate continuously from kappa_c (Fig. 10: just below and just above kappa_c). The seed's RK4
-chatters across deltadot = 0 instead of sticking (right panel).
+Claim (seed conclusion 7, REFERENCE §5), eq. 8 as printed ("paper"), v = 1 m/s, stick and slip
+resolved as events, every run until its outcome settles (no horizon cut): below kappa_c the
+relative motion sticks at its first maximum compression for good, one asymptotic point (delta*, 0).
+Above kappa_c (an adding-sliding bifurcation of the stuck pair's sliding orbit) the stick breaks
+at the plate's turning points and re-sticks a few nm deeper, N(kappa) times (42 at
+kappa_c (1 + 1e-4)), then escapes after T_run; exactly two stick phases from kappa_2 on. After the
+escape the printed reading runs away (the force acts in tension, energy doubles), the unilateral
+reading separates and the projectile rebounds (apparent restitution up to above 1). The seed's
+fixed-step RK4 chatters across deltadot = 0 instead of sticking (bottom, third panel).
 """
 
 from pathlib import Path
 
 import numpy as np
+from _plots import COUNT_ATOL, COUNT_RTOL, READINGS, claim, outcome_of
 
 from phaseimpact import seed_parameters, simulate
-from phaseimpact.continuation import critical_damping, sweep
-from phaseimpact.plotting import MS, UM, figure, plot_phase, save, save_h5, style
+from phaseimpact.continuation import critical_damping
+from phaseimpact.plotting import MS, UM, figure, mark_points, save, save_h5, style
 
 FIGURES = Path(__file__).resolve().parents[1] / "figures"
 NAME = "fig09_10_phase_diagrams"
-T_END = 0.004
+KAPPAS = (1e9, 1e11, 1.6e12, 3e12)
+#: Fig. 10's pair around kappa_c (relative offsets): below, and above in the staircase.
+BELOW, ABOVE = -1e-4, 1e-4
+
+
+def run(params, law, **kw):
+    return simulate(params, law, None, save="steps", rtol=COUNT_RTOL, atol=COUNT_ATOL, **kw)
+
+
+def phase(ax, tr, **kw):
+    ax.plot(tr.delta * UM, tr.deltadot, **kw)
+    ax.set_xlabel(r"$\delta = x_1 - x_2$ (µm)")
+    ax.set_ylabel(r"$\dot\delta$ (m/s)")
+
+
+def short(tr) -> str:
+    if tr.outcome == "permanent-stick":
+        return "permanent stick"
+    if tr.stop_reason == "runaway":
+        return "runaway"
+    return f"separation, e = {tr.restitution:.3g}"
+
+
+def ending(tr) -> str:
+    return "cut by the horizon" if tr.cut else f"settled at {tr.t_stop * MS:.3g} ms"
 
 
 def main(quick=False, jobs=1):
     p = seed_parameters(v=1.0)
-    crit = critical_damping(p, "paper", bracket=(1e12, 2e12))
-    kc = crit.kappa_c
-    kappas = [1e9, 1e11, 1.6e12, 3e12]
-    grid = np.linspace(0.0, T_END, 8001 if quick else 40001)
-    data = {"kappa_c": (np.array([kc]), "N s/m^2.5")}
+    crit = critical_damping(p, "paper", with_kappa_2=True)
+    kc, k2 = crit.kappa_c, crit.kappa_2
+    printed, unilateral = READINGS["printed"], READINGS["unilateral"]
+    data = {"kappa_c": (np.array([kc]), "N s/m^2.5"), "kappa_2": (np.array([k2]), "N s/m^2.5")}
     with style():
-        fig, axes = figure(2, 4, width=11, height=5.2)
-        for ax, kappa in zip(axes[0], kappas, strict=True):
-            tr = simulate(p.replace(kappa=kappa), "paper", T_END, save=grid)
-            points = plot_phase(ax, tr, color="C0", lw=0.9)
-            ax.set_title(f"κ = {kappa:.2g} ({'below' if kappa < kc else 'above'} κc): {len(points)} point(s)")
-            ax.legend(loc="upper right")
-            data[f"kappa_{kappa:.2g}/delta"] = (tr.delta, "m")
-            data[f"kappa_{kappa:.2g}/deltadot"] = (tr.deltadot, "m/s")
-            data[f"kappa_{kappa:.2g}/points"] = (points.points, "m, m/s")
-        for ax, factor, color in ((axes[1, 0], 1 - 1e-4, "C2"), (axes[1, 1], 1 + 1e-4, "C3")):
-            tr = simulate(p.replace(kappa=kc * factor), "paper", T_END, save=grid)
-            points = plot_phase(ax, tr, color=color, lw=0.9)
-            ax.set_title(f"Fig. 10: κ = κc·(1 {'-' if factor < 1 else '+'} 1e-4): {len(points)} point(s)")
-            ax.legend(loc="upper right")
-            sticks = points.points[:, 0]
-            if len(sticks) > 1:  # zoom on the split: the stick points, relative to the first
-                inset = ax.inset_axes([0.42, 0.3, 0.55, 0.3])
-                inset.plot((sticks - sticks[0]) * 1e9, np.arange(len(sticks)), "o", mfc="none", color=color, ms=4)
-                inset.set_xlabel("δ* − δ*₁ (nm)", fontsize=6)
-                inset.set_ylabel("stick #", fontsize=6)
-                inset.tick_params(labelsize=6)
-            data[f"kappa_c_{factor:+.4f}/points"] = (points.points, "m, m/s")
-        # The seed's RK4 against the exact stick, seen in deltadot(t) after the first maximum compression.
+        fig, axes = figure(2, 4, width=13, height=6.4)
+        for ax, kappa in zip(axes[0], KAPPAS, strict=True):
+            tr = run(p.replace(kappa=kappa), printed)
+            phase(ax, tr, color="C0", lw=0.9, label="printed: " + short(tr))
+            _, delta, _ = tr.stick_points()
+            mark_points(ax, np.column_stack([delta, np.zeros_like(delta)]), label="stick point")
+            key = f"kappa_{kappa:.2g}"
+            data[f"{key}/printed/delta"] = (tr.delta, "m")
+            data[f"{key}/printed/deltadot"] = (tr.deltadot, "m/s")
+            data[f"{key}/stick_delta"] = (delta, "m")
+            side = "< κc" if kappa < kc else "> κ2"
+            title = f"κ = {kappa:.2g} ({side}): {tr.n_stick} stick point{'s' if tr.n_stick > 1 else ''}"
+            if kappa > kc:
+                un = run(p.replace(kappa=kappa), unilateral)
+                phase(ax, un, color="C1", lw=0.9, ls="--", label="unilateral: " + short(un))
+                data[f"{key}/unilateral/delta"] = (un.delta, "m")
+                data[f"{key}/unilateral/deltadot"] = (un.deltadot, "m/s")
+                title += ",\nthen escape; " + ending(tr)
+            else:
+                title += f",\npermanent; {ending(tr)}"
+            ax.set_title(title)
+            ax.legend(loc="center left" if kappa > kc else "lower left", fontsize=6)
+
+        # Fig. 10: just below and just above kappa_c.
+        below = run(p.replace(kappa=kc * (1 + BELOW)), printed)
+        above = run(p.replace(kappa=kc * (1 + ABOVE)), printed)
+        ax = axes[1, 0]
+        phase(ax, below, color="C2", lw=0.9)
+        _, d_below, _ = below.stick_points()
+        mark_points(ax, np.column_stack([d_below, np.zeros_like(d_below)]), label="stick point (permanent)")
+        ax.set_title(f"Fig. 10: κ = κc (1 − 1e-4)\n{below.n_stick} stick point, {outcome_of(below)}")
+        ax.legend(loc="lower left", fontsize=6)
+        ax = axes[1, 1]
+        phase(ax, above, color="C3", lw=0.6)
+        t_st, d_st, _ = above.stick_points()
+        mark_points(ax, np.column_stack([d_st, np.zeros_like(d_st)]), label="stick points")
+        ax.set_title(f"Fig. 10: κ = κc (1 + 1e-4), printed\n{above.n_stick} stick points, escape at "
+                     f"{above.t_run * MS:.3g} ms, runaway")
+        ax.legend(loc="lower right", fontsize=6)
+        inset = ax.inset_axes([0.22, 0.5, 0.24, 0.34])
+        inset.plot(np.arange(1, len(d_st) + 1), (d_st - d_st[0]) * 1e9, "o", ms=2, color="C3")
+        inset.set_xlabel("stick phase k", fontsize=6, labelpad=1)
+        inset.set_ylabel("δ*ₖ − δ*₁ (nm)", fontsize=6, labelpad=1)
+        inset.tick_params(labelsize=5)
+        data["fig10_below/delta"] = (below.delta, "m")
+        data["fig10_below/deltadot"] = (below.deltadot, "m/s")
+        data["fig10_above/delta"] = (above.delta, "m")
+        data["fig10_above/deltadot"] = (above.deltadot, "m/s")
+        data["fig10_above/stick_t"] = (t_st, "s")
+        data["fig10_above/stick_delta"] = (d_st, "m")
+
+        # The seed's RK4 against the exact stick, seen in deltadot(t) around the first maximum compression.
         kappa = 1e9
         exact = simulate(p.replace(kappa=kappa), "paper", 2e-4, save=np.linspace(0, 2e-4, 2001))
         ax = axes[1, 2]
@@ -63,23 +119,29 @@ def main(quick=False, jobs=1):
         ax.set_ylim(-0.02, 0.05)
         ax.set_xlabel("time t (ms)")
         ax.set_ylabel(r"$\dot\delta$ (m/s)")
-        ax.set_title("κ = 1e9: RK4 chatters at the stick")
-        ax.legend(loc="upper right")
-        ax = axes[1, 3]  # the split, zoomed: every stick point against kappa near kappa_c
-        near = sweep(p, "paper", np.linspace(0.99 * kc, 1.02 * kc, 16 if quick else 61), t_end=T_END, n_jobs=jobs)
-        for kappa, pts in zip(near.kappa, near.points, strict=True):
-            ax.plot(np.full(len(pts), kappa / kc), pts[:, 0] * UM, ".", color="C0", ms=3)
-        ax.axvline(1.0, color="C3", ls="--", label=f"κc = {kc:.6g}")
-        ax.set_xlabel("κ / κc")
-        ax.set_ylabel("stick points δ* (µm)")
-        ax.set_title("the split near κc")
-        ax.legend(loc="upper left")
+        ax.set_title("κ = 1e9: the seed's RK4 chatters\nwhere the exact solution sticks")
+        ax.legend(loc="upper right", fontsize=6)
+
+        # The ratchet and the escape of the run above kappa_c, over its whole length.
+        ax = axes[1, 3]
+        after = above.t >= t_st[0]
+        ax.plot(above.t[after] * MS, (above.delta[after] - d_st[0]) * 1e9, color="C3", lw=0.8, label="δ(t) − δ*₁")
+        ax.plot(t_st * MS, (d_st - d_st[0]) * 1e9, "k.", ms=3, label="stick phases")
+        ax.axvline(above.t_run * MS, color="k", ls=":", lw=0.8, label=f"escape, T_run = {above.t_run * MS:.3g} ms")
+        ax.set_ylim(-2, 1.3 * max(1.0, (d_st[-1] - d_st[0]) * 1e9))
+        ax.set_xlabel("time t (ms)")
+        ax.set_ylabel("δ − δ*₁ (nm)")
+        ax.set_title("κ = κc (1 + 1e-4): δ* ratchets\noutwards, then escapes (off the axis)")
+        ax.legend(loc="upper left", fontsize=6)
+        data["fig10_above/t"] = (above.t, "s")
         out = save(fig, FIGURES / f"{NAME}.png")
-    save_h5(FIGURES / "data" / f"{NAME}.h5", data, {"v": 1.0, "law": "paper", "claim": __doc__.strip()})
+    save_h5(FIGURES / "data" / f"{NAME}.h5", data,
+            {"v": 1.0, "law": "paper (printed; unilateral where named)", "rtol": COUNT_RTOL, "atol": COUNT_ATOL,
+             "n_stick_above": above.n_stick, "t_run_above": above.t_run, "claim": claim(__doc__)})
     return out
 
 
 if __name__ == "__main__":
-    from _cli import run
+    from _cli import run as run_study
 
-    run(main, __doc__)
+    run_study(main, __doc__)

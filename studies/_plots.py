@@ -1,0 +1,124 @@
+"""Helpers shared by the study scripts: labels, the two readings of eq. 8, fits and archiving.
+
+General figure style and the PNG/HDF5 writers live in :mod:`phaseimpact.plotting`; what is only
+needed by the studies lives here.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import subprocess
+from pathlib import Path
+
+import numpy as np
+
+from phaseimpact import ContactLaw, archive
+
+ROOT = Path(__file__).resolve().parents[1]
+
+KAPPA_LABEL = "damping κ (N s/m$^{2.5}$)"
+V_LABEL = "impact speed v (m/s)"
+#: The two readings of eq. 8 (REFERENCE §3): printed |delta| (acts in tension too) and unilateral.
+READINGS = {"printed": ContactLaw("paper"), "unilateral": ContactLaw("paper", contact="unilateral")}
+READING_TEXT = {"printed": "paper, printed reading (acts in tension)",
+                "unilateral": "paper, unilateral reading (P = 0 for δ ≤ 0)"}
+#: Tolerances for counting stick phases near kappa_c: with the default absolute tolerances the
+#: engine misses the re-stick after a very small first slip (reported in the README and issue 14).
+COUNT_RTOL = 1e-12
+COUNT_ATOL = 1e-20
+
+
+def claim(doc: str) -> str:
+    """The study's docstring as one attribute string."""
+    return " ".join(doc.split())
+
+
+def loglog_fit(x, y) -> tuple[float, float]:
+    """Slope and intercept of ``log y`` against ``log x`` (finite, positive points only)."""
+    x, y = np.asarray(x, float), np.asarray(y, float)
+    ok = np.isfinite(x) & np.isfinite(y) & (x > 0) & (y > 0)
+    slope, intercept = np.polyfit(np.log(x[ok]), np.log(y[ok]), 1)
+    return float(slope), float(intercept)
+
+
+def code_epoch() -> str | None:
+    """Commit time of the last change to the code that computes the figures (not to ``figures/``).
+
+    Archives written by :func:`save_archive` carry it as their ``created`` time, so committing
+    regenerated figures does not change what the next ``make reproduce`` writes.
+    """
+    try:
+        out = subprocess.run(["git", "log", "-1", "--format=%ct", "--", "phaseimpact", "studies", "pyproject.toml"],
+                             cwd=ROOT, capture_output=True, text=True, timeout=30).stdout.strip()
+    except (OSError, subprocess.SubprocessError):
+        return None
+    return out if out.isdigit() else None
+
+
+@contextlib.contextmanager
+def _epoch(value: str | None):
+    old = os.environ.get("SOURCE_DATE_EPOCH")
+    if value is not None:
+        os.environ["SOURCE_DATE_EPOCH"] = value
+    try:
+        yield
+    finally:
+        if old is None:
+            os.environ.pop("SOURCE_DATE_EPOCH", None)
+        else:
+            os.environ["SOURCE_DATE_EPOCH"] = old
+
+
+def save_archive(result, path) -> str:
+    """:func:`phaseimpact.archive.save` (schema 2, ``archive.load`` reads it back) with a stable time stamp."""
+    Path(path).parent.mkdir(parents=True, exist_ok=True)
+    with _epoch(code_epoch()):
+        return archive.save(result, path, force=True)
+
+
+def kappa_axis(ax, which="x"):
+    """Label a damping axis (log scale)."""
+    if which == "x":
+        ax.set_xscale("log")
+        ax.set_xlabel(KAPPA_LABEL)
+    else:
+        ax.set_yscale("log")
+        ax.set_ylabel(KAPPA_LABEL)
+
+
+def outcome_of(trajectory) -> str:
+    """How a run of ``paper`` ended, in words for a legend or title."""
+    if trajectory.outcome == "permanent-stick":
+        return "permanent stick"
+    if trajectory.stop_reason == "runaway":
+        return "escape, then runaway (energy doubled)"
+    if trajectory.outcome == "ratchet-escape":
+        e = trajectory.restitution
+        return f"escape, then separation (e = {e:.3g})" if e is not None else "escape, then separation"
+    return trajectory.outcome
+
+
+def missed_restick(trajectory) -> bool:
+    """Whether the engine visibly missed a re-stick of ``paper`` (reported as a library defect).
+
+    Two signatures: an escape after a single stick phase (the first slip above kappa_c goes
+    deeper and is damped, so it always re-sticks), and a run that ends slipping with a mode whose
+    sign disagrees with ``deltadot`` (the zero crossing of ``deltadot`` was stepped over).
+    """
+    if trajectory.n_stick == 1 and trajectory.outcome != "permanent-stick":
+        return True
+    mode = trajectory.final_mode
+    y = trajectory.final_state
+    return mode in (1, -1) and (y[2] - y[3]) * mode < 0
+
+
+def log_ticks(axis, ticks) -> None:
+    """Plain-number major ticks on a log axis (``ax.xaxis`` or ``ax.yaxis``), no minor labels."""
+    from matplotlib.ticker import FixedLocator, NullFormatter, ScalarFormatter
+
+    axis.set_major_locator(FixedLocator(ticks))
+    formatter = ScalarFormatter()
+    formatter.set_scientific(False)
+    axis.set_major_formatter(formatter)
+    axis.set_minor_formatter(NullFormatter())
