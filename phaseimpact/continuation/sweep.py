@@ -137,19 +137,18 @@ class SweepResult:
     def store(self, indices: np.ndarray, columns) -> None:
         """Put a chunk's :class:`~phaseimpact.integrate.Columns` at flat ``indices``."""
         indices = np.asarray(indices, dtype=np.int64)
-        redo = np.isin(self.stick_point, indices)
-        if np.any(redo):  # a recomputed (previously failed) point replaces its old stick points
-            for name in ("stick_point", "stick_t", "stick_delta", "stick_dwell"):
-                setattr(self, name, getattr(self, name)[~redo])
+        if np.any(self.status[indices] >= 0):  # a recomputed (failed) point replaces its old stick phases
+            keep = ~np.isin(self.stick_point, indices)
+            for name in _STICK_FIELDS:
+                setattr(self, name, np.ascontiguousarray(getattr(self, name)[keep]))
         self.status[indices] = columns.status
         self.outcome[indices] = columns.outcome
         self.stop_reason[indices] = columns.stop_reason
         for name, values in columns.values.items():
             self.values[name][indices] = values
-        self.stick_point = np.concatenate([self.stick_point, np.repeat(indices, columns.stick_count)])
-        self.stick_t = np.concatenate([self.stick_t, columns.stick_t])
-        self.stick_delta = np.concatenate([self.stick_delta, columns.stick_delta])
-        self.stick_dwell = np.concatenate([self.stick_dwell, columns.stick_dwell])
+        new = (np.repeat(indices, columns.stick_count), columns.stick_t, columns.stick_delta, columns.stick_dwell)
+        for name, part in zip(_STICK_FIELDS, new, strict=True):
+            setattr(self, name, _append(getattr(self, name), part))
 
     def summary(self) -> dict:
         """Counts of outcomes and failures, for people."""
@@ -157,6 +156,24 @@ class SweepResult:
         return {"points": int(self.grid.size), "computed": int(np.count_nonzero(self.status >= 0)),
                 "failed": int(np.count_nonzero(self.failed)), "cut_by_horizon": int(np.count_nonzero(self.cut)),
                 "outcomes": {str(k): int(v) for k, v in zip(names, counts, strict=True)}}
+
+
+_STICK_FIELDS = ("stick_point", "stick_t", "stick_delta", "stick_dwell")
+
+
+def _append(array: np.ndarray, part: np.ndarray) -> np.ndarray:
+    """``array`` followed by ``part``, in a buffer grown by doubling: appending chunk after chunk
+    costs time proportional to the data, not to the number of chunks times the data."""
+    n, m = len(array), len(part)
+    base = array.base if isinstance(array.base, np.ndarray) and array.base.ndim == 1 else None
+    if base is not None and base.dtype == array.dtype and len(base) >= n + m \
+            and array.__array_interface__["data"][0] == base.__array_interface__["data"][0]:
+        buffer = base
+    else:
+        buffer = np.empty(max(2 * (n + m), 1024), dtype=array.dtype)
+        buffer[:n] = array
+    buffer[n:n + m] = part
+    return buffer[:n + m]
 
 
 def _check_previous(previous: SweepResult, grid: Grid, t_end, rtol) -> None:
