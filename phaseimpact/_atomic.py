@@ -21,7 +21,7 @@ import os
 import re
 import tempfile
 
-__all__ = ["PathLockedError", "atomic_path", "exclusive", "check_target"]
+__all__ = ["PathLockedError", "atomic_path", "exclusive", "check_target", "fsync_file", "fsync_folder"]
 
 
 class PathLockedError(ValueError):
@@ -173,7 +173,31 @@ def atomic_path(path, name: str = "path"):
             with open(tmp, "rb+") as handle:
                 os.fsync(handle.fileno())
             os.replace(tmp, path)
+            fsync_folder(folder)  # the rename itself survives a power cut
         except BaseException:
             if os.path.exists(tmp):
                 os.remove(tmp)
             raise
+
+
+def fsync_folder(folder: str) -> None:
+    """fsync a folder, so that a rename in it is on disk (a no-op where folders cannot be opened)."""
+    try:
+        fd = os.open(folder, os.O_RDONLY)
+    except OSError:
+        return
+    try:
+        os.fsync(fd)
+    except OSError:
+        pass
+    finally:
+        os.close(fd)
+
+
+def fsync_file(h5file) -> None:
+    """fsync an open HDF5 file (an ``h5py.File`` or its low-level ``FileID``) after its flush, so that
+    what HDF5 wrote is on disk before anything written after it."""
+    import h5py
+
+    fid = h5file.id if isinstance(h5file, h5py.File) else h5file
+    os.fsync(fid.get_vfd_handle())

@@ -1,44 +1,87 @@
-"""HDF5 archives of sweeps and ``kappa_c(v)`` curves, readable with plain h5py.
+"""HDF5 archives of sweeps, atlases and continued curves: netCDF-4 / CF-1.8 files that xarray opens as
+labelled arrays, and that plain h5py reads just as well.
 
-Schema (``schema_version`` 2; the README has the full table)::
+Layout (``schema_version`` 3). Every variable is in the root group, so
+``xarray.open_dataset(path, engine="h5netcdf")`` shows them all, with one dimension per axis::
 
-    /                      attrs: schema_version, package_version, kind ("sweep" | "critical-curve"),
-                                  law (JSON), parameters (JSON, SI), case (JSON, when the base is a case),
-                                  engine, rtol, t_end (s; NaN: each run until its outcome settles),
-                                  created (ISO 8601 UTC; from SOURCE_DATE_EPOCH when set)
-    /sweep                 attrs: axes (JSON list of axis names, C order)
-    /sweep/<axis>          (n_i,) float64  the axis values (an HDF5 dimension scale), e.g. /sweep/kappa
-    /sweep/status          shape  str      success, step-size-collapse, ...; "" where not computed
-    /sweep/outcome         shape  str      permanent-stick, ratchet-escape, rebound, runaway, ...
-    /sweep/stop_reason     shape  str      horizon, settled, runaway, asked, failed
-    /sweep/<column>        shape  float64 or int64, with a units attribute: max_force (N), n_stick, ...
-    /sweep/sticks/point    (m,)   int64    flat (C order) index of the point each stick phase belongs to
-    /sweep/sticks/t, delta, dwell (m,) float64  s, m, s (inf: a permanent stick)
-    /curve                 attrs: param, what, rtol, contact_index, message
-    /curve/<param>         (k,)   float64  the second parameter, e.g. /curve/v (m/s)
-    /curve/kappa           (k,)   float64  the continued kappa_c (or kappa_2, grazing); NaN where lost
-    /curve/requested       (k,)   bool     asked for (False: an intermediate step)
-    /curve/closed_form, predicted  (k,) float64
+    / attrs       Conventions "CF-1.8", schema_version 3, package_version, kind ("sweep": one axis,
+                  "atlas": two or more, "critical-curve"), law (JSON), contact (its reading of
+                  |delta|^alpha), base ("parameters" or "case"), case (JSON: the Case, or the
+                  Parameters), parameters (JSON, SI: the base's Parameters), engine, rtol, t_end (s;
+                  NaN: each run until its outcome settles), created (ISO 8601 UTC; from
+                  SOURCE_DATE_EPOCH when set), settings (JSON)
 
-Strings are variable-length UTF-8; plain h5py returns them as bytes unless read through
-``dataset.asstr()[()]``. Files are written to a temporary file in the same folder and renamed
-over the target, under the path's write lock (:mod:`phaseimpact._atomic`), so a reader (or a
-crash) only ever sees the previous file or the complete new one. Archives of schema 1 (phaseimpact
-0.1) still load.
+    sweep or atlas, grid shape (n_1, ..., n_d) in C order over the axes (attrs axes: the names,
+    dimensions: their netCDF names, columns: the summary columns stored, both JSON lists):
+    <axis>        (n_i,)  float64  a coordinate variable (HDF5 dimension scale) per axis, named by it
+                                   with characters other than letters, digits and _ made _
+                                   (plate.E -> plate_E); attrs units, long_name, parameter (the
+                                   original name), log (1: a log-spaced axis)
+    status        grid    int8     0 success, 1 step-size-collapse, 2 too-many-steps, 3 non-finite;
+                                   _FillValue -1: not computed (flag_values, flag_meanings)
+    outcome       grid    int8     failed, permanent-stick, ratchet-escape, rebound, runaway, bounded,
+                                   unsettled (flag_values, flag_meanings); _FillValue -1
+    stop_reason   grid    int8     horizon, settled, runaway, asked, failed; _FillValue -1
+    <column>      grid    float64 or int64: every summary column (max_force, n_stick, t_run, ...)
+                                   with its units (N, m, s, J, 1); _FillValue NaN or -1
+    stick_first   grid    int64    row of the point's first stick phase (-1: none or not computed)
+    stick_count   grid    int64    its number of stick phases (-1: not computed)
+    stick_point   (stick,) int64   flat (C order) index of each row's point: a CF indexed ragged
+                                   array, instance_dimension "point" (the grid stacked in C order,
+                                   ``ds.stack(point=dims)``); -1: an unused row
+    stick_t, stick_delta, stick_dwell  (stick,) float64  s, m, s (dwell inf: a permanent stick)
+    point, stick  netCDF dimensions without a variable: the grid's size, the rows
+
+    critical curve, k points (attrs param, what, contact_index, message):
+    <param>       (k,)  float64    coordinate variable, e.g. v (m s-1)
+    kappa         (k,)  float64    the continued kappa_c, kappa_2 or grazing value (long_name says
+                                   which), N s m-(1+alpha); NaN where lost
+    requested     (k,)  int8       1: asked for, 0: an intermediate step of the continuation
+    closed_form, predicted  (k,) float64
+
+    /extras       SweepResult.extras: arrays as datasets, dicts as groups, the rest as JSON in the
+                  group's attribute "json" (a group: the xarray root view leaves it out)
+
+Units are UDUNITS strings (``N s m-2.5`` for kappa with alpha = 1.5). A point is computed when its
+``status`` is not the fill value; its stick phases are rows ``stick_first .. stick_first +
+stick_count - 1`` (also found through ``stick_point``).
+
+Writing. :func:`save` writes the whole file to a temporary file beside the target, fsyncs it and
+renames it over the target, under the path's write lock (:mod:`phaseimpact._atomic`): a reader or a
+crash sees the previous file or the complete new one. :class:`Checkpoint` (a sweep's ``on_chunk``)
+writes in place instead: the datasets have fixed sizes, uncompressed chunks allocated when the file
+is made (C-order slabs of :data:`CHUNK_POINTS` points) and room for more stick phases, so a
+checkpoint only overwrites the bytes of the new points and appends their stick phases; no HDF5
+metadata changes. It is crash-safe by ordering (each step flushed and fsynced before the next):
+
+0. points being recomputed (they failed before) get status -1 (not computed);
+1. the new points' stick phases go to free rows, then their outcome, columns, ``stick_first`` and
+   ``stick_count``;
+2. last, their ``status``: the commit.
+
+A kill before step 2 leaves the new points at status -1: not computed, recomputed on resume; rows
+not referenced by a committed point's ``stick_first``/``stick_count`` are ignored by :func:`load`
+and reused. A kill during step 2 commits some of the new points, each complete. When the rows run
+out (or the file is not an archive of the same grid) a checkpoint rewrites the file atomically as
+:func:`save` does, with room for the stick phases still to come. Archives of schema 1
+(phaseimpact 0.1) and 2 (groups ``/sweep``, ``/curve``) still load.
 """
 
 from __future__ import annotations
 
 import datetime
+import hashlib
 import json
 import math
 import os
+import re
+from dataclasses import dataclass
 
 import h5py
 import numpy as np
 
 from . import __version__
-from ._atomic import atomic_path
+from ._atomic import atomic_path, exclusive, fsync_file
 from .continuation import CriticalCurve, SweepResult
 from .continuation.grid import Axis, Grid
 from .integrate import OUTCOMES, STATUSES
@@ -47,13 +90,39 @@ from .integrate.result import SUMMARY_COLUMNS
 from .model import ContactLaw
 from .parameters import Parameters
 
-__all__ = ["SCHEMA_VERSION", "KINDS", "save", "load", "describe", "same_work", "check_overwrite"]
+__all__ = ["SCHEMA_VERSION", "KINDS", "CHUNK_POINTS", "Checkpoint", "save", "load", "describe", "same_work",
+           "check_overwrite", "kind_of", "created_timestamp"]
 
-SCHEMA_VERSION = 2
-KINDS = ("sweep", "critical-curve")
-_STR = h5py.string_dtype("utf-8")
+SCHEMA_VERSION = 3
+KINDS = ("sweep", "atlas", "critical-curve")
+CONVENTIONS = "CF-1.8"
+#: Points of one chunk of a grid variable (a C-order slab; 64 KiB of float64).
+CHUNK_POINTS = 8192
+#: Rows of one chunk of the stick variables.
+CHUNK_ROWS = 8192
 STOP_REASONS = _driver.STOP_REASONS
+_STR = h5py.string_dtype("utf-8")
 _UNITS = {name: unit for name, _, _, unit in SUMMARY_COLUMNS}
+_DTYPES = {name: np.dtype(dtype) for name, _, dtype, _ in SUMMARY_COLUMNS}
+_CODES = {"status": STATUSES, "outcome": OUTCOMES, "stop_reason": STOP_REASONS}
+_LONG_NAMES = {
+    "status": "numerical health of the run", "outcome": "outcome class (REFERENCE section 5)",
+    "stop_reason": "why the run stopped", "t_stop": "time the run stopped", "max_force": "largest contact force",
+    "max_indentation": "largest indentation", "restitution": "coefficient of restitution (first contact)",
+    "contact_duration": "duration of the first contact", "dissipated_energy": "energy dissipated",
+    "loop_area": "work of the contact force (area of the force-indentation loop)",
+    "n_stick": "number of stick phases", "n_contacts": "number of contacts",
+    "t_run": "time the first stick broke (ratchet escape)", "first_stick_delta": "indentation of the first stick",
+    "first_stick_margin": "margin of the first stick (negative: it breaks)", "nsteps": "integrator steps",
+    "nfev": "right-hand side evaluations", "stick_first": "row of the point's first stick phase",
+    "stick_count": "number of stick phases stored", "stick_point": "flat (C order) index of the grid point",
+    "stick_t": "time the stick phase began", "stick_delta": "indentation of the stick phase",
+    "stick_dwell": "duration of the stick phase (inf: permanent)",
+}
+#: Datasets of a sweep that are not summary columns (an axis must not take these names).
+_RESERVED = ("status", "outcome", "stop_reason", "stick_first", "stick_count", "stick_point", "stick_t",
+             "stick_delta", "stick_dwell", "point", "stick", "extras")
+_NOT_A_VARIABLE = "This is a netCDF dimension but not a netCDF variable."
 
 
 # ------------------------------------------------------------------------------------------------
@@ -95,14 +164,222 @@ def _base_attrs(base) -> dict:
     from .case import Case
 
     if isinstance(base, Case):
-        return {"parameters": _json(base.parameters().as_dict()), "case": _json(base.as_dict())}
+        return {"base": "case", "parameters": _json(base.parameters().as_dict()), "case": _json(base.as_dict())}
     if isinstance(base, Parameters):
-        return {"parameters": _json(base.as_dict())}
+        params = _json(base.as_dict())
+        return {"base": "parameters", "parameters": params, "case": params}
     raise TypeError(f"cannot archive a base of type {type(base).__name__}")
 
 
+def _base_parameters(base) -> Parameters:
+    return base if isinstance(base, Parameters) else base.parameters()
+
+
+def kind_of(result) -> str:
+    """The archive kind of a result (or of a :class:`Grid`): ``sweep`` (one axis), ``atlas`` (two or
+    more) or ``critical-curve``."""
+    if isinstance(result, CriticalCurve):
+        return "critical-curve"
+    grid = result.grid if isinstance(result, SweepResult) else result
+    if not isinstance(grid, Grid):
+        raise TypeError(f"cannot archive a {type(result).__name__}")
+    return "sweep" if len(grid.axes) == 1 else "atlas"
+
+
 # ------------------------------------------------------------------------------------------------
-# Writing
+# Names and units that netCDF tools and unit parsers read
+# ------------------------------------------------------------------------------------------------
+
+def netcdf_name(name: str) -> str:
+    """An axis name as a netCDF / Python identifier: ``plate.E`` -> ``plate_E``."""
+    safe = re.sub(r"[^A-Za-z0-9_]", "_", name)
+    return safe if re.match(r"[A-Za-z_]", safe) else "_" + safe
+
+
+def _g(x: float) -> str:
+    return f"{x:.6g}"
+
+
+def _udunits(text: str) -> str:
+    """``kg/m^3`` -> ``kg m-3``, ``m/s`` -> ``m s-1``, ``-`` -> ``1`` (UDUNITS and pint read these)."""
+    text = text.strip()
+    if text in ("", "-"):
+        return "1"
+    top, _, bottom = text.partition("/")
+    words = [re.sub(r"\^\(?([-\d.]+)\)?", r"\1", w) for w in top.split()]
+    for w in bottom.split():
+        unit, _, power = w.partition("^")
+        power = power.strip("()") or "1"
+        words.append(f"{unit}-{power}" if not power.startswith("-") else f"{unit}{power[1:]}")
+    return " ".join(words)
+
+
+def kappa_units(alpha: float) -> str:
+    """Units of the damping coefficient: ``N s m-(1+alpha)``, e.g. ``N s m-2.5`` for Hertz."""
+    return f"N s m-{_g(1 + alpha)}"
+
+
+def axis_units(name: str, alpha: float) -> str:
+    """UDUNITS units of a grid axis or curve parameter (``alpha``: the base case's exponent)."""
+    from .case import SETTABLE
+
+    fixed = {"kappa": kappa_units(alpha), "K": f"N m-{_g(alpha)}", "v": "m s-1", "M1": "kg", "M2": "kg",
+             "Kb": "N m-1", "Km": "N m-3", "alpha": "1", "R": "m"}
+    if name in fixed:
+        return fixed[name]
+    return _udunits(SETTABLE[name][0]) if name in SETTABLE else "1"
+
+
+def _axis_names(names) -> list[str]:
+    out = []
+    for name in names:
+        safe = netcdf_name(name)
+        while safe in _RESERVED or safe in _UNITS or safe in out:
+            safe += "_axis"
+        out.append(safe)
+    return out
+
+
+# ------------------------------------------------------------------------------------------------
+# Low-level pieces: fixed-size datasets, dimensions, C-order boxes
+# ------------------------------------------------------------------------------------------------
+
+def _fill_of(dtype) -> np.generic:
+    dtype = np.dtype(dtype)
+    return dtype.type(np.nan) if dtype.kind == "f" else dtype.type(-1)
+
+
+def _slab_chunks(shape, target: int) -> tuple:
+    """Chunk shape whose chunks are contiguous runs of flat (C order) indices, about ``target`` long."""
+    chunks = [1] * len(shape)
+    room = max(1, int(target))
+    for i in reversed(range(len(shape))):
+        if shape[i] <= room:
+            chunks[i] = max(1, shape[i])
+            room = max(1, room // max(1, shape[i]))
+        else:
+            chunks[i] = room
+            break
+    return tuple(chunks)
+
+
+def _fixed(group, name, data, dtype, chunks, *, fill=None, fill_attr=True, units=None, dims=()):
+    """A dataset of fixed size whose chunks are allocated when it is made (writing into it later never
+    changes the file's metadata), holding ``data``."""
+    dtype = np.dtype(dtype)
+    fill = _fill_of(dtype) if fill is None else dtype.type(fill)
+    shape = np.shape(data)
+    if 0 in shape:
+        d = group.create_dataset(name, shape=shape, dtype=dtype, fillvalue=fill)
+    else:
+        dcpl = h5py.h5p.create(h5py.h5p.DATASET_CREATE)
+        dcpl.set_alloc_time(h5py.h5d.ALLOC_TIME_EARLY)
+        # every element is written just below: HDF5 need not write the fill value first
+        d = group.create_dataset(name, shape=shape, dtype=dtype, chunks=chunks, fillvalue=fill, fill_time="never",
+                                 dcpl=dcpl)
+        d[...] = data
+    if fill_attr:
+        d.attrs["_FillValue"] = fill
+    if units is not None:
+        d.attrs["units"] = units
+    if name in _LONG_NAMES:
+        d.attrs["long_name"] = _LONG_NAMES[name]
+    for i, scale in enumerate(dims):
+        d.dims[i].attach_scale(scale)
+    return d
+
+
+def _dimension(group, name: str, size: int):
+    """A netCDF dimension without a variable (as netCDF-C writes it: an empty dimension scale)."""
+    d = group.create_dataset(name, shape=(size,), dtype="f4")
+    d.make_scale(f"{_NOT_A_VARIABLE}{size:10d}")
+    return d
+
+
+def _flags(d, names) -> None:
+    d.attrs["flag_values"] = np.arange(len(names), dtype=np.int8)
+    d.attrs["flag_meanings"] = " ".join(names)
+
+
+def _boxes(lo: int, hi: int, shape) -> list:
+    """The flat (C order) range ``[lo, hi)`` of a grid as at most ``2 d - 1`` boxes (tuples of slices)."""
+    if lo >= hi:
+        return []
+    if len(shape) == 1:
+        return [(slice(lo, hi),)]
+    inner = int(np.prod(shape[1:]))
+    i0, r0 = divmod(lo, inner)
+    i1, r1 = divmod(hi, inner)
+    if i0 == i1:
+        return [(slice(i0, i0 + 1), *b) for b in _boxes(r0, r1, shape[1:])]
+    out = []
+    if r0:
+        out += [(slice(i0, i0 + 1), *b) for b in _boxes(r0, inner, shape[1:])]
+        i0 += 1
+    if i1 > i0:
+        out.append((slice(i0, i1), *(slice(0, n) for n in shape[1:])))
+    if r1:
+        out += [(slice(i1, i1 + 1), *b) for b in _boxes(0, r1, shape[1:])]
+    return out
+
+
+def _aligned_boxes(lo: int, hi: int, shape) -> list:
+    """Boxes that cover ``[lo, hi)``, widened to whole rows of the leading axes when that costs at most
+    ``max(hi - lo, CHUNK_POINTS)`` more points: fewer, larger writes (the points added are written
+    with the values they already have)."""
+    allowance = max(hi - lo, CHUNK_POINTS)
+    for k in range(1, len(shape)):
+        unit = int(np.prod(shape[k:]))
+        a, b = (lo // unit) * unit, -(-hi // unit) * unit
+        if (b - a) - (hi - lo) <= allowance:
+            return [(*box, *(slice(0, n) for n in shape[k:])) for box in _boxes(a // unit, b // unit, shape[:k])]
+    return _boxes(lo, hi, shape)
+
+
+#: Gaps of at most this many points between new points are written over (their bytes are the same).
+_GAP = 512
+_MAX_RUNS = 64
+
+
+def _runs(indices: np.ndarray) -> list[tuple[int, int]]:
+    """Sorted flat indices as ``[lo, hi)`` runs; short gaps are bridged and many runs become one."""
+    if indices.size == 0:
+        return []
+    breaks = np.flatnonzero(np.diff(indices) > _GAP + 1)
+    starts = np.concatenate([[0], breaks + 1])
+    stops = np.concatenate([breaks, [indices.size - 1]])
+    runs = [(int(indices[a]), int(indices[b]) + 1) for a, b in zip(starts, stops, strict=True)]
+    if len(runs) > _MAX_RUNS:
+        runs = [(runs[0][0], runs[-1][1])]
+    return runs
+
+
+def _stamp(path):
+    st = os.stat(path)
+    return st.st_dev, st.st_ino, st.st_size, st.st_mtime_ns
+
+
+def _digest(tree) -> str:
+    """A fingerprint of ``SweepResult.extras`` (a checkpoint rewrites the file when they change)."""
+    h = hashlib.sha256()
+
+    def walk(obj, key):
+        h.update(key.encode())
+        if isinstance(obj, dict):
+            for k in sorted(obj, key=str):
+                walk(obj[k], f"{key}/{k}")
+        elif isinstance(obj, np.ndarray):
+            h.update(f"{obj.dtype.str}{obj.shape}".encode())
+            h.update(np.ascontiguousarray(obj).tobytes())
+        else:
+            h.update(_json(obj).encode())
+
+    walk(tree, "")
+    return h.hexdigest()
+
+
+# ------------------------------------------------------------------------------------------------
+# Writing whole files
 # ------------------------------------------------------------------------------------------------
 
 def save(result: SweepResult | CriticalCurve, path, *, force: bool = False) -> str:
@@ -117,112 +394,512 @@ def save(result: SweepResult | CriticalCurve, path, *, force: bool = False) -> s
         is refused (``ValueError``); an existing archive is replaced. (The command line also refuses
         an archive of other work: see :func:`check_overwrite`.)
 
-    Raises ``ValueError`` (before writing anything) for a path that cannot be written, and
-    :class:`phaseimpact._atomic.PathLockedError` if another process is writing ``path``.
+    Returns the path. Raises ``ValueError`` (before writing anything) for a path that cannot be
+    written, and :class:`phaseimpact._atomic.PathLockedError` if another process is writing ``path``.
     """
     if not isinstance(result, (SweepResult, CriticalCurve)):
         raise TypeError(f"cannot archive a {type(result).__name__}")
-    path = os.fspath(path)
+    _write_file(result, os.fspath(path), force=force, spare_rows=0)
+    return os.fspath(path)
+
+
+def _write_file(result, path: str, *, force: bool, spare_rows: int):
+    """Write a whole archive atomically; a sweep's stick variables get ``spare_rows`` free rows.
+    Returns the sweep's per-point ``(stick_first, stick_count)`` (None for a curve)."""
+    created = created_timestamp()  # a bad SOURCE_DATE_EPOCH is refused before anything is written
+    layout = _sweep_layout(result) if isinstance(result, SweepResult) else None
     with atomic_path(path, "path") as tmp:
         if not force and os.path.isfile(path) and not _is_archive(path):
             raise ValueError(f"path = {path!r} exists and is not a phaseimpact archive; refusing to replace it "
                              "(force=True replaces it)")
         with h5py.File(tmp, "w") as f:
-            if isinstance(result, SweepResult):
-                _write_sweep(f, result)
+            if layout is None:
+                _write_curve(f, result, created)
             else:
-                _write_curve(f, result)
-    return path
+                _write_sweep(f, result, created, layout, spare_rows)
+    return None if layout is None else (layout.first, layout.count)
 
 
-def _header(f, kind: str, law: ContactLaw, base, t_end, rtol, engine: str) -> None:
-    f.attrs["schema_version"] = SCHEMA_VERSION
+def _header(f, kind: str, law: ContactLaw, base, t_end, rtol, engine: str, created: str, settings=None) -> None:
+    f.attrs["Conventions"] = CONVENTIONS
+    f.attrs["schema_version"] = np.int64(SCHEMA_VERSION)
     f.attrs["package_version"] = __version__
     f.attrs["kind"] = kind
     f.attrs["law"] = _json(law.as_dict())
+    f.attrs["contact"] = str(law.contact)
     for key, value in _base_attrs(base).items():
         f.attrs[key] = value
     f.attrs["engine"] = str(engine)
     f.attrs["rtol"] = _float(rtol)
     f.attrs["t_end"] = _float(t_end)
-    f.attrs["created"] = created_timestamp()
+    f.attrs["created"] = created
+    if settings is not None:
+        f.attrs["settings"] = _json(settings)
 
 
-def _dataset(group, name, data, units=None, dtype=None):
-    d = group.create_dataset(name, data=data, dtype=dtype)
-    if units is not None:
-        d.attrs["units"] = units
-    return d
+@dataclass
+class _Layout:
+    """Stick rows of a sweep arranged for the file: each point's rows contiguous."""
+
+    point: np.ndarray
+    t: np.ndarray
+    delta: np.ndarray
+    dwell: np.ndarray
+    first: np.ndarray
+    count: np.ndarray
 
 
-def _names(codes: np.ndarray, names) -> np.ndarray:
-    table = np.array([*names, ""], dtype=object)
-    codes = np.asarray(codes).astype(np.int64)
-    return table[np.where(codes < 0, len(names), codes)]
+def _sweep_layout(r: SweepResult) -> _Layout:
+    n = r.grid.size
+    for name in ("status", "outcome", "stop_reason"):
+        codes = np.asarray(getattr(r, name))
+        if codes.shape != (n,):
+            raise ValueError(f"{name} has shape {codes.shape}; allowed: ({n},), one code per grid point")
+    point = np.asarray(r.stick_point, dtype=np.int64)
+    columns = [np.asarray(getattr(r, f"stick_{k}"), dtype=float) for k in ("t", "delta", "dwell")]
+    if any(c.shape != point.shape for c in columns) or point.ndim != 1:
+        raise ValueError("stick_point, stick_t, stick_delta and stick_dwell must be 1-d arrays of one length")
+    if point.size and (point.min() < 0 or point.max() >= n):
+        raise ValueError(f"stick_point is out of range; allowed: flat indices 0 <= i < {n}")
+    computed = np.asarray(r.status) >= 0
+    if point.size and not computed[point].all():
+        raise ValueError("stick phases of points that are not computed (status -1) cannot be archived")
+    if point.size:
+        starts = np.concatenate([[0], np.flatnonzero(point[1:] != point[:-1]) + 1])
+        if np.unique(point[starts]).size != starts.size:  # a point's rows are apart: group them, in order
+            order = np.argsort(point, kind="stable")
+            point = point[order]
+            columns = [c[order] for c in columns]
+            starts = np.concatenate([[0], np.flatnonzero(point[1:] != point[:-1]) + 1])
+    else:
+        starts = np.empty(0, dtype=np.int64)
+    count = np.where(computed, np.bincount(point, minlength=n), -1).astype(np.int64)
+    first = np.full(n, -1, dtype=np.int64)
+    first[point[starts]] = starts
+    return _Layout(point, *columns, first, count)
 
 
-def _codes(strings: np.ndarray, names) -> np.ndarray:
-    lookup = {name: i for i, name in enumerate(names)}
-    lookup[""] = -1
-    try:
-        return np.array([lookup[s] for s in strings.ravel()], dtype=np.int8).reshape(strings.shape)
-    except KeyError as error:
-        raise ValueError(f"unknown code {error.args[0]!r}; allowed: one of {', '.join(names)}") from None
-
-
-def _write_sweep(f, r: SweepResult) -> None:
-    _header(f, "sweep", r.law, r.grid.base, r.t_end, r.settings.get("rtol"), r.settings.get("engine", ""))
-    g = f.create_group("sweep")
-    shape = r.grid.shape
-    g.attrs["axes"] = _json(list(r.grid.names))
+def _write_sweep(f, r: SweepResult, created: str, layout: _Layout, spare_rows: int) -> None:
+    grid = r.grid
+    shape = grid.shape
+    alpha = _base_parameters(grid.base).alpha
+    _header(f, kind_of(r), r.law, grid.base, r.t_end, r.settings.get("rtol"), r.settings.get("engine", ""), created,
+            r.settings)
+    dims = _axis_names(grid.names)
+    f.attrs["axes"] = _json(list(grid.names))
+    f.attrs["dimensions"] = _json(dims)
+    columns = list(r.values)
+    f.attrs["columns"] = _json(columns)
+    f.attrs["extras_digest"] = _digest(r.extras)
     scales = []
-    for axis in r.grid.axes:
-        d = _dataset(g, axis.name, np.asarray(axis.values, dtype=float), _axis_units(axis.name))
-        d.attrs["log"] = bool(axis.log)
-        d.make_scale(axis.name)
+    for axis, dim in zip(grid.axes, dims, strict=True):
+        d = f.create_dataset(dim, data=np.asarray(axis.values, dtype=float))
+        d.make_scale(dim)
+        d.attrs["units"] = axis_units(axis.name, alpha)
+        d.attrs["long_name"] = axis.name
+        d.attrs["parameter"] = axis.name
+        d.attrs["log"] = np.int8(bool(axis.log))
         scales.append(d)
+    _dimension(f, "point", grid.size)
+    chunks = _slab_chunks(shape, CHUNK_POINTS)
 
-    def gridded(name, data, units=None, dtype=None):
-        d = _dataset(g, name, np.asarray(data).reshape(shape), units, dtype)
-        for i, scale in enumerate(scales):
-            d.dims[i].attach_scale(scale)
+    def gridded(name, data, dtype, units=None):
+        d = _fixed(f, name, np.asarray(data).reshape(shape), dtype, chunks, units=units, dims=scales)
+        if name in _CODES:
+            _flags(d, _CODES[name])
         return d
 
-    gridded("status", _names(r.status, STATUSES), dtype=_STR)
-    gridded("outcome", _names(r.outcome, OUTCOMES), dtype=_STR)
-    gridded("stop_reason", _names(r.stop_reason, STOP_REASONS), dtype=_STR)
-    for name, values in r.values.items():
-        gridded(name, values, _UNITS.get(name, ""))
-    s = g.create_group("sticks")
-    s.attrs["layout"] = "indexed ragged: row j is a stick phase of the point with flat (C order) index point[j]"
-    _dataset(s, "point", np.asarray(r.stick_point, dtype=np.int64), "1")
-    _dataset(s, "t", np.asarray(r.stick_t, dtype=float), "s")
-    _dataset(s, "delta", np.asarray(r.stick_delta, dtype=float), "m")
-    _dataset(s, "dwell", np.asarray(r.stick_dwell, dtype=float), "s")
+    for name in ("status", "outcome", "stop_reason"):
+        gridded(name, getattr(r, name), np.int8)
+    for name in columns:
+        values = np.asarray(r.values[name])
+        if values.shape != (grid.size,):
+            raise ValueError(f"column {name} has shape {values.shape}; allowed: ({grid.size},)")
+        gridded(name, values, values.dtype, _UNITS.get(name))
+    gridded("stick_first", layout.first, np.int64)
+    gridded("stick_count", layout.count, np.int64)
+
+    rows = layout.point.size + max(0, int(spare_rows))
+    stick = _dimension(f, "stick", rows)
+    row_chunks = (min(CHUNK_ROWS, max(rows, 1)),)
+
+    def padded(values, fill):
+        out = np.full(rows, fill, dtype=values.dtype)
+        out[:values.size] = values
+        return out
+
+    sp = _fixed(f, "stick_point", padded(layout.point, -1), np.int64, row_chunks, fill=-1, fill_attr=False,
+                units="1", dims=(stick,))
+    sp.attrs["instance_dimension"] = "point"
+    for name, values, units in (("stick_t", layout.t, "s"), ("stick_delta", layout.delta, "m"),
+                                ("stick_dwell", layout.dwell, "s")):
+        _fixed(f, name, padded(values, np.nan), float, row_chunks, units=units, dims=(stick,))
+    if r.extras:
+        _write_tree(f.create_group("extras"), r.extras)
 
 
-def _axis_units(name: str) -> str:
-    from .case import SETTABLE
+def _write_tree(group, tree: dict) -> None:
+    rest = {}
+    for key, value in tree.items():
+        key = str(key)
+        if isinstance(value, dict):
+            _write_tree(group.create_group(key), value)
+            continue
+        array = np.asarray(value) if isinstance(value, (np.ndarray, list, tuple)) else None
+        if array is not None and array.dtype.kind in "biuf" and array.size:
+            d = group.create_dataset(key, data=array.astype(np.int8) if array.dtype.kind == "b" else array)
+            d.attrs["type"] = "bool" if array.dtype.kind == "b" else "array"
+        else:
+            rest[key] = value
+    group.attrs["json"] = _json(rest)
 
-    units = {"kappa": "N s/m^(1+alpha)", "v": "m/s", "M1": "kg", "M2": "kg", "K": "N/m^alpha", "Kb": "N/m",
-             "Km": "N/m^3", "alpha": "1", "R": "m"}
-    return units.get(name) or SETTABLE.get(name, ("",))[0]
 
-
-def _write_curve(f, c: CriticalCurve) -> None:
-    _header(f, "critical-curve", c.law, c.base, None, c.rtol, "")
-    g = f.create_group("curve")
-    g.attrs["param"] = c.param
-    g.attrs["what"] = c.what
-    g.attrs["rtol"] = float(c.rtol)
-    g.attrs["contact_index"] = int(c.contact_index)
-    g.attrs["message"] = str(c.message)
-    values = _dataset(g, c.param, np.asarray(c.values, dtype=float), _axis_units(c.param))
-    values.make_scale(c.param)
-    for name in ("kappa", "requested", "closed_form", "predicted"):
-        data = np.asarray(getattr(c, name), dtype=bool if name == "requested" else float)
-        d = _dataset(g, name, data, None if name == "requested" else "N s/m^(1+alpha)")
+def _write_curve(f, c: CriticalCurve, created: str) -> None:
+    _header(f, "critical-curve", c.law, c.base, None, c.rtol, "", created)
+    alpha = _base_parameters(c.base).alpha
+    dim = _axis_names([c.param])[0]
+    f.attrs["param"] = c.param
+    f.attrs["what"] = c.what
+    f.attrs["contact_index"] = np.int64(c.contact_index)
+    f.attrs["message"] = str(c.message)
+    values = f.create_dataset(dim, data=np.asarray(c.values, dtype=float))
+    values.make_scale(dim)
+    values.attrs["units"] = axis_units(c.param, alpha)
+    values.attrs["long_name"] = c.param
+    values.attrs["parameter"] = c.param
+    for name in ("kappa", "closed_form", "predicted"):
+        d = f.create_dataset(name, data=np.asarray(getattr(c, name), dtype=float))
+        d.attrs["_FillValue"] = np.float64(np.nan)
+        d.attrs["units"] = kappa_units(alpha)
+        d.attrs["long_name"] = {"kappa": c.what, "closed_form": "closed-form kappa_c (REFERENCE section 5)",
+                                "predicted": "the continuation's prediction"}[name]
         d.dims[0].attach_scale(values)
+    d = f.create_dataset("requested", data=np.asarray(c.requested, dtype=bool).astype(np.int8))
+    d.attrs["flag_values"] = np.array([0, 1], dtype=np.int8)
+    d.attrs["flag_meanings"] = "intermediate requested"
+    d.attrs["long_name"] = "asked for (0: an intermediate step of the continuation)"
+    d.dims[0].attach_scale(values)
+
+
+# ------------------------------------------------------------------------------------------------
+# Checkpoints written in place
+# ------------------------------------------------------------------------------------------------
+
+@dataclass
+class _OnDisk:
+    """What a checkpointed file holds, mirrored in memory so that a checkpoint reads nothing."""
+
+    stamp: tuple
+    shape: tuple
+    status: np.ndarray      # int8 per point
+    first: np.ndarray       # int64 per point
+    count: np.ndarray       # int64 per point
+    capacity: int           # stick rows
+    free: int               # first free row
+    rows: int               # stick rows of committed points (= rows of the result in memory)
+    failed: np.ndarray      # committed failed points (recomputed on resume)
+    failed_snapshot: dict   # their codes and columns, to see whether a recomputation changed them
+    columns: list
+
+
+class Checkpoint:
+    """Write a growing sweep or atlas to ``path``: pass it as ``on_chunk`` of
+    :func:`~phaseimpact.continuation.atlas` (or ``sweep``), and call :func:`save` once at the end.
+
+    The first call writes the file whole (atomically, as :func:`save`, with room for the stick phases
+    still to come); later calls write only the points computed since the previous call, in place, in
+    the crash-safe order described in the module docstring. A file that is not an archive of the same
+    grid (law, base, axes, ``t_end``, ``rtol``, columns, extras) is rewritten whole, as is one whose
+    spare stick rows are used up. ``path``'s write lock is taken for every call (re-entrant: a caller
+    may hold it for the whole sweep).
+
+    Parameters
+    ----------
+    path : str or path-like
+    force : bool
+        As for :func:`save`: replace a file that is not a phaseimpact archive.
+    fsync : bool
+        fsync after each step, so that the order also holds after a power cut (not only after a
+        killed process). Default True.
+
+    Attributes
+    ----------
+    in_place, rewrites : int
+        How many calls wrote in place, and how many rewrote the whole file.
+    """
+
+    def __init__(self, path, *, force: bool = False, fsync: bool = True):
+        self.path = os.fspath(path)
+        self.force = bool(force)
+        self.fsync = bool(fsync)
+        self.in_place = 0
+        self.rewrites = 0
+        self._disk: _OnDisk | None = None
+
+    def __repr__(self) -> str:
+        return f"Checkpoint({self.path!r}, in_place={self.in_place}, rewrites={self.rewrites})"
+
+    def __call__(self, result: SweepResult) -> None:
+        if not isinstance(result, SweepResult):
+            raise TypeError(f"Checkpoint writes a SweepResult, not a {type(result).__name__}")
+        with exclusive(self.path, "path"):
+            try:
+                if self._write_in_place(result):
+                    self.in_place += 1
+                else:
+                    self._rewrite(result)
+                    self.rewrites += 1
+            except BaseException:
+                self._disk = None  # whatever happened, read the file again next time
+                raise
+
+    # -- whole file -----------------------------------------------------------------------------
+
+    def _rewrite(self, r: SweepResult) -> None:
+        n = r.grid.size
+        status = np.asarray(r.status)
+        computed = int(np.count_nonzero(status >= 0))
+        per_point = max(1.0, len(r.stick_point) / computed) if computed else 2.0
+        remaining = n - int(np.count_nonzero(status == _driver.SUCCESS))
+        spare = int(math.ceil(1.25 * per_point * remaining)) + 1024
+        first, count = _write_file(r, self.path, force=self.force, spare_rows=spare)
+        rows = len(r.stick_point)
+        self._disk = _OnDisk(_stamp(self.path), r.grid.shape, status.astype(np.int8, copy=True), first, count,
+                             rows + spare, rows, rows, np.empty(0, dtype=np.int64), {}, list(r.values))
+        self._remember_failed(r, np.flatnonzero(status > _driver.SUCCESS))
+
+    def _remember_failed(self, r: SweepResult, failed: np.ndarray) -> None:
+        disk = self._disk
+        disk.failed = failed
+        disk.failed_snapshot = {"outcome": np.asarray(r.outcome)[failed].copy(),
+                                "stop_reason": np.asarray(r.stop_reason)[failed].copy(),
+                                **{k: np.asarray(v)[failed].copy() for k, v in r.values.items()}}
+
+    # -- reading the file's state ---------------------------------------------------------------
+
+    def _read_disk(self, r: SweepResult) -> _OnDisk | None:
+        """The file's state if it is a schema-3 archive of ``r``'s grid that can be written in place."""
+        path = self.path
+        if not os.path.isfile(path) or not _is_archive(path):
+            return None
+        stamp = _stamp(path)
+        with h5py.File(path, "r+", locking=False) as f:
+            if int(f.attrs["schema_version"]) != SCHEMA_VERSION or not _same_grid(f, r):
+                return None
+            if any(name not in f for name in ("status", "stick_first", "stick_count", "stick_point")):
+                return None
+            status = f["status"][()].reshape(-1)
+            first = f["stick_first"][()].reshape(-1).astype(np.int64)
+            count = f["stick_count"][()].reshape(-1).astype(np.int64)
+            capacity = int(f["stick_point"].shape[0])
+            committed = (status >= 0) & (count > 0)
+            free = int((first[committed] + count[committed]).max()) if committed.any() else 0
+            rows = int(count[committed].sum())
+            disk = _OnDisk(stamp, r.grid.shape, status.astype(np.int8), first, count, capacity, free, rows,
+                           np.empty(0, dtype=np.int64), {}, json.loads(_attr_str(f, "columns")))
+            failed = np.flatnonzero(status > _driver.SUCCESS)
+            disk.failed = failed
+            if failed.size:
+                snapshot = {}
+                for name in ("outcome", "stop_reason", *disk.columns):
+                    snapshot[name] = f[name][()].reshape(-1)[failed]
+                disk.failed_snapshot = snapshot
+            # rows no committed point owns (a killed checkpoint, a recomputed point) are marked unused,
+            # so that readers of stick_point alone do not see them
+            if capacity:
+                point = f["stick_point"][()]
+                owned = np.zeros(capacity, dtype=bool)
+                owned[_owned_rows(first, count, status >= 0)] = True
+                stale = (point != -1) & ~owned
+                if stale.any():
+                    point[stale] = -1
+                    f["stick_point"][...] = point
+        disk.stamp = _stamp(path)
+        return disk
+
+    # -- in place ---------------------------------------------------------------------------------
+
+    def _write_in_place(self, r: SweepResult) -> bool:
+        """Write the points of ``r`` that differ from the file; False when a whole rewrite is needed."""
+        disk = self._disk
+        if disk is not None and (not os.path.exists(self.path) or disk.stamp != _stamp(self.path)):
+            disk = None
+        if disk is None:
+            disk = self._disk = self._read_disk(r)
+            if disk is None:
+                return False
+        if r.grid.shape != disk.shape or list(r.values) != disk.columns:
+            return False
+        status = np.asarray(r.status)
+        new = np.flatnonzero(status != disk.status)
+        if disk.failed.size:
+            new = np.union1d(new, disk.failed[self._changed_failed(r)])
+        if new.size == 0:
+            return True
+        if np.any(status[new] < 0):
+            return False  # a point went back to "not computed": not a continuation of the file
+        # the new points' stick phases: appended by SweepResult.store since the last checkpoint, so
+        # they lie after the rows of the points committed then, less the rows of recomputed points
+        point = np.asarray(r.stick_point, dtype=np.int64)
+        failed_rows = int(disk.count[disk.failed].sum()) if disk.failed.size else 0
+        start = max(0, disk.rows - failed_rows)
+        mine = np.zeros(r.grid.size, dtype=bool)
+        mine[new] = True
+        window = point[start:]
+        if window.size and (window.min() < 0 or window.max() >= r.grid.size):
+            return False
+        selected = np.flatnonzero(mine[window])
+        rows = start + selected
+        owner = np.searchsorted(new, window[selected])
+        if owner.size and np.any(np.diff(owner) < 0):
+            order = np.argsort(owner, kind="stable")
+            rows, owner = rows[order], owner[order]
+        counts = np.bincount(owner, minlength=new.size).astype(np.int64)
+        recomputed = new[disk.status[new] >= 0]
+        expected = disk.rows - int(disk.count[recomputed].sum()) + rows.size
+        if point.size != expected or disk.free + rows.size > disk.capacity:
+            return False  # not the continuation of the file, or no room left: rewrite it whole
+        self._commit(r, new, recomputed, rows, counts)
+        return True
+
+    def _changed_failed(self, r: SweepResult) -> np.ndarray:
+        disk = self._disk
+        idx = disk.failed
+        changed = np.zeros(idx.size, dtype=bool)
+        for name, old in disk.failed_snapshot.items():
+            now = np.asarray(getattr(r, name) if name in ("outcome", "stop_reason") else r.values[name])[idx]
+            differs = now != old
+            if now.dtype.kind == "f":
+                differs &= ~(np.isnan(now) & np.isnan(old))
+            changed |= differs
+        return changed
+
+    def _flush(self, raw) -> None:
+        raw.flush()
+        if self.fsync:
+            fsync_file(raw.fid)
+
+    def _commit(self, r: SweepResult, new, recomputed, rows, counts) -> None:
+        disk = self._disk
+        shape = disk.shape
+        boxes = [b for lo, hi in _runs(new) for b in _aligned_boxes(lo, hi, shape)]
+        old_first, old_count = disk.first[recomputed].copy(), disk.count[recomputed].copy()
+        with _Raw(self.path) as raw:
+            # 0. points recomputed over a committed (failed) state are first marked not computed
+            if recomputed.size:
+                disk.status[recomputed] = -1
+                for lo, hi in _runs(recomputed):
+                    for box in _boxes(lo, hi, shape):
+                        raw.write("status", box, disk.status.reshape(shape))
+                self._flush(raw)
+            # 1. stick phases to free rows, then every column of the new points
+            n_rows = rows.size
+            if n_rows:
+                lo = disk.free
+                raw.write_rows("stick_point", lo, new[np.repeat(np.arange(new.size), counts)])
+                for name in ("t", "delta", "dwell"):
+                    raw.write_rows(f"stick_{name}", lo, np.asarray(getattr(r, f"stick_{name}"), dtype=float)[rows])
+            offsets = np.cumsum(counts) - counts
+            disk.first[new] = np.where(counts > 0, disk.free + offsets, -1)
+            disk.count[new] = counts
+            sources = {"outcome": r.outcome, "stop_reason": r.stop_reason, **r.values,
+                       "stick_first": disk.first, "stick_count": disk.count}
+            for name, values in sources.items():
+                grid_values = np.asarray(values).reshape(shape)
+                for box in boxes:
+                    raw.write(name, box, grid_values)
+            self._flush(raw)
+            # 2. the commit: the new points' status
+            disk.status[new] = np.asarray(r.status)[new]
+            for box in boxes:
+                raw.write("status", box, disk.status.reshape(shape))
+            self._flush(raw)
+            # 3. rows of recomputed points are no one's now
+            for a, c in zip(old_first, old_count, strict=True):
+                if a >= 0 and c > 0:
+                    raw.write_rows("stick_point", int(a), np.full(int(c), -1, dtype=np.int64))
+        disk.free += n_rows
+        disk.rows = len(r.stick_point)
+        disk.stamp = _stamp(self.path)
+        touched = np.union1d(disk.failed, new)
+        self._remember_failed(r, touched[disk.status[touched] > _driver.SUCCESS])
+
+
+class _Raw:
+    """An archive opened for in-place writes through HDF5's low-level API (no HDF5 file locking: the
+    sidecar lock of :mod:`phaseimpact._atomic` keeps writers apart, and readers may look on)."""
+
+    def __init__(self, path: str):
+        fapl = h5py.h5p.create(h5py.h5p.FILE_ACCESS)
+        fapl.set_file_locking(False, True)
+        self.fid = h5py.h5f.open(os.fsencode(path), h5py.h5f.ACC_RDWR, fapl=fapl)
+        self._datasets = {}
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        for d in self._datasets.values():
+            d.close()
+        self._datasets.clear()
+        self.fid.close()
+
+    def _dataset(self, name: str):
+        d = self._datasets.get(name)
+        if d is None:
+            d = self._datasets[name] = h5py.h5d.open(self.fid, name.encode())
+        return d
+
+    def _put(self, name: str, start: tuple, block: np.ndarray) -> None:
+        d = self._dataset(name)
+        block = np.ascontiguousarray(block, dtype=d.dtype)
+        space = d.get_space()
+        space.select_hyperslab(start, block.shape)
+        d.write(h5py.h5s.create_simple(block.shape), space, block)
+
+    def write(self, name: str, box: tuple, grid_values: np.ndarray) -> None:
+        """Write ``grid_values[box]`` (a grid-shaped array) into the same box of dataset ``name``."""
+        self._put(name, tuple(s.start for s in box), grid_values[box])
+
+    def write_rows(self, name: str, lo: int, values: np.ndarray) -> None:
+        """Write ``values`` into rows ``lo, lo + 1, ...`` of the 1-d dataset ``name``."""
+        self._put(name, (lo,), values)
+
+    def flush(self) -> None:
+        h5py.h5f.flush(self.fid)
+
+
+def _owned_rows(first, count, committed) -> np.ndarray:
+    """Rows referenced by the committed points' ``stick_first``/``stick_count``, in point order."""
+    points = np.flatnonzero(committed & (count > 0) & (first >= 0))
+    counts = count[points]
+    total = int(counts.sum())
+    if total == 0:
+        return np.empty(0, dtype=np.int64)
+    offsets = np.repeat(np.cumsum(counts) - counts, counts)
+    return np.repeat(first[points], counts) + (np.arange(total) - offsets)
+
+
+def _same_grid(f, r: SweepResult) -> bool:
+    """Whether the open file ``f`` archives the grid, law, base and settings of ``r``."""
+    grid = r.grid
+    try:
+        if _attr_str(f, "kind") != kind_of(r) or json.loads(_attr_str(f, "axes")) != list(grid.names):
+            return False
+        if json.loads(_attr_str(f, "law")) != json.loads(_json(r.law.as_dict())):
+            return False
+        base = _base_attrs(grid.base)
+        if any(_attr_str(f, key) != value for key, value in base.items()):
+            return False
+        if not (_same_number(f.attrs["t_end"], r.t_end) and _same_number(f.attrs["rtol"], r.settings.get("rtol"))):
+            return False
+        if _attr_str(f, "extras_digest") != _digest(r.extras):
+            return False
+        dims = json.loads(_attr_str(f, "dimensions"))
+        return all(np.array_equal(f[dim][()], np.asarray(axis.values, dtype=float))
+                   for dim, axis in zip(dims, grid.axes, strict=True))
+    except (KeyError, TypeError, ValueError):
+        return False
 
 
 # ------------------------------------------------------------------------------------------------
@@ -243,7 +920,7 @@ def _open(path):
 
 def _is_archive(path) -> bool:
     try:
-        with h5py.File(path, "r") as f:
+        with h5py.File(path, "r", locking=False) as f:
             return "schema_version" in f.attrs and "kind" in f.attrs
     except OSError:
         return False
@@ -276,17 +953,22 @@ def _law(f) -> ContactLaw:
 
 
 def _base(f):
-    if "case" in f.attrs:
-        from .case import case_from_dict
+    from .case import case_from_dict
 
+    if "base" in f.attrs:  # schema 3: case holds the Case, or the Parameters
+        data = json.loads(_attr_str(f, "case"))
+        return case_from_dict(data, origin="archive") if _attr_str(f, "base") == "case" else Parameters(**data)
+    if "case" in f.attrs:  # schema 2: case only when the base is a case
         return case_from_dict(json.loads(_attr_str(f, "case")), origin="archive")
     return Parameters(**json.loads(_attr_str(f, "parameters")))
 
 
 def load(path):
-    """Read an archive back: a :class:`SweepResult` or a :class:`CriticalCurve`.
+    """Read an archive back: a :class:`SweepResult` (with its :class:`Grid`) or a :class:`CriticalCurve`.
 
-    Raises ``ValueError`` for a missing, foreign, truncated or newer-schema file.
+    Points of an archive in progress that are not committed (status -1) come back as not computed,
+    whatever else a killed checkpoint left of them. Raises ``ValueError`` for a missing, foreign,
+    truncated, damaged or newer-schema file.
     """
     path = os.fspath(path)
     with _open(path) as f:
@@ -295,8 +977,10 @@ def load(path):
         try:
             if version == 1:
                 return _read_sweep_v1(f) if kind == "sweep" else _read_curve_v1(f)
-            return _read_sweep(f) if kind == "sweep" else _read_curve(f)
-        except (KeyError, OSError, TypeError, json.JSONDecodeError) as error:
+            if version == 2:
+                return _read_sweep_v2(f) if kind == "sweep" else _read_curve_v2(f)
+            return _read_curve(f) if kind == "critical-curve" else _read_sweep(f)
+        except (KeyError, OSError, TypeError, ValueError, IndexError, json.JSONDecodeError) as error:
             raise ValueError(f"{path!r} is an incomplete or damaged phaseimpact archive: {error}") from None
 
 
@@ -305,7 +989,86 @@ def _t_end(f):
     return None if math.isnan(t_end) else t_end
 
 
+def _settings(f) -> dict:
+    if "settings" in f.attrs:
+        return json.loads(_attr_str(f, "settings"))
+    return {"rtol": float(f.attrs["rtol"]), "engine": _attr_str(f, "engine"),
+            "version": _attr_str(f, "package_version")}
+
+
+def _axes(f) -> tuple:
+    names = json.loads(_attr_str(f, "axes"))
+    dims = json.loads(_attr_str(f, "dimensions"))
+    return tuple(Axis(name, f[dim][()], bool(f[dim].attrs.get("log", 0))) for name, dim in zip(names, dims,
+                                                                                             strict=True))
+
+
 def _read_sweep(f) -> SweepResult:
+    grid = Grid(_base(f), _law(f), _axes(f))
+    status = f["status"][()].reshape(-1).astype(np.int8)
+    computed = status >= 0
+    codes = {}
+    for name in ("outcome", "stop_reason"):
+        codes[name] = np.where(computed, f[name][()].reshape(-1), -1).astype(np.int8)
+    values = {}
+    for name in json.loads(_attr_str(f, "columns")):
+        column = f[name][()].reshape(-1)
+        if not computed.all():
+            column = np.where(computed, column, _fill_of(column.dtype))
+        values[name] = column
+    first = f["stick_first"][()].reshape(-1).astype(np.int64)
+    count = f["stick_count"][()].reshape(-1).astype(np.int64)
+    rows = _owned_rows(first, count, computed)
+    owner = np.repeat(np.flatnonzero(computed & (count > 0) & (first >= 0)),
+                      count[computed & (count > 0) & (first >= 0)])
+    order = np.argsort(rows, kind="stable")
+    rows, owner = rows[order], owner[order]
+    capacity = f["stick_point"].shape[0]
+    if rows.size and (rows[-1] >= capacity or np.any(np.diff(rows) == 0)):
+        raise ValueError("stick_first/stick_count point outside the stick rows or overlap")
+    point = f["stick_point"][()][rows] if rows.size else np.empty(0, dtype=np.int64)
+    if not np.array_equal(point, owner):
+        raise ValueError("stick_point disagrees with stick_first/stick_count")
+    sticks = {name: (f[f"stick_{name}"][()][rows] if rows.size else np.empty(0)) for name in ("t", "delta", "dwell")}
+    result = SweepResult(grid, _t_end(f), _settings(f), status=status, outcome=codes["outcome"],
+                         stop_reason=codes["stop_reason"], stick_point=point.astype(np.int64), stick_t=sticks["t"],
+                         stick_delta=sticks["delta"], stick_dwell=sticks["dwell"],
+                         extras=_read_tree(f["extras"]) if "extras" in f else {})
+    result.values.update(values)
+    return result
+
+
+def _read_tree(group) -> dict:
+    tree = json.loads(_attr_str(group, "json")) if "json" in group.attrs else {}
+    for key, item in group.items():
+        if isinstance(item, h5py.Group):
+            tree[key] = _read_tree(item)
+        else:
+            data = item[()]
+            tree[key] = data.astype(bool) if _attr_str(item, "type") == "bool" else data
+    return tree
+
+
+def _read_curve(f) -> CriticalCurve:
+    param = _attr_str(f, "param")
+    dim = _axis_names([param])[0]
+    return CriticalCurve(param, f[dim][()], f["kappa"][()], f["requested"][()].astype(bool), f["closed_form"][()],
+                         f["predicted"][()], _attr_str(f, "what"), _law(f), _base(f), float(f.attrs["rtol"]),
+                         int(f.attrs["contact_index"]), _attr_str(f, "message"))
+
+
+# -- schema 2 (groups /sweep and /curve, codes as strings) ------------------------------------------
+
+def _codes(strings: np.ndarray, names) -> np.ndarray:
+    lookup = {name: i for i, name in enumerate(names)}
+    lookup[""] = -1
+    try:
+        return np.array([lookup[s] for s in strings.ravel()], dtype=np.int8).reshape(strings.shape)
+    except KeyError as error:
+        raise ValueError(f"unknown code {error.args[0]!r}; allowed: one of {', '.join(names)}") from None
+
+
+def _read_sweep_v2(f) -> SweepResult:
     g = f["sweep"]
     names = json.loads(_attr_str(g, "axes"))
     axes = tuple(Axis(name, g[name][()], bool(g[name].attrs.get("log", False))) for name in names)
@@ -326,7 +1089,7 @@ def _read_sweep(f) -> SweepResult:
     return result
 
 
-def _read_curve(f) -> CriticalCurve:
+def _read_curve_v2(f) -> CriticalCurve:
     g = f["curve"]
     param = _attr_str(g, "param")
     return CriticalCurve(param, g[param][()], g["kappa"][()], g["requested"][()].astype(bool), g["closed_form"][()],
@@ -334,7 +1097,9 @@ def _read_curve(f) -> CriticalCurve:
                          int(g.attrs["contact_index"]), _attr_str(g, "message"))
 
 
-#: Schema 1 (phaseimpact 0.1) outcome names in today's terms.
+# -- schema 1 (phaseimpact 0.1) ----------------------------------------------------------------------
+
+#: Schema 1 outcome names in today's terms.
 _V1_OUTCOMES = {"stick": "permanent-stick", "rest": "permanent-stick", "rebound": "rebound", "runaway": "runaway",
                 "bounded-oscillation": "bounded", "failed": "failed", "": ""}
 
@@ -386,7 +1151,8 @@ def describe(path) -> dict:
     """The identity of the work an archive holds, read from its header and axes only.
 
     Returns ``{"kind", "law", "parameters", "axes", "t_end", "rtol", "schema_version"}``
-    (``axes``: ``{name: values}``). Raises ``ValueError`` if ``path`` is not a phaseimpact archive.
+    (``axes``: ``{name: values}``, names as given, e.g. ``plate.E``). Raises ``ValueError`` if
+    ``path`` is not a phaseimpact archive.
     """
     path = os.fspath(path)
     with _open(path) as f:
@@ -395,7 +1161,13 @@ def describe(path) -> dict:
         try:
             law = ContactLaw(**json.loads(_attr_str(f, "law"))).as_dict()
             params = json.loads(_attr_str(f, "parameters"))
-            if kind == "sweep":
+            if version >= 3:
+                if kind == "critical-curve":
+                    param = _attr_str(f, "param")
+                    axes = {param: f[_axis_names([param])[0]][()]}
+                else:
+                    axes = {axis.name: axis.values for axis in _axes(f)}
+            elif kind == "sweep":
                 g = f["sweep"]
                 names = ["kappa"] if version == 1 else json.loads(_attr_str(g, "axes"))
                 axes = {name: g[name][()] for name in names}

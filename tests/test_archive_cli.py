@@ -34,31 +34,8 @@ def small_sweep():
 
 
 # ------------------------------------------------------------------------------------------------
-# Schema
+# Schema (the layout, xarray and plain h5py: tests/test_archive.py)
 # ------------------------------------------------------------------------------------------------
-
-def test_archive_round_trip_and_plain_h5py(tmp_path, small_sweep):
-    path = tmp_path / "s.h5"
-    archive.save(small_sweep, path)
-    with h5py.File(path, "r") as f:  # plain h5py, documented names and units
-        assert f.attrs["schema_version"] == archive.SCHEMA_VERSION
-        assert f["sweep/kappa"].attrs["units"] == "N s/m^(1+alpha)"
-        assert f["sweep/max_force"].attrs["units"] == "N"
-        assert json.loads(f.attrs["parameters"])["M1"] == small_sweep.grid.base.M1
-        outcome = f["sweep/outcome"].asstr()[()]  # strings come back as str through .asstr()
-        assert all(isinstance(s, str) for s in outcome)
-        assert list(outcome) == list(small_sweep.outcome_names())
-        points = f["sweep/sticks/point"][()]
-        assert np.array_equal(np.bincount(points, minlength=8), f["sweep/n_stick"][()])
-    back = archive.load(path)
-    assert np.array_equal(back.kappa, small_sweep.kappa)
-    assert np.array_equal(back.status, small_sweep.status) and np.array_equal(back.outcome, small_sweep.outcome)
-    for name, values in small_sweep.values.items():
-        assert np.array_equal(back.values[name], values, equal_nan=values.dtype.kind == "f"), name
-    assert np.array_equal(back.stick_delta, small_sweep.stick_delta)
-    assert back.law == small_sweep.law and back.grid.base == small_sweep.grid.base
-    assert back.t_end is None and back.settings["rtol"] == small_sweep.settings["rtol"]
-
 
 def test_archive_rejects_foreign_truncated_and_newer(tmp_path, small_sweep):
     foreign = tmp_path / "foreign.h5"
