@@ -979,8 +979,8 @@ def cmd_plot(args) -> int:
     return EXIT_OK
 
 
-#: Samples drawn along each portrait's trajectory.
-PORTRAIT_SAMPLES = 4001
+#: Samples drawn along each portrait's trajectory (at least one per integrator step, up to 16).
+PORTRAIT_SAMPLES = 400_000
 
 
 def cmd_portrait(args) -> int:
@@ -1002,7 +1002,13 @@ def cmd_portrait(args) -> int:
             end += 2 * period  # show the stuck pair's orbit on the plate springs for two periods
         if not end > 0:
             end = summary.t_end
-        times = np.linspace(0.0, end, PORTRAIT_SAMPLES)
+        # sample where the integrator needed steps (contacts, slips), a few points per step
+        steps = simulate(p, setup.law, end, rtol=args.rtol, save="steps", stop_when_settled=False).t
+        per_step = int(np.clip(PORTRAIT_SAMPLES // max(len(steps), 1), 1, 16))
+        fine = steps[:-1, None] + np.diff(steps)[:, None] * (np.arange(per_step) / per_step)
+        first = np.linspace(0.0, min(end, 3 * scales(p).contact_time), 401)  # the first contact, finely
+        times = np.unique(np.concatenate([fine.ravel(), steps, first, np.linspace(0.0, end, 401)]))
+        times = times[(times >= 0) & (times <= end)]
         drawn.append(simulate(p, setup.law, end, rtol=args.rtol, save=times, stop_when_settled=False))
         summaries.append(summary)
     title = f"{setup.law.label()}, {setup.case.name}, v = {setup.params.v:g} m/s, {setup.params.target} target"
@@ -1037,7 +1043,10 @@ def _settable_help() -> str:
 
 
 def build_parser() -> argparse.ArgumentParser:
-    parser = _Parser(prog="phaseimpact", description=__doc__.split("\n\n")[0].replace("\n", " "),
+    parser = _Parser(prog="phaseimpact", description="Impact models analysed as dynamical systems: one impact, "
+                                                     "the critical damping and the other transitions, sweeps, "
+                                                     "atlases and continued curves over a case's parameters, and "
+                                                     "their figures.",
                      epilog="SI units throughout. Exit codes: 0 done, 1 numerical failure (reported), "
                             "2 bad input (nothing computed), 130 interrupted.")
     parser.add_argument("--version", action="version", version=f"phaseimpact {__version__}")

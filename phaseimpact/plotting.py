@@ -267,8 +267,10 @@ def plot_atlas(result, *, contours: str | None = None, curves=()):
         ax.set_xlim(_edges(ax0.values, ax0.log)[[0, -1]])
         ax.set_ylim(_edges(ax1.values, ax1.log)[[0, -1]])
         _outcome_legend(ax, present, ax.get_legend_handles_labels()[0])
+        computed = int(np.count_nonzero(result.status >= 0))
+        partial = f" ({computed} computed)" if computed < result.grid.size else ""
         ax.set_title(f"{result.law.label()}, case {_case_name(result.grid.base)}: "
-                     f"{result.shape[0]} x {result.shape[1]} points")
+                     f"{result.shape[0]} x {result.shape[1]} points{partial}")
     return fig
 
 
@@ -438,7 +440,7 @@ def plot_portraits(trajectories, plane=("delta", "deltadot"), *, summaries=None,
                 counts += " (at least: cut)"
             if not summary.ok:
                 counts += f"; {summary.status}"
-            ax.set_title(rf"$\kappa$ = {kappa:.4g}: {summary.outcome}" + f"\n{counts}")
+            ax.set_title(rf"$\kappa$ = {kappa:.6g}: {summary.outcome}" + f"\n{counts}")
             ax.legend(loc="best", fontsize=6)
         for k in range(n, nrows * ncols):
             axes[k // ncols, k % ncols].set_visible(False)
