@@ -92,7 +92,7 @@ def main(quick=False, jobs=1):
         ax.axvline(kc, color="k", ls="--", lw=0.8)
         kappa_axis(ax)
         ax.set_ylabel("dissipated energy (mJ)")
-        ax.set_title("energy lost (paper has no Hertz potential)\n< 0: gained; −M1 v²/2: stopped when doubled")
+        ax.set_title("energy lost (paper: no Hertz potential)\nnegative = gained; floor = stopped at 2 E0")
         ax.legend(loc="lower left", fontsize=6)
         ax.set_xlabel(KAPPA_LABEL)
         out = save(fig, FIGURES / f"{NAME}.png")

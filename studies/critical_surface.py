@@ -16,13 +16,13 @@ the seed's geometry and 7 % for a 20 mm plate or a 50 mm ball at 0.3 m/s.
 from pathlib import Path
 
 import numpy as np
-from _plots import KAPPA_LABEL, V_LABEL, loglog_fit, save_archive
+from _plots import KAPPA_LABEL, V_LABEL, claim, loglog_fit, save_archive
 from matplotlib.ticker import NullFormatter
 
 from phaseimpact import scales
 from phaseimpact.case import apply_settings, load_case
 from phaseimpact.continuation import critical_curve, critical_damping
-from phaseimpact.plotting import figure, save, style
+from phaseimpact.plotting import figure, save, save_h5, style
 
 FIGURES = Path(__file__).resolve().parents[1] / "figures"
 NAME = "critical_surface"
@@ -95,12 +95,14 @@ def main(quick=False, jobs=1):
         ax.set_title("closed form: exact for a slow plate")
         ax.legend(loc="lower right", fontsize=5, ncol=2)
         out = save(fig, FIGURES / f"{NAME}.png")
-    print(f"R1 = 2 mm, v = 1 m/s: {missing.status}: {missing.message}")
+    summary = {"claim": claim(__doc__), "R1_2mm_v1_status": missing.status, "R1_2mm_v1_message": missing.message,
+               "kappa_c_R1_slope_v1": slope_r1}
     for key, c in curves.items():
-        err = np.abs(c.closed_form / c.kappa - 1)
-        print(f"{key:10s} kappa_c {c.kappa.min():.3g}..{c.kappa.max():.3g}, "
-              f"closed-form error {err.min():.2g}..{err.max():.2g}, "
-              f"T/T_plate {ratio[key].min():.2g}..{ratio[key].max():.2g} {c.message}")
+        summary[f"{key}/closed_form_error_max"] = float(np.max(np.abs(c.closed_form / c.kappa - 1)))
+        summary[f"{key}/kappa_c_range"] = f"{c.kappa.min():.4g}..{c.kappa.max():.4g}"
+        summary[f"{key}/message"] = c.message
+    save_h5(FIGURES / "data" / f"{NAME}.h5",
+            {f"{key.replace('=', '_')}/ratio": (ratio[key], "1") for key in curves}, summary)
     return out
 
 

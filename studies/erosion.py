@@ -155,11 +155,6 @@ def main(quick=False, jobs=1):
             {"case": CASE, "law": LAW, "yield_strength": Y, "first_yield_pressure": limit,
              "v_first_yield": v_yield, "v_contact_ratio_limit": v_radius, "pressure_exponent": float(p_fit[0]),
              "cases": json.dumps(cases), "claim": claim(__doc__)})
-    for c in cases:
-        print(f"{c['name']:14s} v {c['v']:5g} R1 {c['R1']:.3g} F {c['peak_force_N']:.3g} N "
-              f"p0 {c['peak_pressure_Pa']:.3g} "
-              f"T {c['contact_time_s']:.3g} s p0/1.6Y {c['pressure_to_first_yield']} | {c['validity'][:60]}")
-    print(f"first yield at v = {v_yield:.3g} m/s, contact radius 0.3 R1 at {v_radius:.3g} m/s")
     return out
 
 
