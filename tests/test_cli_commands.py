@@ -199,6 +199,7 @@ def test_simulate_with_a_horizon_says_when_it_cut_the_run():
 # critical, transitions
 # ------------------------------------------------------------------------------------------------
 
+@pytest.mark.slow  # the kappa_2 search: several seconds
 def test_critical_json_kappa_c_against_the_closed_form_and_kappa_2_above():
     out = run_json(["critical", "--law", "paper", "--v", "1"])
     assert_finite(out)
@@ -231,6 +232,7 @@ def test_transitions_hunt_crossley_are_grazings_and_agree_with_contact_counts():
             assert single["n_contacts"] == t[key], (t, factor)
 
 
+@pytest.mark.slow  # the kappa_2 search: several seconds
 def test_transitions_paper_starts_at_kappa_c():
     out = run_json(["transitions", "--law", "paper", "--v", "1", "--kappa-min", "1e11", "--kappa-max", "1e13"])
     kinds = [t["kind"] for t in out["transitions"]]
@@ -258,8 +260,8 @@ def test_critical_curve_over_v_archive_round_trip_and_independent_searches(tmp_p
     with h5py.File(path) as f:
         assert json.loads(f.attrs["case"])["name"] == "seed"
     # the last point, reached by continuation from the first, against an independent search there
-    single = run_json(["critical", "--law", "paper", "--v", "3"])
-    assert out["kappa"][-1] == pytest.approx(single["kappa_c"], rel=1e-8)
+    single = continuation.critical_damping(curve.base.parameters(v=3.0), "paper")
+    assert out["kappa"][-1] == pytest.approx(single.kappa_c, rel=1e-8)
     closed = np.asarray(out["closed_form"])
     assert np.allclose(out["kappa"], closed, rtol=2.5e-3)  # REFERENCE §5 at every speed
     # the old spelling: log-spaced speeds
