@@ -725,7 +725,10 @@ class Checkpoint:
         if disk is not None and (not os.path.exists(self.path) or disk.stamp != _stamp(self.path)):
             disk = None
         if disk is None:
-            disk = self._disk = self._read_disk(r)
+            try:
+                disk = self._disk = self._read_disk(r)
+            except OSError:  # unreadable, or open in this process with HDF5 file locking: rewrite it
+                disk = None
             if disk is None:
                 return False
         if r.grid.shape != disk.shape or list(r.values) != disk.columns:
@@ -759,7 +762,13 @@ class Checkpoint:
         expected = disk.rows - int(disk.count[recomputed].sum()) + rows.size
         if point.size != expected or disk.free + rows.size > disk.capacity:
             return False  # not the continuation of the file, or no room left: rewrite it whole
-        self._commit(r, new, recomputed, rows, counts)
+        try:
+            raw = _Raw(self.path)
+        except OSError:  # e.g. open elsewhere in this process with HDF5 file locking: rewrite it
+            return False
+        with raw:
+            self._commit(raw, r, new, recomputed, rows, counts)
+        self._disk.stamp = _stamp(self.path)  # after the close: what the next call must find
         return True
 
     def _changed_failed(self, r: SweepResult) -> np.ndarray:
@@ -779,48 +788,46 @@ class Checkpoint:
         if self.fsync:
             fsync_file(raw.fid)
 
-    def _commit(self, r: SweepResult, new, recomputed, rows, counts) -> None:
+    def _commit(self, raw, r: SweepResult, new, recomputed, rows, counts) -> None:
         disk = self._disk
         shape = disk.shape
         boxes = [b for lo, hi in _runs(new) for b in _aligned_boxes(lo, hi, shape)]
         old_first, old_count = disk.first[recomputed].copy(), disk.count[recomputed].copy()
-        with _Raw(self.path) as raw:
-            # 0. points recomputed over a committed (failed) state are first marked not computed
-            if recomputed.size:
-                disk.status[recomputed] = -1
-                for lo, hi in _runs(recomputed):
-                    for box in _boxes(lo, hi, shape):
-                        raw.write("status", box, disk.status.reshape(shape))
-                self._flush(raw)
-            # 1. stick phases to free rows, then every column of the new points
-            n_rows = rows.size
-            if n_rows:
-                lo = disk.free
-                raw.write_rows("stick_point", lo, new[np.repeat(np.arange(new.size), counts)])
-                for name in ("t", "delta", "dwell"):
-                    raw.write_rows(f"stick_{name}", lo, np.asarray(getattr(r, f"stick_{name}"), dtype=float)[rows])
-            offsets = np.cumsum(counts) - counts
-            disk.first[new] = np.where(counts > 0, disk.free + offsets, -1)
-            disk.count[new] = counts
-            sources = {"outcome": r.outcome, "stop_reason": r.stop_reason, **r.values,
-                       "stick_first": disk.first, "stick_count": disk.count}
-            for name, values in sources.items():
-                grid_values = np.asarray(values).reshape(shape)
-                for box in boxes:
-                    raw.write(name, box, grid_values)
+        # 0. points recomputed over a committed (failed) state are first marked not computed
+        if recomputed.size:
+            disk.status[recomputed] = -1
+            for lo, hi in _runs(recomputed):
+                for box in _boxes(lo, hi, shape):
+                    raw.write("status", box, disk.status.reshape(shape))
             self._flush(raw)
-            # 2. the commit: the new points' status
-            disk.status[new] = np.asarray(r.status)[new]
+        # 1. stick phases to free rows, then every column of the new points
+        n_rows = rows.size
+        if n_rows:
+            lo = disk.free
+            raw.write_rows("stick_point", lo, new[np.repeat(np.arange(new.size), counts)])
+            for name in ("t", "delta", "dwell"):
+                raw.write_rows(f"stick_{name}", lo, np.asarray(getattr(r, f"stick_{name}"), dtype=float)[rows])
+        offsets = np.cumsum(counts) - counts
+        disk.first[new] = np.where(counts > 0, disk.free + offsets, -1)
+        disk.count[new] = counts
+        sources = {"outcome": r.outcome, "stop_reason": r.stop_reason, **r.values,
+                   "stick_first": disk.first, "stick_count": disk.count}
+        for name, values in sources.items():
+            grid_values = np.asarray(values).reshape(shape)
             for box in boxes:
-                raw.write("status", box, disk.status.reshape(shape))
-            self._flush(raw)
-            # 3. rows of recomputed points are no one's now
-            for a, c in zip(old_first, old_count, strict=True):
-                if a >= 0 and c > 0:
-                    raw.write_rows("stick_point", int(a), np.full(int(c), -1, dtype=np.int64))
+                raw.write(name, box, grid_values)
+        self._flush(raw)
+        # 2. the commit: the new points' status
+        disk.status[new] = np.asarray(r.status)[new]
+        for box in boxes:
+            raw.write("status", box, disk.status.reshape(shape))
+        self._flush(raw)
+        # 3. rows of recomputed points are no one's now
+        for a, c in zip(old_first, old_count, strict=True):
+            if a >= 0 and c > 0:
+                raw.write_rows("stick_point", int(a), np.full(int(c), -1, dtype=np.int64))
         disk.free += n_rows
         disk.rows = len(r.stick_point)
-        disk.stamp = _stamp(self.path)
         touched = np.union1d(disk.failed, new)
         self._remember_failed(r, touched[disk.status[touched] > _driver.SUCCESS])
 
@@ -919,11 +926,13 @@ def _open(path):
 
 
 def _is_archive(path) -> bool:
-    try:
-        with h5py.File(path, "r", locking=False) as f:
-            return "schema_version" in f.attrs and "kind" in f.attrs
-    except OSError:
-        return False
+    for locking in (False, None):  # None: as another h5py.File of this process may hold it open
+        try:
+            with h5py.File(path, "r", locking=locking) as f:
+                return "schema_version" in f.attrs and "kind" in f.attrs
+        except OSError:
+            continue
+    return False
 
 
 def _attr_str(f, key) -> str:

@@ -338,7 +338,7 @@ def test_schema_2_archives_still_load(tmp_path, small_atlas):
 # Checkpoints: in place, only the new points
 # ------------------------------------------------------------------------------------------------
 
-def test_each_checkpoint_loads_back_as_the_result_in_memory(tmp_path, small_atlas, chunks_of_5):
+def test_each_checkpoint_loads_back_as_the_result_in_memory(tmp_path, monkeypatch, small_atlas, chunks_of_5):
     path = tmp_path / "atlas.h5"
     checkpoint = archive.Checkpoint(path)
     seen = []
@@ -348,9 +348,13 @@ def test_each_checkpoint_loads_back_as_the_result_in_memory(tmp_path, small_atla
         assert_same_result(archive.load(path), result)
         seen.append(int(np.count_nonzero(result.status >= 0)))
 
+    reads = []
+    read_disk = archive.Checkpoint._read_disk
+    monkeypatch.setattr(archive.Checkpoint, "_read_disk", lambda self, r: reads.append(1) or read_disk(self, r))
     result = atlas(seed_parameters(), "paper", AXES, on_chunk=check)
     assert seen == [5, 10, 15, 20, 25, 28]
     assert (checkpoint.rewrites, checkpoint.in_place) == (1, 5)  # made once, then written in place
+    assert len(reads) == 1  # only before the file existed: later calls know what it holds
     assert_same_result(result, small_atlas)
     with xr.open_dataset(path, engine="h5netcdf") as ds:
         assert int(ds.status.notnull().sum()) == 28
@@ -486,6 +490,28 @@ def test_checkpoint_refuses_a_foreign_file_and_replaces_other_work(tmp_path, sma
     checkpoint(other)  # an archive of other work is replaced whole, never written into
     assert checkpoint.rewrites == 1
     assert_same_result(archive.load(notes), other)
+
+
+def test_checkpoint_notices_a_file_replaced_or_held_open(tmp_path, small_atlas, chunks_of_5):
+    """A file replaced between checkpoints is read again, never written into blindly; one held open by
+    h5py in this process (HDF5 file locking) is rewritten whole instead of failing the sweep."""
+    path = tmp_path / "atlas.h5"
+    checkpoint = archive.Checkpoint(path)
+    calls = []
+
+    def meddle(result):
+        calls.append(1)
+        if len(calls) == 5:
+            with h5py.File(path, "r"):
+                checkpoint(result)
+        else:
+            checkpoint(result)
+        if len(calls) == 2:  # someone saves other work over it
+            archive.save(atlas(seed_parameters(), "paper", {"kappa": [1e11, 1e12]}), path)
+
+    result = atlas(seed_parameters(), "paper", AXES, on_chunk=meddle)
+    assert (checkpoint.rewrites, checkpoint.in_place) == (3, 3)  # the 1st, the 3rd and the 5th (held open)
+    assert_same_result(archive.load(path), result)
 
 
 # ------------------------------------------------------------------------------------------------
