@@ -971,7 +971,8 @@ def cmd_plot(args) -> int:
         else:
             raise ValueError(f"archive = {args.archive!r} has {ndim} axes ({', '.join(result.grid.names)}); "
                              "allowed: 1 (a sweep) or 2 (an atlas)")
-    plotting.save(fig, args.out)
+    with exclusive(args.out, "out"):
+        plotting.save(fig, args.out)
     if args.json:
         _print_json({"out": args.out, "archive": args.archive, "kind": kind})
     else:
@@ -983,15 +984,12 @@ def cmd_plot(args) -> int:
 PORTRAIT_SAMPLES = 400_000
 
 
-def cmd_portrait(args) -> int:
-    from . import plotting
+def _portrait_runs(args, setup: Setup):
+    """Each ``--kappa``'s run until its outcome settles (for the events, the counts and the title) and
+    the same run sampled for drawing: where the integrator stepped (a few points per step) and the
+    first contact finely; a permanent stick is drawn on for two plate periods (the stuck pair's orbit)."""
     from .integrate import scales, simulate
 
-    _check_figure_target(args.out, args.force)
-    setup = _setup(args)
-    _check_reads_kappa(setup.law, "panel")
-    plane = tuple(args.plane.split(","))
-    _note(f"integrating {len(args.kappas)} trajectories of {setup.law.label()}")
     summaries, drawn = [], []
     period = scales(setup.params).plate_period
     for kappa in args.kappas:
@@ -999,21 +997,32 @@ def cmd_portrait(args) -> int:
         summary = simulate(p, setup.law, args.t_end, rtol=args.rtol)
         end = summary.t_stop
         if args.t_end is None and summary.outcome == "permanent-stick" and math.isfinite(period):
-            end += 2 * period  # show the stuck pair's orbit on the plate springs for two periods
+            end += 2 * period
         if not end > 0:
             end = summary.t_end
-        # sample where the integrator needed steps (contacts, slips), a few points per step
         steps = simulate(p, setup.law, end, rtol=args.rtol, save="steps", stop_when_settled=False).t
         per_step = int(np.clip(PORTRAIT_SAMPLES // max(len(steps), 1), 1, 16))
         fine = steps[:-1, None] + np.diff(steps)[:, None] * (np.arange(per_step) / per_step)
-        first = np.linspace(0.0, min(end, 3 * scales(p).contact_time), 401)  # the first contact, finely
+        first = np.linspace(0.0, min(end, 3 * scales(p).contact_time), 401)
         times = np.unique(np.concatenate([fine.ravel(), steps, first, np.linspace(0.0, end, 401)]))
         times = times[(times >= 0) & (times <= end)]
         drawn.append(simulate(p, setup.law, end, rtol=args.rtol, save=times, stop_when_settled=False))
         summaries.append(summary)
-    title = f"{setup.law.label()}, {setup.case.name}, v = {setup.params.v:g} m/s, {setup.params.target} target"
-    fig = plotting.plot_portraits(drawn, plane, summaries=summaries, title=title)
-    plotting.save(fig, args.out)
+    return summaries, drawn
+
+
+def cmd_portrait(args) -> int:
+    from . import plotting
+
+    _check_figure_target(args.out, args.force)
+    setup = _setup(args)
+    _check_reads_kappa(setup.law, "panel")
+    plane = tuple(args.plane.split(","))
+    _note(f"integrating {len(args.kappas)} trajectories of {setup.law.label()}")
+    with exclusive(args.out, "out"):  # one writer: a second one is refused now, not after the work
+        summaries, drawn = _portrait_runs(args, setup)
+        title = f"{setup.law.label()}, {setup.case.name}, v = {setup.params.v:g} m/s, {setup.params.target} target"
+        plotting.save(plotting.plot_portraits(drawn, plane, summaries=summaries, title=title), args.out)
     panels = [{"kappa": float(k), "outcome": tr.outcome, "status": tr.status, "stop_reason": tr.stop_reason,
                "n_stick": tr.n_stick, "n_contacts": tr.n_contacts, "cut": tr.cut, "t_stop": tr.t_stop}
               for k, tr in zip(args.kappas, summaries, strict=True)]
