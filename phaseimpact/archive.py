@@ -101,7 +101,6 @@ CHUNK_POINTS = 8192
 #: Rows of one chunk of the stick variables.
 CHUNK_ROWS = 8192
 STOP_REASONS = _driver.STOP_REASONS
-_STR = h5py.string_dtype("utf-8")
 _UNITS = {name: unit for name, _, _, unit in SUMMARY_COLUMNS}
 _DTYPES = {name: np.dtype(dtype) for name, _, dtype, _ in SUMMARY_COLUMNS}
 _CODES = {"status": STATUSES, "outcome": OUTCOMES, "stop_reason": STOP_REASONS}
