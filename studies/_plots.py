@@ -43,13 +43,14 @@ def loglog_fit(x, y) -> tuple[float, float]:
 
 
 def code_epoch() -> str | None:
-    """Commit time of the last change to the code that computes the figures (not to ``figures/``).
+    """Commit time of the last change to ``studies/`` (the scripts that define the figures).
 
-    Archives written by :func:`save_archive` carry it as their ``created`` time, so committing
-    regenerated figures does not change what the next ``make reproduce`` writes.
+    Archives written by :func:`save_archive` carry it as their ``created`` time, so neither
+    committing regenerated figures nor a library commit that leaves the results alone changes
+    what the next ``make reproduce`` writes (the archives also record the package version).
     """
     try:
-        out = subprocess.run(["git", "log", "-1", "--format=%ct", "--", "phaseimpact", "studies", "pyproject.toml"],
+        out = subprocess.run(["git", "log", "-1", "--format=%ct", "--", "studies"],
                              cwd=ROOT, capture_output=True, text=True, timeout=30).stdout.strip()
     except (OSError, subprocess.SubprocessError):
         return None
