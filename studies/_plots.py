@@ -38,6 +38,8 @@ def loglog_fit(x, y) -> tuple[float, float]:
     """Slope and intercept of ``log y`` against ``log x`` (finite, positive points only)."""
     x, y = np.asarray(x, float), np.asarray(y, float)
     ok = np.isfinite(x) & np.isfinite(y) & (x > 0) & (y > 0)
+    if ok.sum() < 2:  # e.g. a quick preview without points in the fit range
+        return float("nan"), float("nan")
     slope, intercept = np.polyfit(np.log(x[ok]), np.log(y[ok]), 1)
     return float(slope), float(intercept)
 
