@@ -59,9 +59,10 @@ metadata changes. It is crash-safe by ordering (each step flushed and fsynced be
    ``stick_count``;
 2. last, their ``status``: the commit.
 
-A kill before step 2 leaves the new points at status -1: not computed, recomputed on resume; rows
-not referenced by a committed point's ``stick_first``/``stick_count`` are ignored by :func:`load`
-and reused. A kill during step 2 commits some of the new points, each complete. When the rows run
+A kill before step 2 leaves the new points at status -1: not computed, recomputed on resume (their
+other variables may hold the interrupted values until then; :func:`load` returns them as not
+computed); rows not referenced by a committed point's ``stick_first``/``stick_count`` are ignored by
+:func:`load` and reused. A kill during step 2 commits some of the new points, each complete. When the rows run
 out (or the file is not an archive of the same grid) a checkpoint rewrites the file atomically as
 :func:`save` does, with room for the stick phases still to come. Archives of schema 1
 (phaseimpact 0.1) and 2 (groups ``/sweep``, ``/curve``) still load.
