@@ -22,10 +22,12 @@ from phaseimpact.integrate.events import (
     EVENT_KINDS,
     FORCE_RATE,
     N_EVENTS,
+    PAIR_CENTRE,
     REACH,
     STICK_BREAK,
     STOP_RUNAWAY,
     STOP_SETTLED,
+    departure_sign,
     energy_limit_of,
     event_values,
     initial_mode,
@@ -105,9 +107,10 @@ def oracle(params, law, t_end=None, *, rtol=1e-12, method="DOP853", settle=True,
         for col in range(N_EVENTS):
             ev = column(col)
             ev.terminal = bool(restarts(code, col, mode, settle) or col == ENERGY)
-            natural = {DELTA: 0, DELTADOT: 0, FORCE_RATE: -1, STICK_BREAK: -1, ENERGY: -1, REACH: 1}[col]
+            natural = {DELTA: 0, DELTADOT: 0, FORCE_RATE: -1, STICK_BREAK: -1, ENERGY: -1, REACH: 1,
+                       PAIR_CENTRE: 0}[col]
             if natural == 0:  # the next crossing is to the other side of where the phase starts
-                start = g0[col] if g0[col] != 0 else (y[2] - y[3] if col == DELTA else (mode or 1))
+                start = g0[col] if g0[col] != 0 else departure_sign(col, y, mode)
                 natural = -1 if start > 0 else 1
             ev.direction = natural
             events.append(ev)
@@ -139,7 +142,8 @@ def oracle(params, law, t_end=None, *, rtol=1e-12, method="DOP853", settle=True,
         max_force = max(max_force, *(rhs(code, c, sol.y[:, i], mode, out) for i in range(sol.y.shape[1])))
         kind_code, mode, action = transition(code, c, col, y_ev, mode, settle)
         force = rhs(code, c, y_ev, mode, out)
-        kinds.append(EVENT_KINDS[kind_code]), times.append(t_ev), states.append(y_ev.copy()), forces.append(force)
+        if EVENT_KINDS[kind_code] != "centre":  # a restart only, not logged
+            kinds.append(EVENT_KINDS[kind_code]), times.append(t_ev), states.append(y_ev.copy()), forces.append(force)
         max_force = max(max_force, force)
         t, y = t_ev, y_ev
         if action == STOP_SETTLED:

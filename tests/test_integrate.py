@@ -176,3 +176,13 @@ def test_extreme_cases_end_with_a_status_not_nan(v, kappa):
         assert tr.status in ("success", "step-size-collapse", "too-many-steps", "non-finite")
         assert np.all(np.isfinite(tr.final_state)) and math.isfinite(tr.max_force)
         assert tr.message
+
+
+@pytest.mark.parametrize("kappa", np.geomspace(1e13, 1e14, 5))
+def test_stick_counts_do_not_depend_on_the_tolerance(kappa):
+    """Stiff damping: the stuck pair's stick-break function switches branch where the pair passes
+    its centre; a step over both that switch and the break missed the break (N flipped 2/3/4 with
+    rtol). The run now restarts at the centre."""
+    counts = {simulate(seed_parameters(v=1.0, kappa=float(kappa)), "paper", rtol=r).n_stick
+              for r in (1e-8, 1e-10, 1e-12)}
+    assert counts == {2}

@@ -18,6 +18,7 @@ from ..model.rhs import rhs
 N_STAGES = _tableau.N_STAGES  # 12
 A = np.ascontiguousarray(_tableau.A, dtype=np.float64)
 B = np.ascontiguousarray(_tableau.B, dtype=np.float64)
+B2 = B.reshape(1, -1)  # as a one-row table for _combine
 C = np.ascontiguousarray(_tableau.C, dtype=np.float64)
 E3 = np.ascontiguousarray(_tableau.E3, dtype=np.float64)
 E5 = np.ascontiguousarray(_tableau.E5, dtype=np.float64)
@@ -28,11 +29,14 @@ SAFETY, MIN_FACTOR, MAX_FACTOR = 0.9, 0.2, 10.0
 
 
 @numba.njit(cache=True)
-def _combine(y, h, K, coef, n, out):
-    """``out = y + h * sum_r coef[r] K[r]`` over the first ``n`` stages (zeros skipped)."""
+def _combine(y, h, K, coef, row, n, out):
+    """``out = y + h * sum_r coef[row, r] K[r]`` over the first ``n`` stages (zeros skipped).
+
+    Indices, not row views: a view of a local array costs a reference-count pair in the hot loop.
+    """
     a0 = a1 = a2 = a3 = a4 = 0.0
     for r in range(n):
-        a = coef[r]
+        a = coef[row, r]
         if a != 0.0:
             a0 += a * K[r, 0]
             a1 += a * K[r, 1]
@@ -47,15 +51,22 @@ def _combine(y, h, K, coef, n, out):
 
 
 @numba.njit(cache=True)
+def _stage(code, c, mode, tmp, K, s, fs):
+    rhs(code, c, tmp, mode, fs)
+    for j in range(5):
+        K[s, j] = fs[j]
+
+
+@numba.njit(cache=True)
 def step(code, c, mode, y, f, h, K, y_new, f_new, tmp):
     """One step of size ``h`` from ``(y, f)``: fills stages ``K`` (16, 5), ``y_new``, ``f_new``;
     returns the contact force at ``y_new``."""
     for j in range(5):
         K[0, j] = f[j]
     for s in range(1, N_STAGES):
-        _combine(y, h, K, A[s], s, tmp)
-        rhs(code, c, tmp, mode, K[s])
-    _combine(y, h, K, B, N_STAGES, y_new)
+        _combine(y, h, K, A, s, s, tmp)
+        _stage(code, c, mode, tmp, K, s, f_new)
+    _combine(y, h, K, B2, 0, N_STAGES, y_new)
     force = rhs(code, c, y_new, mode, f_new)
     for j in range(5):
         K[N_STAGES, j] = f_new[j]
@@ -87,8 +98,8 @@ def error_norm(K, h, y, y_new, rtol, atol):
 def dense_coefficients(code, c, mode, y, f, y_new, f_new, h, K, F, tmp):
     """The interpolant of the last step (three extra stages): fills ``F`` (7, 5)."""
     for s in range(N_STAGES + 1, 16):
-        _combine(y, h, K, A[s], s, tmp)
-        rhs(code, c, tmp, mode, K[s])
+        _combine(y, h, K, A, s, s, tmp)
+        _stage(code, c, mode, tmp, K, s, F[0])
     for j in range(5):
         dy = y_new[j] - y[j]
         F[0, j] = dy

@@ -34,6 +34,7 @@ from .events import (
     REVERSAL,
     SEPARATION,
     SETTLED,
+    SILENT,
     SLIP,
     STICK,
     STOP_RUNAWAY,
@@ -258,7 +259,7 @@ def run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count,
     s_mode = np.empty(s_t.shape[0], np.int64)
     s_force = np.empty(s_t.shape[0])
     n_s = 0
-    counts = np.zeros(8, np.int64)
+    counts = np.zeros(9, np.int64)
     max_force = force
     max_indentation = y[X1] - y[X2]
     i_time = 0  # next output time (save_kind == SAVE_TIMES)
@@ -509,6 +510,12 @@ def run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count,
             y[:] = y_r
             force = rhs(code, c, y, mode, f)
             nfev += 1
+            if kind == SILENT:  # a restart only (the pair at its centre): nothing to log
+                quiet = restart_col
+                event_values(code, c, y, f, force, mode, energy_limit, g_old)
+                _quiet_start(quiet, y, mode, g_old)
+                h_abs = max(h_next, h_r)
+                continue
             if n_ev == ev_t.shape[0]:
                 ev_t, ev_kind, ev_mode = _grow(ev_t, n_ev), _grow(ev_kind, n_ev), _grow(ev_mode, n_ev)
                 ev_y, ev_force = _grow(ev_y, n_ev), _grow(ev_force, n_ev)

@@ -14,6 +14,8 @@ column              direction  action     meaning
 ``ENERGY``          down       stop       ``2 E(0) - E``: the energy has doubled (runaway)
 ``REACH``           up         stop**     ``-(x1 + A)``: a receding projectile is beyond the
                                           reach ``A`` of the plate: no contact can follow
+``PAIR_CENTRE``      both       restart    ``x2`` while stuck: the pair passes its centre, where
+                                          ``STICK_BREAK`` switches branch (not logged)
 ==================  =========  =========  ===================================================
 
 (*) record only for laws without stick; (**) stop when the run stops once settled.
@@ -47,12 +49,14 @@ from ..model.rhs import (
     target_reach,
 )
 
-DELTA, DELTADOT, FORCE_RATE, STICK_BREAK, ENERGY, REACH = range(6)
-N_EVENTS = 6
+DELTA, DELTADOT, FORCE_RATE, STICK_BREAK, ENERGY, REACH, PAIR_CENTRE = range(7)
+N_EVENTS = 7
 
 # Event kinds in the log.
-CONTACT, SEPARATION, REVERSAL, STICK, SLIP, FORCE_PEAK, SETTLED, RUNAWAY = range(8)
-EVENT_KINDS = ("contact", "separation", "reversal", "stick", "slip", "force-peak", "settled", "runaway")
+CONTACT, SEPARATION, REVERSAL, STICK, SLIP, FORCE_PEAK, SETTLED, RUNAWAY, CENTRE = range(9)
+EVENT_KINDS = ("contact", "separation", "reversal", "stick", "slip", "force-peak", "settled", "runaway", "centre")
+#: Kinds the driver acts on but does not log.
+SILENT = CENTRE
 # What a transition asks of the driver.
 GO_ON, STOP_SETTLED, STOP_RUNAWAY = 0, 1, 2
 
@@ -82,7 +86,11 @@ def event_values(code, c, y, f, force, mode, energy_limit, g):
     g[ENERGY] = energy_limit - energy(code, c, y)
     g[REACH] = -1.0
     g[STICK_BREAK] = 1.0
+    g[PAIR_CENTRE] = 1.0
     if mode == STUCK:
+        # the stick-break function below jumps where x2 crosses 0: the run restarts there, so that
+        # the jump never falls inside a step (a break right after it would be stepped over)
+        g[PAIR_CENTRE] = y[X2] if c[SPRINGS_] > 0 else 1.0
         g[DELTADOT] = 1.0
         # the stuck force M1/M S(x2) peaks where x2 does
         g[FORCE_RATE] = (c[KB_] + 3.0 * c[KM_] * y[X2] * y[X2]) * y[V2] * c[M1_] / (c[M1_] + c[M2_])
@@ -101,7 +109,7 @@ def event_values(code, c, y, f, force, mode, energy_limit, g):
 def direction(column):
     """+1: the event fires on an increase through zero, -1: on a decrease, 0: on both (the table above).
     A branch, not a lookup in a global array: that costs an array per call in the hot loop."""
-    if column == DELTA or column == DELTADOT:
+    if column == DELTA or column == DELTADOT or column == PAIR_CENTRE:
         return 0
     if column == REACH:
         return 1
@@ -126,6 +134,8 @@ def departure_sign(column, y, mode):
         return 1.0 if dd >= 0 else -1.0
     if column == DELTADOT:
         return -1.0 if mode < 0 else 1.0
+    if column == PAIR_CENTRE:
+        return -1.0 if y[V2] < 0 else 1.0
     return 1.0
 
 
@@ -203,6 +213,12 @@ def transition(code, c, column, y, mode, settle):
         return FORCE_PEAK, mode, action
     if column == ENERGY:
         return RUNAWAY, mode, STOP_RUNAWAY
+    if column == PAIR_CENTRE:
+        # exactly at the centre (delta kept): the stick-break function then starts on the branch
+        # of the swing that follows, whatever the root finder's residue
+        y[X1] = y[X1] - y[X2]
+        y[X2] = 0.0
+        return CENTRE, mode, action
     # REACH
     return SETTLED, mode, (STOP_SETTLED if settle else GO_ON)
 
