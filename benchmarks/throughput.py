@@ -1,146 +1,149 @@
-"""Sweep throughput: ``sweep`` (n_jobs = 1, 2) vs a user's loop of ``solve_ivp``.
+"""Sweep throughput: ``sweep`` (threads, loky), ``simulate_many``, a loop of ``simulate`` and a loop of
+the scipy oracle; and the 20,000-``kappa`` sweep through the command line, start-up included.
 
-Paper law, seed case, N kappa values log-spaced in [1e9, 1e14], t_end = 0.01 s. The user's loop:
-``solve_ivp(DOP853)`` on the plain right-hand side ``rhs(y, c, law)``, rtol = 1e-10 (atol scaled
-like ours), max force from the accepted steps refined on the dense output around the largest
-one (so it can agree with ours to ~1e-6). The loop is timed on a random subset of points
-(``--subset``) and its full time extrapolated; each solve_ivp run is abandoned after
-``--cap`` seconds (the plain RHS of ``paper`` chatters across deltadot = 0 once stuck), which
-makes the extrapolated loop time a lower bound.
+Seed case, v = 1 m/s, ``N`` kappa log-spaced in [1e8, 1e13], each run until its outcome settles
+(rtol 1e-10), for ``paper`` (the command line's example) and ``hunt-crossley``. The in-process
+contenders take turns within each repeat (medians); the oracle loop (``tests/oracle.py``:
+``solve_ivp`` DOP853 with the same events) is timed on a random subset and extrapolated. The
+command line is timed as a whole process (``phaseimpact sweep ... --out X.h5 --no-progress``,
+median of 3), with ``--jobs 1`` (its default) and ``--jobs 2``.
 
-    python benchmarks/throughput.py [--quick] [--n 2000] [--subset 50] [--cap 10]
+    python benchmarks/throughput.py [--quick] [--n 2000] [--cli-n 20000]
 """
 
 from __future__ import annotations
 
 import argparse
+import statistics
+import subprocess
 import sys
+import tempfile
 import time
 from pathlib import Path
 
 import numpy as np
-from scipy.integrate import solve_ivp
-from scipy.optimize import minimize_scalar
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from _common import emit, machine, save_section, table  # noqa: E402
+from _common import ROOT, VENV_BIN, emit, load, machine, save_section, save_targets, table, target  # noqa: E402
 
-import phaseimpact.integrate as integrate  # noqa: E402
+sys.path.insert(0, str(ROOT / "tests"))
+from oracle import oracle  # noqa: E402
+
+from phaseimpact import seed_parameters, simulate, simulate_many  # noqa: E402
 from phaseimpact.continuation import sweep  # noqa: E402
-from phaseimpact.integrate._trajectory import state_scale  # noqa: E402
-from phaseimpact.model import as_law, coefficients, contact_force, initial_state, rhs  # noqa: E402
-from phaseimpact.parameters import seed_parameters  # noqa: E402
 
-T_END = 0.01
-LAW = "paper"
+LAWS = ("paper", "hunt-crossley")
+RTOL = 1e-10
 
 
-class _Timeout(Exception):
-    pass
+def cli_command(n: int, out: Path, jobs: int) -> list[str]:
+    return [str(VENV_BIN / "phaseimpact"), "sweep", "--law", "paper", "--v", "1", "--kappa-min", "1e8",
+            "--kappa-max", "1e13", "--num", str(n), "--out", str(out), "--no-progress", "--force", "--jobs", str(jobs)]
 
 
-def user_point(params, law, rtol, cap):
-    """One point of the user's loop: (max force, finished?)."""
-    law = as_law(law)
-    c = coefficients(params, law)
-    deadline = time.perf_counter() + cap
-    best = [0.0]
-
-    def f(t, y):
-        if time.perf_counter() > deadline:
-            raise _Timeout
-        return rhs(y, c, law)
-
-    try:
-        sol = solve_ivp(f, (0.0, T_END), initial_state(params.v), method="DOP853", rtol=rtol,
-                        atol=rtol * state_scale(params, c), dense_output=True)
-    except _Timeout:
-        return best[0], False
-    force = contact_force(sol.y.T, c, law)
-    i = int(np.argmax(force))
-    lo, hi = sol.t[max(i - 1, 0)], sol.t[min(i + 1, len(sol.t) - 1)]
-    if hi > lo:
-        res = minimize_scalar(lambda t: -float(contact_force(sol.sol(t), c, law)), bounds=(lo, hi),
-                              method="bounded", options={"xatol": 1e-14 * max(hi, 1e-9)})
-        return max(float(force[i]), -res.fun), True
-    return float(force[i]), True
+def time_cli(n: int, jobs: int, repeats: int) -> tuple[float, list[float]]:
+    """Median wall time of the whole command (start-up, compute, archive), s."""
+    times = []
+    with tempfile.TemporaryDirectory() as tmp:
+        for _ in range(repeats):
+            start = time.perf_counter()
+            subprocess.run(cli_command(n, Path(tmp) / "sweep.h5", jobs), check=True, capture_output=True)
+            times.append(time.perf_counter() - start)
+    return statistics.median(times), times
 
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__)
-    ap.add_argument("--quick", action="store_true", help="N = 100, subset 10, cap 3 s")
-    ap.add_argument("--n", type=int, default=None)
-    ap.add_argument("--subset", type=int, default=None)
-    ap.add_argument("--cap", type=float, default=None)
-    ap.add_argument("--rtol", type=float, default=1e-10, help="rtol of the user's solve_ivp loop")
-    ap.add_argument("--law", default=LAW, help="contact law (default paper)")
+    ap.add_argument("--quick", action="store_true", help="3 repeats, oracle on 5 points, CLI once per setting")
+    ap.add_argument("--n", type=int, default=2000)
+    ap.add_argument("--cli-n", type=int, default=20000)
     args = ap.parse_args(argv)
-    n = args.n or (100 if args.quick else 2000)
-    subset = args.subset or (10 if args.quick else 50)
-    cap = args.cap or (3.0 if args.quick else 10.0)
-    law = args.law
-    emit(f"# Sweep throughput ({law}, N = {n}, kappa in [1e9, 1e14], t_end = {T_END:g} s)\n")
-    emit(machine() + "\n")
-    params = seed_parameters()
-    kappas = np.logspace(9, 14, n)
-    rows, results = [], {}
+    repeats = 3 if args.quick else 5
+    subset = 5 if args.quick else 20
+    cli_repeats = 1 if args.quick else 3
+    start_load = load()
+    emit(f"# Sweep throughput (N = {args.n}, kappa in [1e8, 1e13], until settled, rtol {RTOL:g})\n")
+    emit(machine())
+    emit(start_load + "\n")
+    params = seed_parameters(v=1.0)
+    kappas = np.geomspace(1e8, 1e13, args.n)
+    plist = [params.replace(kappa=float(k)) for k in kappas]
+    rows, targets = [], []
+    for law in LAWS:
+        contenders = {
+            "sweep, threads, n_jobs=1": lambda law=law: sweep(params, law, kappas, n_jobs=1),
+            "sweep, threads, n_jobs=2": lambda law=law: sweep(params, law, kappas, n_jobs=2),
+            "simulate_many, n_threads=2": lambda law=law: simulate_many(plist, law, rtol=RTOL, n_threads=2),
+            "sweep, loky, n_jobs=2": lambda law=law: sweep(params, law, kappas, n_jobs=2, backend="loky"),
+        }
+        results = {name: fn() for name, fn in contenders.items()}  # warm-up (loky starts its workers)
+        times = {name: [] for name in contenders}
+        for _ in range(repeats):
+            for name, fn in contenders.items():
+                start = time.perf_counter()
+                fn()
+                times[name].append(time.perf_counter() - start)
+        med = {name: statistics.median(t) for name, t in times.items()}
+        start = time.perf_counter()
+        loop = [simulate(p, law, rtol=RTOL) for p in plist]
+        med["loop of simulate"] = time.perf_counter() - start
+        rng = np.random.default_rng(0)
+        pick = np.sort(rng.choice(args.n, size=subset, replace=False))
+        start = time.perf_counter()
+        oracle_force = [oracle(plist[i], law, rtol=RTOL).max_force for i in pick]
+        oracle_time = (time.perf_counter() - start) / subset * args.n
+        ref = results["sweep, threads, n_jobs=2"]
+        loop_force = np.array([tr.max_force for tr in loop])
+        loop_n = np.array([tr.n_stick for tr in loop])
+        same = {name: bool(np.array_equal(res.max_force, ref.max_force) and np.array_equal(res.n_stick, ref.n_stick)
+                           and np.array_equal(res.outcome, ref.outcome))
+                for name, res in results.items()}
+        same_loop = bool(np.array_equal(loop_force, ref.max_force) and np.array_equal(loop_n, ref.n_stick))
+        oracle_dis = float(np.max(np.abs(np.array(oracle_force) - ref.max_force[pick]) / ref.max_force[pick]))
+        base = med["sweep, threads, n_jobs=2"]
+        for name in contenders:
+            rows.append((law, name, f"{med[name]:.3g}", f"{args.n / med[name]:.3g}", f"{med[name] / base:.2f}",
+                         "identical" if same[name] else "DIFFERENT", f"median of {repeats}"))
+        rows.append((law, "loop of simulate (Python)", f"{med['loop of simulate']:.3g}",
+                     f"{args.n / med['loop of simulate']:.3g}", f"{med['loop of simulate'] / base:.2f}",
+                     "identical" if same_loop else "DIFFERENT", "one run"))
+        rows.append((law, "loop of the scipy oracle (same events)", f"{oracle_time:.3g}",
+                     f"{args.n / oracle_time:.3g}", f"{oracle_time / base:.0f}",
+                     f"max force within {oracle_dis:.1e}", f"extrapolated from {subset} random points"))
+        emit(f"{law}: " + ", ".join(f"{k} {v:.3g} s" for k, v in med.items()) + f", oracle loop ~{oracle_time:.3g} s")
+        if law == "paper":
+            targets.append(target(f"{args.n}-kappa sweep (1e8-1e13), 2 jobs (threads), paper", "<= 0.15 s compute",
+                                  f"{base:.3g} s", bool(base <= 0.15), "python benchmarks/throughput.py"))
+    cli_rows = []
+    fixed, fixed_times = time_cli(2, 1, cli_repeats)
+    cli_rows.append(("the same with `--num 2 --jobs 1` (start-up and archive, next to no compute)", f"{fixed:.3g}",
+                     ", ".join(f"{t:.3g}" for t in fixed_times), "-", f"{fixed:.3g}"))
     for jobs in (1, 2):
+        wall, all_times = time_cli(args.cli_n, jobs, cli_repeats)
         start = time.perf_counter()
-        res = sweep(params, law, kappas, t_end=T_END, n_jobs=jobs)
-        wall = time.perf_counter() - start
-        results[jobs] = (wall, res)
-        kinds, counts = np.unique(res.status, return_counts=True)
-        emit(f"sweep n_jobs={jobs}: {wall:.2f} s, statuses {dict(zip(kinds, counts.tolist(), strict=True))}")
-    if hasattr(integrate, "simulate_batch"):
-        start = time.perf_counter()
-        batch = integrate.simulate_batch([params.replace(kappa=float(k)) for k in kappas], law, T_END, rtol=1e-10)
-        results["batch"] = (time.perf_counter() - start, np.array([tr.max_force for tr in batch]))
-        emit(f"simulate_batch: {results['batch'][0]:.2f} s")
-    else:
-        emit("simulate_batch not available (placeholder row)")
-    rng = np.random.default_rng(0)
-    pick = np.sort(rng.choice(n, size=min(subset, n), replace=False))
-    times, forces, finished = [], [], []
-    for idx in pick:
-        start = time.perf_counter()
-        fmax, ok = user_point(params.replace(kappa=float(kappas[idx])), law, args.rtol, cap)
-        times.append(time.perf_counter() - start)
-        forces.append(fmax)
-        finished.append(ok)
-    times, forces, finished = np.array(times), np.array(forces), np.array(finished)
-    loop_time = float(np.mean(times) * n)
-    # A runaway's largest force is wherever its run stopped, not an impact force: left out.
-    ref = np.where(results[1][1].outcome == "runaway", np.nan, results[1][1].max_force)
-    finished &= np.isfinite(ref[pick])
-    disagree = np.abs(forces[finished] - ref[pick][finished]) / np.abs(ref[pick][finished])
-    worst = float(np.max(disagree)) if disagree.size else float("nan")
-    bound = "" if finished.all() else ">= "
-    emit(f"solve_ivp loop: {len(pick)} of {n} points timed, {int((~finished).sum())} abandoned after {cap:g} s; "
-         f"mean {np.mean(times):.3f} s/point; estimated full loop {bound}{loop_time:.1f} s")
-    for jobs in (1, 2):
-        wall, res = results[jobs]
-        dis = np.abs(res.max_force - ref) / np.abs(ref)  # NaN (runaways) ignored by nanmax
-        rows.append((f"sweep n_jobs={jobs}", n, wall, n / wall, f"{bound}{loop_time / wall:.1f}",
-                     float(np.nanmax(dis)) if jobs != 1 else "(reference)", "measured, all points"))
-    if "batch" in results:
-        wall, mf = results["batch"]
-        rows.append(("simulate_batch (rtol 1e-10)", n, wall, n / wall, f"{bound}{loop_time / wall:.1f}",
-                     float(np.nanmax(np.abs(mf - ref) / np.abs(ref))), "measured, all points"))
-    else:
-        rows.append(("simulate_batch", "-", "-", "-", "-", "-", "NOT AVAILABLE (placeholder)"))
-    rows.append((f"solve_ivp DOP853 loop (rtol {args.rtol:g}, plain RHS)", n, f"{bound}{loop_time:.1f}",
-                 f"<= {n / loop_time:.3g}" if bound else n / loop_time, "1",
-                 worst, f"estimated from {len(pick)} random points; {int((~finished).sum())} capped at {cap:g} s"))
-    header = ("method", "N", "time [s]", "points/s", "speedup vs loop", "max rel. max-force disagreement",
+        sweep(params, "paper", np.geomspace(1e8, 1e13, args.cli_n), n_jobs=jobs)
+        compute = time.perf_counter() - start
+        cmd = " ".join(["phaseimpact", *cli_command(args.cli_n, Path("X.h5"), jobs)[1:]])
+        cli_rows.append((f"`{cmd}`", f"{wall:.3g}", ", ".join(f"{t:.3g}" for t in all_times), f"{compute:.3g}",
+                         f"{wall - compute:.3g}"))
+        emit(f"CLI {args.cli_n} jobs={jobs}: {wall:.3g} s (runs {all_times}), in-process sweep {compute:.3g} s")
+        targets.append(target(f"{args.cli_n} kappa through the CLI, start-up included (--jobs {jobs})", "<= 2.5 s",
+                              f"{wall:.3g} s (compute {compute:.3g} s)", bool(wall <= 2.5),
+                              f"time {cmd} (median of {cli_repeats})"))
+    end_load = load()
+    header = ("law", "method", "time [s]", "points/s", "time / sweep n_jobs=2", "same columns as sweep n_jobs=2",
               "note")
-    text = table(header, rows)
+    cli_header = ("command", "wall, median [s]", "runs [s]", "in-process sweep, same jobs [s]",
+                  "start-up + archive [s]")
+    text = table(header, rows) + "\n\nThe command line, whole process:\n\n" + table(cli_header, cli_rows)
     emit()
     emit(text)
-    save_section(f"throughput_{law}" + args.quick * "_quick",
-                 f"## Sweep throughput ({law})\n\n{machine()}\n\n{law}, N = {n} kappa log-spaced in "
-                 f"[1e9, 1e14], t_end = {T_END:g} s; disagreement relative to sweep n_jobs=1 "
-                 f"(loop: over its finished points; runaways, whose largest force is where the run stopped, "
-                 f"left out).\n\n" + text)
+    emit(f"\nat the end: {end_load}")
+    save_section("throughput" + args.quick * "_quick",
+                 f"## Sweep throughput\n\n{machine()}\n\n{start_load} at the start, {end_load} at the end.\n\n"
+                 f"Seed case, v = 1 m/s, N = {args.n} kappa log-spaced in [1e8, 1e13], each run until its outcome "
+                 f"settles, rtol {RTOL:g}. `python benchmarks/throughput.py`\n\n" + text)
+    save_targets("throughput" + args.quick * "_quick", targets)
     return 0
 
 
