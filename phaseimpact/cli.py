@@ -659,8 +659,7 @@ def _run_grid(args, setup: Setup, axes: list):
             archive.check_overwrite(out, kind, setup.law, setup.params, named, args.t_end, args.rtol,
                                     force=args.force)
 
-        def checkpoint(result):
-            archive.save(result, out, force=args.force)
+        checkpoint = archive.Checkpoint(out, force=args.force)  # writes only the new points, in place
 
         try:
             result = atlas(setup.case, setup.law, axes, t_end=args.t_end, n_jobs=args.jobs, backend=args.backend,

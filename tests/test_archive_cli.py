@@ -291,7 +291,7 @@ KILL_AFTER = textwrap.dedent("""
     sweep_module = importlib.import_module("phaseimpact.continuation.sweep")  # the module, not the function
 
     sweep_module.CHUNK_THREADS = 16  # small chunks: several checkpoints
-    save, saves = archive.save, [0]
+    save, saves = archive.Checkpoint.__call__, [0]
 
     def save_then_die(*args, **kwargs):
         save(*args, **kwargs)
@@ -299,7 +299,7 @@ KILL_AFTER = textwrap.dedent("""
         if saves[0] == int(os.environ["KILL_AFTER"]):
             os.kill(os.getpid(), signal.SIGKILL)  # no clean-up at all, like a kill -9
 
-    archive.save = save_then_die
+    archive.Checkpoint.__call__ = save_then_die
     sys.exit(main(sys.argv[1:]))
 """)
 
@@ -333,7 +333,7 @@ def test_sweep_killed_after_two_checkpoints_then_resumed_equals_uninterrupted(tm
 def test_ctrl_c_during_a_sweep_prints_the_resume_command(tmp_path, monkeypatch, capsys):
     sweep_module = importlib.import_module("phaseimpact.continuation.sweep")
     monkeypatch.setattr(sweep_module, "CHUNK_THREADS", 8)
-    save, saves = archive.save, []
+    save, saves = archive.Checkpoint.__call__, []
 
     def save_then_interrupt(*args, **kwargs):
         save(*args, **kwargs)
@@ -341,7 +341,7 @@ def test_ctrl_c_during_a_sweep_prints_the_resume_command(tmp_path, monkeypatch, 
         if len(saves) == 1:
             raise KeyboardInterrupt
 
-    monkeypatch.setattr(archive, "save", save_then_interrupt)
+    monkeypatch.setattr(archive.Checkpoint, "__call__", save_then_interrupt)
     out = tmp_path / "s.h5"
     assert main([*SWEEP, "--out", str(out)]) == 130
     err = capsys.readouterr().err
@@ -349,7 +349,7 @@ def test_ctrl_c_during_a_sweep_prints_the_resume_command(tmp_path, monkeypatch, 
     command = err.strip().splitlines()[-1].strip()
     words = shlex.split(command)
     assert words[0] == "phaseimpact" and words[-1] == "--resume"
-    monkeypatch.setattr(archive, "save", save)
+    monkeypatch.setattr(archive.Checkpoint, "__call__", save)
     assert main(words[1:]) == 0  # the printed command completes the sweep
     assert archive.load(out).done.all()
 

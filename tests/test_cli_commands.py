@@ -340,7 +340,7 @@ def test_atlas_over_a_geometry_axis_of_the_case(tmp_path):
 def test_atlas_ctrl_c_prints_the_resume_command_that_completes_it(tmp_path, monkeypatch):
     sweep_module = importlib.import_module("phaseimpact.continuation.sweep")
     monkeypatch.setattr(sweep_module, "CHUNK_THREADS", 4)
-    save, saves = archive.save, []
+    save, saves = archive.Checkpoint.__call__, []
 
     def save_then_interrupt(*args, **kwargs):
         save(*args, **kwargs)
@@ -348,13 +348,13 @@ def test_atlas_ctrl_c_prints_the_resume_command_that_completes_it(tmp_path, monk
         if len(saves) == 1:
             raise KeyboardInterrupt
 
-    monkeypatch.setattr(archive, "save", save_then_interrupt)
+    monkeypatch.setattr(archive.Checkpoint, "__call__", save_then_interrupt)
     path = tmp_path / "a.h5"
     code, _, err = run([*ATLAS, "--out", path])
     assert code == 130 and "4 of 9 points are saved" in err
     words = shlex.split(err.strip().splitlines()[-1].strip())
     assert words[0] == "phaseimpact" and words[-1] == "--resume"
-    monkeypatch.setattr(archive, "save", save)
+    monkeypatch.setattr(archive.Checkpoint, "__call__", save)
     assert run(words[1:])[0] == 0
     assert archive.load(path).done.all()
 
