@@ -848,6 +848,7 @@ def _check_curve_overwrite(out, args, setup: Setup, param, values, what) -> None
 def cmd_critical_curve(args) -> int:
     from . import archive
     from .continuation import critical_curve, transitions
+    from .continuation.transition import RunFailed
 
     setup = _setup(args)
     law = setup.law
@@ -899,7 +900,7 @@ def cmd_critical_curve(args) -> int:
             curve = critical_curve(setup.case, law, param, values, what=what, rtol=args.kappa_rtol,
                                    integrator_rtol=args.rtol, contact_index=index, kappa_start=start,
                                    progress=not args.no_progress)
-        except ValueError as error:  # every input was checked: this is the curve's own failure
+        except RunFailed as error:  # every input was checked: this is the curve's own failure
             print(f"phaseimpact: the curve failed to start: {error}; nothing written", file=sys.stderr)
             return EXIT_FAILURE
         archive.save(curve, out, force=args.force)

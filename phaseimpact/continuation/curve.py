@@ -19,7 +19,14 @@ from tqdm.auto import tqdm
 from ..case import Case
 from ..model.laws import ContactLaw, as_law
 from ..parameters import Parameters
-from .transition import closed_form_kappa_c, critical_damping, delta_extremum, first_stick_margin, locate_kappa_2
+from .transition import (
+    RunFailed,
+    closed_form_kappa_c,
+    critical_damping,
+    delta_extremum,
+    first_stick_margin,
+    locate_kappa_2,
+)
 
 __all__ = ["CriticalCurve", "critical_curve", "CURVE_QUANTITIES"]
 
@@ -81,7 +88,12 @@ def critical_curve(base: Parameters | Case, law: ContactLaw | str, param: str, v
                    what: str = "kappa_c", rtol: float = 1e-10, integrator_rtol: float = 1e-10,
                    contact_index: int = 1, kappa_start: float | None = None, max_halvings: int = 6,
                    progress: bool = False) -> CriticalCurve:
-    """Continue ``what`` over ``values`` of ``param`` (see the module docstring)."""
+    """Continue ``what`` over ``values`` of ``param`` (see the module docstring).
+
+    Raises ``ValueError`` for bad arguments (before any work) and
+    :class:`~phaseimpact.continuation.transition.RunFailed` when no start point is found; a curve
+    lost on the way ends there, with :attr:`CriticalCurve.message` saying where.
+    """
     law = as_law(law)
     if what not in CURVE_QUANTITIES:
         raise ValueError(f"what = {what!r} is out of range; allowed: one of {', '.join(CURVE_QUANTITIES)}")
@@ -121,7 +133,7 @@ def critical_curve(base: Parameters | Case, law: ContactLaw | str, param: str, v
     else:
         found = critical_damping(p0, law, integrator_rtol=integrator_rtol, rtol=rtol)
         if found.kappa_c is None:
-            raise ValueError(f"no kappa_c at {param} = {values[0]:g}: {found.message}")
+            raise RunFailed(f"no kappa_c at {param} = {values[0]:g} to start from: {found.message}")
         first = found.kappa_c
     log_x = bool(np.all(values > 0))
 

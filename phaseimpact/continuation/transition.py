@@ -267,7 +267,8 @@ def locate_kappa_2(params: Parameters, law: ContactLaw | str, kappa_c: float, *,
             eps_lo = mid
     kappa_2 = kappa_c * (1 + eps_hi)
     staircase = []
-    for eps in np.geomspace(1e-6, eps_hi * 1.5, samples):
+    # from eps = 1e-5 up: closer to kappa_c the escape takes thousands of plate periods (N > 3000)
+    for eps in np.geomspace(min(1e-5, eps_hi / 10), eps_hi * 1.5, samples):
         n, t_run, cut = count(float(eps))
         staircase.append({"kappa": kappa_c * (1 + float(eps)), "relative": float(eps), "n_stick": int(n),
                           "t_run": t_run, "cut": bool(cut)})
@@ -322,12 +323,18 @@ def delta_extremum(params: Parameters, law: ContactLaw | str, j: int, *, rtol: f
     """
     # no stop when out of reach: the extrema go on (below zero), so each stays defined across
     # the kappa where the projectile stops getting out of reach
-    horizon = EXTREMA_PERIODS * scales(params).plate_period if params.target == "plate" else None
-    trajectory = simulate(params, law, horizon, rtol=rtol, stop_on=("reversal", j), stop_when_settled=False)
+    trajectory = simulate(params, law, _extrema_horizon(params), rtol=rtol, stop_on=("reversal", j),
+                          stop_when_settled=False)
     if trajectory.stop_reason != "asked":
         return -math.inf
     y = trajectory.final_state
     return float(y[0] - y[1])
+
+
+def _extrema_horizon(params: Parameters) -> float:
+    """Horizon of an extremum search: a few tens of the case's slowest periods."""
+    s = scales(params)
+    return EXTREMA_PERIODS * (s.plate_period if math.isfinite(s.plate_period) else s.contact_time)
 
 
 def extrema(params: Parameters, law: ContactLaw | str, *, rtol: float = 1e-10) -> np.ndarray:
@@ -337,7 +344,7 @@ def extrema(params: Parameters, law: ContactLaw | str, *, rtol: float = 1e-10) -
     y = trajectory.event_y[trajectory.event_kind == _REVERSAL]
     values = list(y[:, 0] - y[:, 1])
     if trajectory.stop_reason == "settled" and trajectory.final_mode != 0:
-        after = simulate(params, law, EXTREMA_PERIODS * scales(params).plate_period, rtol=rtol,
+        after = simulate(params, law, _extrema_horizon(params), rtol=rtol,
                          initial=trajectory.final_state[:4], stop_when_settled=False, stop_on=("reversal", 2))
         y = after.event_y[after.event_kind == _REVERSAL]
         values += list(y[:, 0] - y[:, 1])
