@@ -1,0 +1,128 @@
+"""Start-up: the first-ever compile of the engine (empty numba cache), the warm load, and the
+command line's start-up.
+
+Cold: a fresh process with ``NUMBA_CACHE_DIR`` pointing to an empty temporary directory (numba
+then neither reads nor writes the in-tree caches) imports phaseimpact and makes one call of
+each compiled entry a session needs: ``simulate`` (Hunt-Crossley, ``paper``, the seed's RK4,
+saved steps) and ``simulate_many`` (the parallel loop). Warm: the same in a second process on
+the now filled cache. Then whole commands on the project's own cache: ``phaseimpact params``,
+``python -c "import phaseimpact"``, ``phaseimpact simulate`` (medians of 5).
+
+    python benchmarks/startup.py [--quick]
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from _common import VENV_BIN, emit, load, machine, save_section, save_targets, table, target  # noqa: E402
+
+SESSION = r"""
+import json, time
+t0 = time.perf_counter()
+import phaseimpact
+from phaseimpact import seed_parameters, simulate, simulate_many
+out = {"import phaseimpact": time.perf_counter() - t0}
+p = seed_parameters(v=1.0, kappa=3e9)
+for name, call in (
+        ("simulate hunt-crossley", lambda: simulate(p, "hunt-crossley", 2e-3)),
+        ("simulate paper", lambda: simulate(p, "paper", None, stop_on="slip")),
+        ("simulate rk4", lambda: simulate(p, "paper", 2e-4, integrator="rk4")),
+        ("simulate save=steps", lambda: simulate(p, "hunt-crossley", 2e-3, save="steps")),
+        ("simulate_many (parallel)", lambda: simulate_many([p, p.replace(kappa=1e12)], "paper", n_threads=2))):
+    t = time.perf_counter()
+    call()
+    out[name] = time.perf_counter() - t
+out["total"] = time.perf_counter() - t0
+print(json.dumps(out))
+"""
+
+
+def session(cache_dir: str) -> dict:
+    env = {**os.environ, "NUMBA_CACHE_DIR": cache_dir}
+    start = time.perf_counter()
+    res = subprocess.run([str(VENV_BIN / "python"), "-c", SESSION], env=env, capture_output=True, text=True,
+                         check=True)
+    out = json.loads(res.stdout.strip().splitlines()[-1])
+    out["process"] = time.perf_counter() - start
+    return out
+
+
+def command_time(cmd: list[str], repeats: int) -> tuple[float, list[float]]:
+    subprocess.run(cmd, capture_output=True, check=True)  # warm
+    times = []
+    for _ in range(repeats):
+        start = time.perf_counter()
+        subprocess.run(cmd, capture_output=True, check=True)
+        times.append(time.perf_counter() - start)
+    return statistics.median(times), times
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__)
+    ap.add_argument("--quick", action="store_true", help="one cold compile instead of 3")
+    args = ap.parse_args(argv)
+    cold_repeats = 1 if args.quick else 3
+    start_load = load()
+    emit("# Start-up: first-ever compile, warm load, command line\n")
+    emit(machine())
+    emit(start_load + "\n")
+    colds, warms = [], []
+    for i in range(cold_repeats):
+        with tempfile.TemporaryDirectory(prefix="numba-cold-") as cache:
+            colds.append(session(cache))
+            warms.append(session(cache))
+        emit(f"cold {i + 1}: {colds[-1]['process']:.1f} s; warm: {warms[-1]['process']:.2f} s")
+    keys = [k for k in colds[0] if k not in ("total",)]
+    rows = [(k, f"{statistics.median(c[k] for c in colds):.3g}", f"{statistics.median(w[k] for w in warms):.3g}")
+            for k in keys]
+    cold_total = statistics.median(c["process"] for c in colds)
+    py = str(VENV_BIN / "python")
+    commands = {
+        "phaseimpact params": [str(VENV_BIN / "phaseimpact"), "params"],
+        'python -c "import phaseimpact"': [py, "-c", "import phaseimpact"],
+        'python -c "import numpy, scipy, numba"': [py, "-c", "import numpy, scipy, numba"],
+        "phaseimpact simulate --law hunt-crossley --kappa 3e9": [str(VENV_BIN / "phaseimpact"), "simulate", "--law",
+                                                                 "hunt-crossley", "--kappa", "3e9"],
+        "phaseimpact --version": [str(VENV_BIN / "phaseimpact"), "--version"],
+    }
+    cmd_rows = []
+    params_time = None
+    for label, cmd in commands.items():
+        med, all_times = command_time(cmd, 5)
+        cmd_rows.append((f"`{label}`", f"{med:.3g}", ", ".join(f"{t:.2f}" for t in all_times)))
+        if label == "phaseimpact params":
+            params_time = med
+        emit(f"{label}: {med:.3g} s")
+    end_load = load()
+    text = (f"First-ever compile (empty `NUMBA_CACHE_DIR`), median of {cold_repeats}, and the warm load of the "
+            "same calls in a second process:\n\n"
+            + table(("step (one process)", "cold [s]", "warm [s]"), rows)
+            + "\n\nWhole commands on the project's cache (warm), median of 5:\n\n"
+            + table(("command", "wall, median [s]", "runs [s]"), cmd_rows))
+    emit()
+    emit(text)
+    emit(f"\nat the end: {end_load}")
+    save_section("startup" + args.quick * "_quick",
+                 f"## Start-up\n\n{machine()}\n\n{start_load} at the start, {end_load} at the end. "
+                 "`python benchmarks/startup.py`\n\n" + text)
+    save_targets("startup" + args.quick * "_quick", [
+        target("first-ever compile per environment", "<= 20 s",
+               f"{cold_total:.3g} s (one process: import + every compiled entry)", bool(cold_total <= 20),
+               "NUMBA_CACHE_DIR=$(mktemp -d) python -c '<one call of each entry>' (benchmarks/startup.py)"),
+        target("`phaseimpact params` warm", "<= 0.6 s", f"{params_time:.3g} s", bool(params_time <= 0.6),
+               "time phaseimpact params (median of 5)")])
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
