@@ -4,12 +4,13 @@ Claim (REFERENCE §5): over damping 1e10-1e15 N s/m^2.5 and speeds 0.3-13 m/s ev
 ends in one of few ways, and the boundary between the permanent stick and the escape is the
 continued adding-sliding curve kappa_c(v) (the closed form of REFERENCE §5 lies on it to 0.3 %;
 kappa_2(v) is within 6e-4 of it, indistinguishable at this scale). Below it: one permanent stick
-(both readings). Above it: two stick phases (more in the thin staircase next to kappa_c, and 3-4 at
-kappa v / K above about 1e3, where the count depends on the integrator tolerance), then the
-escape. Printed reading: every escape becomes a runaway (the law acts in tension). Unilateral
-reading: the projectile separates and rebounds with an apparent restitution that passes 1 a
-little above kappa_c, or, at higher damping, gains energy faster than it separates (stopped when
-the energy has doubled). Atlases archived in figures/data/atlas_paper_*.h5 (archive schema 2).
+(both readings). Above it: two stick phases (more only in the thin staircase next to kappa_c,
+which this grid does not sample), then the escape; every count is checked against a run at a
+tighter integrator tolerance (points where it differs would be marked). Printed reading: every
+escape becomes a runaway (the law acts in tension). Unilateral reading: the projectile separates
+and rebounds with an apparent restitution that passes 1 a little above kappa_c, or, at higher
+damping, gains energy faster than it separates (stopped when the energy has doubled). Atlases
+archived in figures/data/atlas_paper_*.h5 (phaseimpact archives; archive.load reads them).
 """
 
 from pathlib import Path

@@ -2,14 +2,14 @@
 
 Claim (REFERENCE §5), eq. 8 ("paper"), v = 1 m/s, every run until its outcome settles: just above
 kappa_c the number of stick phases before the escape, N(kappa), is finite, grows without bound as
-kappa -> kappa_c+ and falls in a staircase of even steps to exactly 2 at kappa_2 (kappa_2 / kappa_c
-- 1 = 2.5e-4). T_run, the time to the escape, diverges like a power of kappa - kappa_c: the fitted
-exponent is -1.83 for 7e-6 <= kappa/kappa_c - 1 <= 1e-4, and the local slope still drifts (-1.66
-below 2e-5), so the asymptotic exponent is not reached in the range the engine resolves. At the
-bifurcation the first slip's largest speed grows like (kappa - kappa_c)^(3/2), the offset between
-the first two stick depths like (kappa - kappa_c)^2 and the slip's duration like
-(kappa - kappa_c)^(1/2): the local slopes tend to these values as kappa -> kappa_c (1.43, 1.91,
-0.48 at the smallest offsets; the damping of the slip bends them at larger offsets). The
+kappa -> kappa_c+ (10398 at kappa_c (1 + 5e-6)) and falls in a staircase of even steps to exactly
+2 at kappa_2 (kappa_2 / kappa_c - 1 = 2.5e-4). T_run, the time to the escape, diverges like a power
+of kappa - kappa_c: the fitted exponent is -1.81 for 5e-6 <= kappa/kappa_c - 1 <= 1e-4, and the
+local slope still drifts (-1.65 below 2e-5), so the asymptotic exponent is not reached within the
+horizon cap (1e4 plate periods). At the bifurcation the first slip's largest speed grows like
+(kappa - kappa_c)^(3/2), the offset between the first two stick depths like (kappa - kappa_c)^2 and
+the slip's duration like (kappa - kappa_c)^(1/2): the local slopes are 1.49, 1.99 and 0.50 at
+offsets 1e-7 to 4e-7 and bend away at larger offsets, where the damping of the slip matters. The
 unilateral reading gives the same N and T_run (the escape is where the two readings part).
 """
 
@@ -25,10 +25,10 @@ from phaseimpact.plotting import figure, save, save_h5, style
 FIGURES = Path(__file__).resolve().parents[1] / "figures"
 NAME = "staircase"
 #: Smallest offset kappa/kappa_c - 1 whose escape comes before the horizon cap (1e4 plate periods).
-EPS_MIN = 6e-6
+EPS_MIN = 5e-6
 EPS_MAX = 6e-4
-#: Offsets for the local exponents (below ~2e-6 the slip is too small for the engine to resolve).
-EXPONENT_EPS = np.geomspace(3.6e-6, 3e-4, 8)
+#: Offsets for the local exponents (the first slip's speed is then 2e-11 to 2e-6 m/s).
+EXPONENT_EPS = np.geomspace(1e-7, 3e-4, 10)
 #: Fit range of T_run (the asymptotic regime, well below kappa_2).
 FIT_MAX = 1e-4
 
