@@ -1,231 +1,290 @@
-"""Work-precision: error vs wall time for our integrators, scipy's solve_ivp and the seed's RK4.
+"""Work-precision: error against time for our compiled driver and scipy's ``solve_ivp`` methods.
 
-Seed case (kappa = 3e9, v = 1 m/s), laws ``hunt-crossley`` and ``paper``, t_end = 2 ms.
-Reference: our exact integrator at rtol = 1e-13. Errors: relative error of the max force;
-state at t_end (positions / Hertz indentation scale, velocities / v, max over components);
-``paper`` only: relative error of the stick indentation (delta at the first ``stick`` event;
-methods without events: delta at t_end, stuck by then).
+Seed case (``kappa = 3e9``, v = 1 m/s), laws ``hunt-crossley`` and ``paper``, ``t_end = 2e-3`` s,
+no stop when settled (the state at ``t_end`` is then defined for everyone). Errors:
 
-    python benchmarks/work_precision.py [--quick]
+(a) max force, relative;
+(b) the state at ``t_end``: max over components, positions over the Hertz indentation, velocities
+    over v.
+
+Contenders:
+
+- ours: ``simulate(params, law, 2e-3, rtol=r, stop_when_settled=False)``, rtol 1e-4..1e-13;
+- scipy with the same events: the oracle (``tests/oracle.py``: ``solve_ivp`` on the same law
+  entries, the same event table, phase by phase) with ``method`` DOP853, RK45, Radau, BDF, LSODA;
+  its max force is located on the force-peak event;
+- plain scipy: ``solve_ivp`` on the same right-hand side without events (``paper``: eq. 8 read
+  literally), max force the largest over its steps;
+- heyoka (``benchmarks/peers.py``, its own venv), drawn when ``results/peers.json`` exists.
+
+Reference: the oracle (DOP853) at rtol 1e-13; the floor row says how far ours at 1e-13 is from
+it. Times: median of repeats; a run slower than the budget ends that method's sweep.
+
+    python benchmarks/work_precision.py [--quick] [--plot-only]
 """
 
 from __future__ import annotations
 
 import argparse
+import json
 import math
+import statistics
 import sys
 import time
+import warnings
 from pathlib import Path
 
 import numpy as np
 from scipy.integrate import solve_ivp
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from _common import FIGURES, RESULTS, emit, machine, save_section, table, timed  # noqa: E402
+from _common import FIGURES, RESULTS, ROOT, emit, load, machine, save_section, save_targets, table, target  # noqa: E402
 
-import phaseimpact.integrate as integrate  # noqa: E402
-from phaseimpact.integrate import simulate  # noqa: E402
-from phaseimpact.integrate._trajectory import state_scale  # noqa: E402
-from phaseimpact.model import X1, X2, as_law, coefficients, contact_force, initial_state, rhs  # noqa: E402
-from phaseimpact.parameters import seed_parameters  # noqa: E402
+sys.path.insert(0, str(ROOT / "tests"))
+import oracle as oracle_module  # noqa: E402
+
+from phaseimpact import seed_parameters, simulate  # noqa: E402
+from phaseimpact.integrate import api  # noqa: E402
+from phaseimpact.model import as_law, pack  # noqa: E402
+from phaseimpact.model.laws import PLAIN  # noqa: E402
+from phaseimpact.model.rhs import rhs  # noqa: E402
 
 T_END = 2e-3
 KAPPA = 3e9
 LAWS = ("hunt-crossley", "paper")
-RTOLS = [1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10, 1e-11, 1e-12]
-RK4_STEPS = [1e-6, 3e-7, 1e-7, 3e-8, 1e-8]
-RK4_BUDGET = 20.0  # s: skip RK4 steps predicted slower than this
-SCIPY_BUDGET = 20.0  # s: a solve_ivp run is abandoned after this (paper's plain RHS chatters)
+RTOLS = [10.0**-k for k in range(4, 14)]
+METHODS = ("DOP853", "RK45", "Radau", "BDF", "LSODA")
+ERRORS = ("max force", "state at t_end")
+OURS = "ours (compiled driver)"
 
 
 class _Timeout(Exception):
     pass
 
 
-ERRORS = ("max force", "state at t_end", "stick indentation")
+class Budget:
+    """A deadline for the scipy runs: the right-hand side they call raises after it."""
 
+    def __init__(self):
+        self.deadline = math.inf
 
-def _stick_delta(events, final_state):
-    for e in events:
-        if e.kind == "stick":
-            return e.delta
-    return float(final_state[X1] - final_state[X2])
-
-
-def summary_of(max_force, final_state, stick_delta):
-    return {"max_force": float(max_force), "final": np.asarray(final_state, float)[:4],
-            "stick": float(stick_delta)}
-
-
-def run_exact(params, law, rtol, method):
-    tr = simulate(params, law, T_END, rtol=rtol, method=method, stop_when_settled=False)
-    return tr, summary_of(tr.max_force, tr.final_state, _stick_delta(tr.events, tr.final_state))
-
-
-def run_rk4(params, law, step):
-    tr = simulate(params, law, T_END, integrator="rk4", step=step)
-    return tr, summary_of(tr.max_force, tr.final_state, _stick_delta((), tr.final_state))
-
-
-def run_scipy(params, law, rtol, method):
-    c = coefficients(params, as_law(law))
-    law_ = as_law(law)
-    y0 = initial_state(params.v)
-    scale = state_scale(params, c)
-    deadline = time.perf_counter() + SCIPY_BUDGET
-
-    def f(t, y):
-        if time.perf_counter() > deadline:
+    def rhs(self, *args):
+        if time.perf_counter() > self.deadline:
             raise _Timeout
-        return rhs(y, c, law_)
-
-    sol = solve_ivp(f, (0.0, T_END), y0, method=method, rtol=rtol, atol=rtol * scale)
-    force = contact_force(sol.y.T, c, law_)
-    final = sol.y[:, -1]
-    out = summary_of(np.max(force), final, final[X1] - final[X2])
-    out["nfev"] = sol.nfev
-    out["status"] = "success" if sol.success else sol.message
-    return sol, out
+        return rhs(*args)
 
 
-def run_batch(params, law, rtol):
-    tr = integrate.simulate_batch([params], law, T_END, rtol=rtol, stop_when_settled=False)[0]
-    return tr, summary_of(tr.max_force, tr.final_state, _stick_delta(tr.events, tr.final_state))
+BUDGET = Budget()
+oracle_module.rhs = BUDGET.rhs  # the oracle's right-hand side, with the deadline
 
 
-def errors(res, ref, scale):
-    e_force = abs(res["max_force"] - ref["max_force"]) / abs(ref["max_force"])
-    e_state = float(np.max(np.abs(res["final"] - ref["final"]) / scale[:4]))
-    e_stick = abs(res["stick"] - ref["stick"]) / abs(ref["stick"])
-    return e_force, e_state, e_stick
+def scale_of(params):
+    s = params.hertz_indentation
+    return np.array([s, s, params.v, params.v])
+
+
+def run_ours(params, law, rtol):
+    tr = simulate(params, law, T_END, rtol=rtol, stop_when_settled=False)
+    return tr.max_force, tr.final_state[:4], tr.nfev, tr.status
+
+
+def run_oracle(params, law, rtol, method):
+    run = oracle_module.oracle(params, law, T_END, rtol=rtol, method=method, settle=False)
+    status = "success" if run.t_stop >= T_END * (1 - 1e-12) else f"stopped at {run.t_stop:.3g} s ({run.reason})"
+    return run.max_force, run.final_state[:4], run.nfev, status
+
+
+def run_plain(params, law, rtol, method):
+    law = as_law(law)
+    c = pack(params, law)
+    mode = PLAIN if law.is_filippov else 1
+
+    def fun(_t, y):
+        out = np.empty(5)
+        BUDGET.rhs(law.code, c, y, mode, out)
+        return out
+
+    with warnings.catch_warnings(), np.errstate(all="ignore"):  # the chattering runs overflow their Jacobians
+        warnings.simplefilter("ignore", RuntimeWarning)
+        sol = solve_ivp(fun, (0.0, T_END), api._initial(params, None), method=method, rtol=rtol,
+                        atol=api._atol(params, rtol, None))
+    out = np.empty(5)
+    force = max(rhs(law.code, c, sol.y[:, i], mode, out) for i in range(sol.y.shape[1]))
+    return force, sol.y[:4, -1], sol.nfev, "success" if sol.success else sol.message
+
+
+def measure(fn, repeats, budget):
+    """(median time, result) of ``fn``; one run only if it is slow; None if over ``budget``."""
+    times, result = [], None
+    for _ in range(repeats):
+        BUDGET.deadline = time.perf_counter() + budget
+        start = time.perf_counter()
+        try:
+            result = fn()
+        except _Timeout:
+            return None
+        finally:
+            BUDGET.deadline = math.inf
+        times.append(time.perf_counter() - start)
+        if times[-1] > 0.5:
+            break
+    if times[0] < 1e-3:  # fast: the mean of many calls per repeat
+        number = int(0.02 / times[0]) + 1
+        times = []
+        for _ in range(repeats):
+            start = time.perf_counter()
+            for _ in range(number):
+                fn()
+            times.append((time.perf_counter() - start) / number)
+    return statistics.median(times), result
 
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__)
-    ap.add_argument("--quick", action="store_true", help="fewer tolerances, one repeat")
-    ap.add_argument("--plot-only", action="store_true", help="redraw the figure from results/work_precision.md")
+    ap.add_argument("--quick", action="store_true", help="every other rtol, 3 repeats, 2 s budget")
+    ap.add_argument("--plot-only", action="store_true",
+                    help="redraw the figure from results/work_precision_points.json")
     args = ap.parse_args(argv)
+    name = "work_precision" + args.quick * "_quick"
     if args.plot_only:
-        plot(curves_from_table(RESULTS / "work_precision.md"))
+        plot(json.loads((RESULTS / f"{name}_points.json").read_text())["points"])
         return 0
-    rtols = RTOLS[::2] if args.quick else RTOLS
-    repeats = 1 if args.quick else 3
+    rtols = RTOLS[::2] + [RTOLS[-1]] if args.quick else RTOLS
+    repeats, budget = (3, 2.0) if args.quick else (5, 10.0)
+    start_load = load()
     emit(f"# Work-precision (seed case, kappa = {KAPPA:g}, v = 1 m/s, t_end = {T_END:g} s)\n")
-    emit(machine() + "\n")
-    has_batch = hasattr(integrate, "simulate_batch")
-    if not has_batch:
-        emit("**simulate_batch not available: batch integrator not benchmarked (placeholder).**\n")
-    rows, curves = [], {}
-    params = seed_parameters(kappa=KAPPA)
+    emit(machine())
+    emit(start_load + "\n")
+    params = seed_parameters(v=1.0, kappa=KAPPA)
+    scale = scale_of(params)
+    rows, points, floors = [], [], {}
     for law in LAWS:
-        c = coefficients(params, as_law(law))
-        scale = state_scale(params, c)
-        t0 = time.perf_counter()
-        _, ref = run_exact(params, law, 1e-13, "DOP853")
-        emit(f"reference {law}: max force {ref['max_force']:.10g} N, stick delta {ref['stick']:.10g} m "
-             f"({time.perf_counter() - t0:.2f} s)")
-        runs = []
-        for method in ("DOP853", "RK45"):
-            runs += [(f"exact {method}", f"rtol={r:g}", lambda r=r, m=method, lw=law: run_exact(params, lw, r, m))
-                     for r in rtols]
-        if has_batch:
-            runs += [("batch DOP853", f"rtol={r:g}", lambda r=r, lw=law: run_batch(params, lw, r)) for r in rtols]
-        for method in ("RK45", "DOP853", "LSODA", "Radau"):
-            runs += [(f"solve_ivp {method}", f"rtol={r:g}", lambda r=r, m=method, lw=law: run_scipy(params, lw, r, m))
-                     for r in rtols]
-        rk4_cost = None  # s per step
-        for step in RK4_STEPS:
-            n = math.ceil(T_END / step)
-            if rk4_cost is not None and rk4_cost * n > RK4_BUDGET:
-                rows.append((law, "seed RK4", f"step={step:g}", "skipped", "", "", "", "",
-                             f"predicted {rk4_cost * n:.0f} s > {RK4_BUDGET:g} s"))
-                continue
-            runs.append(("seed RK4", f"step={step:g}", lambda s=step, lw=law: run_rk4(params, lw, s)))
-            wall, (tr, res) = timed(runs.pop()[2], repeats=repeats)
-            rk4_cost = wall / n
-            _record(rows, curves, law, "seed RK4", f"step={step:g}", wall, tr, res, ref, scale)
-        timed_out = set()
-        for name, setting, fn in runs:
-            if name in timed_out:
-                rows.append((law, name, setting, "skipped", "", "", "", "", "a looser rtol exceeded the budget"))
-                continue
-            try:
-                wall, (tr, res) = timed(fn, repeats=repeats)
-            except _Timeout:
-                timed_out.add(name)
-                rows.append((law, name, setting, f"> {SCIPY_BUDGET:g}", "", "", "", "",
-                             f"abandoned after {SCIPY_BUDGET:g} s"))
-                emit(f"{law:14s} {name:18s} {setting:14s} abandoned after {SCIPY_BUDGET:g} s")
-                continue
-            _record(rows, curves, law, name, setting, wall, tr, res, ref, scale)
-    header = ("law", "method", "setting", "time [s]", "nfev", "err max force", "err state(t_end)",
-              "err stick delta", "status")
-    text = table(header, rows)
+        ref_force, ref_state, _, _ = run_oracle(params, law, 1e-13, "DOP853")
+        f13, s13, _, _ = run_ours(params, law, 1e-13)
+        floors[law] = (abs(f13 / ref_force - 1), float(np.max(np.abs(s13 - ref_state) / scale)))
+        emit(f"{law}: reference max force {ref_force!r} N; ours at 1e-13 differs by {floors[law][0]:.1e} (force), "
+             f"{floors[law][1]:.1e} (state)")
+        contenders = [(OURS, lambda r, law=law: run_ours(params, law, r))]
+        contenders += [(f"scipy {m} + events", lambda r, m=m, law=law: run_oracle(params, law, r, m)) for m in METHODS]
+        contenders += [(f"scipy {m}, no events", lambda r, m=m, law=law: run_plain(params, law, r, m)) for m in METHODS]
+        for label, fn in contenders:
+            for r in rtols:
+                got = measure(lambda fn=fn, r=r: fn(r), repeats, budget)
+                if got is None:
+                    rows.append((law, label, f"{r:.0e}", f"> {budget:g} s", "", "", "", "abandoned (budget)"))
+                    emit(f"{law:14s} {label:26s} rtol={r:.0e} abandoned after {budget:g} s")
+                    break
+                seconds, (force, state, nfev, status) = got
+                e_force = abs(force / ref_force - 1)
+                e_state = float(np.max(np.abs(np.asarray(state) - ref_state) / scale))
+                rows.append((law, label, f"{r:.0e}", f"{seconds * 1e3:.3g}", nfev, e_force, e_state, status))
+                if label == "scipy DOP853 + events" and r == 1e-13:
+                    rows[-1] = rows[-1][:-1] + ("the reference",)
+                elif status == "success":
+                    points.append({"law": law, "method": label, "rtol": r, "time": seconds,
+                                   "errors": [e_force, e_state]})
+                emit(f"{law:14s} {label:26s} rtol={r:.0e} {seconds * 1e3:9.3f} ms  force {e_force:.1e}  "
+                     f"state {e_state:.1e}  nfev {nfev}  {status}")
+    peers = RESULTS / "peers.json"
+    if peers.exists():
+        points += json.loads(peers.read_text())["points"]
+    end_load = load()
+    eq_rows, targets = equal_accuracy(points)
+    header = ("law", "method", "rtol", "time [ms]", "nfev", "err max force", "err state(t_end)", "status")
+    eq_header = ("law", "error", "target", "ours [ms]", "fastest scipy (or heyoka) reaching it [ms]",
+                 "ours / fastest other", "every other's time [ms]")
+    floor_text = "; ".join(f"{law}: {f:.1e} (max force), {s:.1e} (state)" for law, (f, s) in floors.items())
+    text = (f"Reference: the oracle (DOP853 with events) at rtol 1e-13. Ours at rtol 1e-13 against it: {floor_text}; "
+            "errors near that level are the reference's own.\n\n"
+            "At equal accuracy: the fastest run of each method whose error meets the target.\n\n"
+            + table(eq_header, eq_rows) + "\n\nEvery run:\n\n" + table(header, rows))
     emit()
     emit(text)
-    save_section("work_precision" + args.quick * "_quick",
-                 f"## Work-precision\n\n{machine()}\n\nSeed case, kappa = {KAPPA:g}, "
-                 f"v = 1 m/s, t_end = {T_END:g} s; reference: exact DOP853 at rtol = 1e-13; "
-                 f"time = median of {repeats} runs.\n\n" + text)
-    plot(curves)
+    emit(f"\nat the end: {end_load}")
+    save_section(name, f"## Work-precision\n\n{machine()}\n\n{start_load} at the start, {end_load} at the end.\n\n"
+                       f"Seed case, kappa = {KAPPA:g}, v = 1 m/s, t_end = {T_END:g} s (no stop when settled); time = "
+                       f"median of {repeats}; figure `figures/work_precision.png`. "
+                       "`python benchmarks/work_precision.py`\n\n" + text)
+    (RESULTS / f"{name}_points.json").write_text(json.dumps({"load": end_load, "points": points}, indent=0) + "\n")
+    save_targets(name, targets)
+    plot(points)
     return 0
 
 
-def _record(rows, curves, law, name, setting, wall, tr, res, ref, scale):
-    e = errors(res, ref, scale)
-    nfev = res.get("nfev", getattr(tr, "nfev", ""))
-    status = res.get("status", getattr(tr, "status", ""))
-    rows.append((law, name, setting, wall, nfev, e[0], e[1], e[2] if law == "paper" else "", status))
-    if status == "success":  # a failed run's numbers are not a point of the trade-off
-        curves.setdefault((law, name), []).append((wall, *e))
-    emit(f"{law:14s} {name:18s} {setting:14s} {wall:9.4f} s  force {e[0]:.2e}  state {e[1]:.2e}  "
-         f"stick {e[2]:.2e}  {status}")
+def equal_accuracy(points):
+    """Rows of the equal-accuracy table, and the targets: ours at or below every other method."""
+    rows, worst = [], {}
+    for law in LAWS:
+        for k, err in enumerate(ERRORS):
+            for goal in (1e-6, 1e-8, 1e-10):
+                best = {}
+                for p in points:
+                    if p["law"] == law and p["errors"][k] <= goal:
+                        if p["method"] not in best or p["time"] < best[p["method"]]:
+                            best[p["method"]] = p["time"]
+                ours = best.pop(OURS, None)
+                if not best:
+                    continue
+                other = min(best, key=best.get)
+                ratio = ours / best[other] if ours else math.inf
+                rows.append((law, err, f"{goal:.0e}", f"{ours * 1e3:.3g}" if ours else "not reached",
+                             f"{best[other] * 1e3:.3g} ({other})", f"{ratio:.2f}",
+                             "; ".join(f"{m.replace('scipy ', '')} {t * 1e3:.3g}"
+                                       for m, t in sorted(best.items(), key=lambda x: x[1]))))
+                key = (law, err)
+                if key not in worst or ratio > worst[key][0]:
+                    worst[key] = (ratio, goal, other)
+    targets = [target(f"work-precision, {law}, {err}", "at or below every scipy method and heyoka",
+                      f"worst ours/fastest other {ratio:.2f} (at {goal:.0e}, vs {other})", bool(ratio <= 1.0),
+                      "python benchmarks/work_precision.py") for (law, err), (ratio, goal, other) in worst.items()]
+    return rows, targets
 
 
-def curves_from_table(path) -> dict:
-    """The plotted points, read back from a results table (``--plot-only``)."""
-    curves = {}
-    for line in Path(path).read_text().splitlines():
-        cells = [c.strip() for c in line.strip().strip("|").split("|")]
-        if len(cells) != 9 or cells[-1] != "success":
-            continue
-        law, name, _, wall, _, force, state, stick, _ = cells
-        try:
-            point = (float(wall), float(force), float(state), float(stick) if stick else float("nan"))
-        except ValueError:
-            continue
-        curves.setdefault((law, name), []).append(point)
-    return curves
-
-
-def plot(curves) -> None:
+def plot(points) -> None:
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    kinds = [(law, k) for law in LAWS for k in range(3) if not (law != "paper" and k == 2)]
-    fig, axes = plt.subplots(1, len(kinds), figsize=(5 * len(kinds), 4.5), squeeze=False)
-    styles = {"exact DOP853": ("C0", "o-"), "exact RK45": ("C1", "o-"), "batch DOP853": ("C2", "D--"),
-              "solve_ivp RK45": ("C3", "s:"), "solve_ivp DOP853": ("C4", "s:"), "solve_ivp LSODA": ("C5", "s:"),
-              "solve_ivp Radau": ("C6", "s:"), "seed RK4": ("k", "^-")}
+    fig, axes = plt.subplots(len(LAWS), len(ERRORS), figsize=(12, 9.5), squeeze=False)
+    colors = {"DOP853": "C0", "RK45": "C1", "Radau": "C2", "BDF": "C3", "LSODA": "C4"}
     floor = 1e-16
-    for ax, (law, k) in zip(axes[0], kinds, strict=True):
-        for (lw, name), pts in curves.items():
-            if lw != law:
-                continue
-            color, style = styles.get(name, ("gray", "x-"))
-            ax.loglog([p[1 + k] if p[1 + k] > floor else floor for p in pts], [p[0] for p in pts], style,
-                      color=color, label=name, ms=4)
-        ax.set_xlabel(f"relative error: {ERRORS[k]}")
-        ax.set_ylabel("wall time [s]")
-        ax.set_title(f"{law}: {ERRORS[k]}")
-        ax.grid(True, which="both", alpha=0.3)
-    axes[0][0].legend(fontsize=7)
-    fig.suptitle(f"Work-precision, seed case kappa = {KAPPA:g}, t_end = {T_END:g} s (errors < 1e-16 drawn at 1e-16)")
-    fig.tight_layout()
+    methods = list(dict.fromkeys(p["method"] for p in points))
+    for i, law in enumerate(LAWS):
+        for k, err in enumerate(ERRORS):
+            ax = axes[i][k]
+            for method in methods:
+                pts = sorted((p for p in points if p["law"] == law and p["method"] == method), key=lambda p: p["rtol"])
+                if not pts:
+                    continue
+                x = [max(p["errors"][k], floor) for p in pts]
+                y = [p["time"] * 1e3 for p in pts]
+                if method == OURS:
+                    ax.loglog(x, y, "o-", color="k", lw=2.5, ms=6, label=method, zorder=5)
+                elif method.startswith("heyoka"):
+                    ax.loglog(x, y, "*-", color="m", lw=1.8, ms=8, label=method, zorder=4)
+                else:
+                    m = method.split()[1].rstrip(",")
+                    events = "events" in method and "no events" not in method
+                    ax.loglog(x, y, "s-" if events else "x:", color=colors.get(m, "gray"), lw=1.2 if events else 1.0,
+                              ms=4, alpha=0.9, label=method)
+            ax.set_xlabel(f"relative error of the {err}")
+            ax.set_ylabel("time per run [ms]")
+            ax.set_title(f"{law}: {err}")
+            ax.grid(True, which="both", alpha=0.3)
+    handles, labels = [], []
+    for ax in axes.flat:
+        for h, lab in zip(*ax.get_legend_handles_labels(), strict=True):
+            if lab not in labels:
+                handles.append(h)
+                labels.append(lab)
+    fig.legend(handles, labels, loc="lower center", ncol=4, fontsize=8, frameon=False)
+    fig.suptitle(f"Work-precision, seed case kappa = {KAPPA:g}, v = 1 m/s, t_end = {T_END:g} s "
+                 "(lower left is better; errors below 1e-16 drawn at 1e-16)", fontsize=11)
+    fig.tight_layout(rect=(0, 0.08, 1, 0.97))
     FIGURES.mkdir(exist_ok=True)
-    fig.savefig(FIGURES / "work_precision.png", dpi=120)
+    fig.savefig(FIGURES / "work_precision.png", dpi=110)
+    plt.close(fig)
     emit(f"\nwrote {FIGURES / 'work_precision.png'}")
 
 
