@@ -17,7 +17,6 @@ as it was used.
 from __future__ import annotations
 
 import argparse
-import asyncio
 import dataclasses
 import json
 import math
@@ -57,7 +56,6 @@ MAX_PANELS = 12
 MAX_JOBS = 4 * (os.cpu_count() or 1)
 BACKENDS = ("threads", "loky", "dask")
 #: Seconds to wait for a Dask scheduler before giving up.
-SCHEDULER_TIMEOUT = 5.0
 #: Statuses of critical_damping that are answers (anything else is a failure: exit 1).
 CRITICAL_ANSWERS = ("success", "not-found", "unconfirmed")
 #: What a critical curve continues.
@@ -380,30 +378,6 @@ def _check_kappa_range(args) -> None:
                          "allowed: kappa-min < kappa-max")
 
 
-def _check_scheduler(address: str) -> None:
-    """Refuse an address where no Dask scheduler answers, within :data:`SCHEDULER_TIMEOUT` s."""
-    try:
-        from distributed.core import rpc
-    except ImportError:
-        raise ValueError("backend = 'dask' needs dask.distributed: pip install 'phaseimpact[dask]'") from None
-
-    async def identity():
-        remote = rpc(address, timeout=SCHEDULER_TIMEOUT)
-        try:
-            return await asyncio.wait_for(remote.identity(), SCHEDULER_TIMEOUT)
-        finally:
-            await remote.close_rpc()
-
-    try:
-        answer = asyncio.run(identity())
-    except Exception as error:  # any failure to talk to it means: not a usable scheduler
-        reason = str(error) or f"no answer within {SCHEDULER_TIMEOUT:g} s"
-        raise ValueError(f"scheduler = {address!r} is out of reach ({type(error).__name__}: {reason}); "
-                         "allowed: the address of a running Dask scheduler, e.g. tcp://host:8786") from None
-    if not (isinstance(answer, dict) and answer.get("type") == "Scheduler"):
-        raise ValueError(f"scheduler = {address!r} is out of range: it answers, but is not a Dask scheduler")
-
-
 def _check_figure_target(path: str, force: bool) -> None:
     """Refuse to replace an existing file that is not a figure of the format asked for, unless ``force``."""
     if force or not os.path.isfile(path):
@@ -632,12 +606,13 @@ def _run_grid(args, setup: Setup, axes: list):
     """
     from . import archive
     from .continuation import Grid, atlas
+    from .continuation._parallel import check_scheduler
 
     Grid(setup.case, setup.law, tuple(axes))  # every check of the grid, before any work
     out = args.out
     archive.created_timestamp()  # a bad SOURCE_DATE_EPOCH is refused now, not at the first checkpoint
     if args.backend == "dask" and args.scheduler is not None:
-        _check_scheduler(args.scheduler)
+        check_scheduler(args.scheduler)  # before any work: a dead address fails within seconds
     named = {axis.name: axis.values for axis in axes}
     size = int(np.prod([len(axis.values) for axis in axes]))
     grid_kinds = [k for k in archive.KINDS if k != "critical-curve"]  # "sweep" (and "atlas": several axes)

@@ -77,6 +77,32 @@ def _grow(a, n):
 
 
 @numba.njit(cache=True)
+def _push_event(ev_t, ev_kind, ev_mode, ev_y, ev_force, n, t, kind, mode, y, force):
+    """Append an event to the log (grown by doubling); returns the arrays and the new length."""
+    if n == ev_t.shape[0]:
+        ev_t, ev_kind, ev_mode, ev_y, ev_force = (_grow(ev_t, n), _grow(ev_kind, n), _grow(ev_mode, n),
+                                                  _grow(ev_y, n), _grow(ev_force, n))
+    ev_t[n] = t
+    ev_kind[n] = kind
+    ev_mode[n] = mode
+    ev_y[n] = y
+    ev_force[n] = force
+    return ev_t, ev_kind, ev_mode, ev_y, ev_force, n + 1
+
+
+@numba.njit(cache=True)
+def _push_sample(s_t, s_y, s_mode, s_force, n, t, y, mode, force):
+    """Append a sample (grown by doubling); returns the arrays and the new length."""
+    if n == s_t.shape[0]:
+        s_t, s_y, s_mode, s_force = _grow(s_t, n), _grow(s_y, n), _grow(s_mode, n), _grow(s_force, n)
+    s_t[n] = t
+    s_y[n] = y
+    s_mode[n] = mode
+    s_force[n] = force
+    return s_t, s_y, s_mode, s_force, n + 1
+
+
+@numba.njit(cache=True)
 def _event_at(code, c, mode, energy_limit, column, F, y0, t0, h, s, ys, fs, gs):
     """Event function ``column`` at time ``s`` on the dense output of the step."""
     dop853.dense_eval(F, y0, t0, h, s, ys)
@@ -280,14 +306,8 @@ def run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count,
         n_s = 1
     if save_kind == SAVE_TIMES:
         while i_time < times.shape[0] and times[i_time] <= 0.0:
-            if n_s == s_t.shape[0]:
-                s_t, s_y, s_mode, s_force = (_grow(s_t, n_s), _grow(s_y, n_s), _grow(s_mode, n_s),
-                                                  _grow(s_force, n_s))
-            s_t[n_s] = times[i_time]
-            s_y[n_s] = y
-            s_mode[n_s] = mode
-            s_force[n_s] = force
-            n_s += 1
+            s_t, s_y, s_mode, s_force, n_s = _push_sample(s_t, s_y, s_mode, s_force, n_s, times[i_time], y,
+                                                            mode, force)
             i_time += 1
 
     status = SUCCESS
@@ -341,16 +361,10 @@ def run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count,
             d_old = y[X1] - y[X2]
             d_new = y_new[X1] - y_new[X2]
             if (d_old <= 0 < d_new) or (d_old > 0 >= d_new):
-                if n_ev == ev_t.shape[0]:
-                    ev_t, ev_kind, ev_mode = _grow(ev_t, n_ev), _grow(ev_kind, n_ev), _grow(ev_mode, n_ev)
-                    ev_y, ev_force = _grow(ev_y, n_ev), _grow(ev_force, n_ev)
                 kind = CONTACT if d_new > 0 else SEPARATION
-                ev_t[n_ev] = t + h * d_old / (d_old - d_new)  # linear: RK4 resolves no event
-                ev_kind[n_ev] = kind
-                ev_mode[n_ev] = mode
-                ev_y[n_ev] = y_new
-                ev_force[n_ev] = force_new
-                n_ev += 1
+                t_cross = t + h * d_old / (d_old - d_new)  # linear: RK4 resolves no event
+                ev_t, ev_kind, ev_mode, ev_y, ev_force, n_ev = _push_event(
+                    ev_t, ev_kind, ev_mode, ev_y, ev_force, n_ev, t_cross, kind, mode, y_new, force_new)
                 counts[kind] += 1
             t += h
             for j in range(5):
@@ -358,14 +372,8 @@ def run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count,
             max_force = max(max_force, force_new)
             max_indentation = max(max_indentation, d_new)
             if save_kind == SAVE_STEPS and (nsteps % rk4_every == 0 or t >= t_end):
-                if n_s == s_t.shape[0]:
-                    s_t, s_y, s_mode, s_force = (_grow(s_t, n_s), _grow(s_y, n_s), _grow(s_mode, n_s),
-                                                  _grow(s_force, n_s))
-                s_t[n_s] = t
-                s_y[n_s] = y
-                s_mode[n_s] = mode
-                s_force[n_s] = force_new
-                n_s += 1
+                s_t, s_y, s_mode, s_force, n_s = _push_sample(s_t, s_y, s_mode, s_force, n_s, t, y,
+                                                                mode, force_new)
             if energy(code, c, y) > energy_limit:
                 reason = RUNAWAY_STOP
                 break
@@ -455,15 +463,8 @@ def run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count,
                 kind = FORCE_PEAK if best == FORCE_RATE else REVERSAL
                 if best == REACH:
                     kind = SETTLED  # recorded only: the run goes on
-                if n_ev == ev_t.shape[0]:
-                    ev_t, ev_kind, ev_mode = _grow(ev_t, n_ev), _grow(ev_kind, n_ev), _grow(ev_mode, n_ev)
-                    ev_y, ev_force = _grow(ev_y, n_ev), _grow(ev_force, n_ev)
-                ev_t[n_ev] = roots[best]
-                ev_kind[n_ev] = kind
-                ev_mode[n_ev] = mode
-                ev_y[n_ev] = ys
-                ev_force[n_ev] = f_ev
-                n_ev += 1
+                ev_t, ev_kind, ev_mode, ev_y, ev_force, n_ev = _push_event(
+                    ev_t, ev_kind, ev_mode, ev_y, ev_force, n_ev, roots[best], kind, mode, ys, f_ev)
                 counts[kind] += 1
                 max_force = max(max_force, f_ev)
                 max_indentation = max(max_indentation, ys[X1] - ys[X2])
@@ -486,15 +487,9 @@ def run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count,
                     dop853.dense_coefficients(code, c, mode, y, f, y_new, f_new, h, K, F, tmp)
                     nfev += 3
                     have_dense = True
-                if n_s == s_t.shape[0]:
-                    s_t, s_y, s_mode, s_force = (_grow(s_t, n_s), _grow(s_y, n_s), _grow(s_mode, n_s),
-                                                  _grow(s_force, n_s))
                 dop853.dense_eval(F, y, t, h, times[i_time], ys)
-                s_t[n_s] = times[i_time]
-                s_y[n_s] = ys
-                s_mode[n_s] = mode
-                s_force[n_s] = rhs(code, c, ys, mode, fs)
-                n_s += 1
+                s_t, s_y, s_mode, s_force, n_s = _push_sample(s_t, s_y, s_mode, s_force, n_s, times[i_time], ys,
+                                                              mode, rhs(code, c, ys, mode, fs))
                 i_time += 1
         if restart_col >= 0:
             # the state at the root from a fresh step that ends there (|delta|^alpha is only C^1
@@ -516,27 +511,14 @@ def run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count,
                 _quiet_start(quiet, y, mode, g_old)
                 h_abs = max(h_next, h_r)
                 continue
-            if n_ev == ev_t.shape[0]:
-                ev_t, ev_kind, ev_mode = _grow(ev_t, n_ev), _grow(ev_kind, n_ev), _grow(ev_mode, n_ev)
-                ev_y, ev_force = _grow(ev_y, n_ev), _grow(ev_force, n_ev)
-            ev_t[n_ev] = t
-            ev_kind[n_ev] = kind
-            ev_mode[n_ev] = mode
-            ev_y[n_ev] = y
-            ev_force[n_ev] = force
-            n_ev += 1
+            ev_t, ev_kind, ev_mode, ev_y, ev_force, n_ev = _push_event(
+                ev_t, ev_kind, ev_mode, ev_y, ev_force, n_ev, t, kind, mode, y, force)
             counts[kind] += 1
             max_force = max(max_force, force)
             max_indentation = max(max_indentation, y[X1] - y[X2])
             if save_kind == SAVE_STEPS:
-                if n_s == s_t.shape[0]:
-                    s_t, s_y, s_mode, s_force = (_grow(s_t, n_s), _grow(s_y, n_s), _grow(s_mode, n_s),
-                                                  _grow(s_force, n_s))
-                s_t[n_s] = t
-                s_y[n_s] = y
-                s_mode[n_s] = mode
-                s_force[n_s] = force
-                n_s += 1
+                s_t, s_y, s_mode, s_force, n_s = _push_sample(s_t, s_y, s_mode, s_force, n_s, t, y,
+                                                                mode, force)
             if action == STOP_SETTLED:
                 reason = SETTLED_STOP
                 break
@@ -563,14 +545,8 @@ def run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count,
         max_force = max(max_force, force)
         max_indentation = max(max_indentation, y[X1] - y[X2])
         if save_kind == SAVE_STEPS:
-            if n_s == s_t.shape[0]:
-                s_t, s_y, s_mode, s_force = (_grow(s_t, n_s), _grow(s_y, n_s), _grow(s_mode, n_s),
-                                                  _grow(s_force, n_s))
-            s_t[n_s] = t
-            s_y[n_s] = y
-            s_mode[n_s] = mode
-            s_force[n_s] = force
-            n_s += 1
+            s_t, s_y, s_mode, s_force, n_s = _push_sample(s_t, s_y, s_mode, s_force, n_s, t, y,
+                                                            mode, force)
 
     summary = _summarize(code, c, y0, y, mode, status, reason, t, max_force, max_indentation, counts,
                          n_ev, ev_t, ev_kind, ev_y, nsteps, nfev)
