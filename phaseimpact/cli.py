@@ -659,6 +659,12 @@ def _histogram(values, computed) -> dict:
     return {int(k): int(n) for k, n in zip(*counts, strict=True)}
 
 
+def _outcome_name(code) -> str:
+    from .integrate import OUTCOMES
+
+    return OUTCOMES[int(code)]
+
+
 def _grid_summary(result, out_path, setup: Setup) -> dict:
     computed = result.status >= 0
     failed = result.failed
@@ -679,6 +685,12 @@ def _grid_summary(result, out_path, setup: Setup) -> dict:
         split = np.flatnonzero(computed[:-1] & computed[1:] & (n_stick[:-1] == 1) & (n_stick[1:] >= 2))
         summary["first_split"] = (None if not split.size
                                   else [float(kappas[split[0]]), float(kappas[split[0] + 1])])
+    boundaries = result.extras.get("boundaries")
+    if boundaries is not None:
+        summary["boundaries"] = {"axis": boundaries["axis"], "rtol": float(boundaries["rtol"]),
+                                 "points": np.asarray(boundaries["points"]).tolist(),
+                                 "below": [_outcome_name(c) for c in boundaries["below"]],
+                                 "above": [_outcome_name(c) for c in boundaries["above"]]}
     summary["case"] = setup.case.as_dict()
     return summary
 
@@ -692,6 +704,9 @@ def _print_grid_summary(s: dict) -> None:
     if s["contact"] is not None:  # paper: stick phases
         print("  stick phases:  " + ", ".join(f"{k}: {v} points" for k, v in s["n_stick"].items()))
     print("  contacts:      " + ", ".join(f"{k}: {v} points" for k, v in s["n_contacts"].items()))
+    if "boundaries" in s:
+        b = s["boundaries"]
+        print(f"  boundaries:    {len(b['points'])} points refined along {b['axis']} to {b['rtol']:g} (relative)")
     if "first_split" in s:
         if s["first_split"] is None:
             print("  the count of stick phases never goes from 1 to 2 on this grid")
@@ -746,7 +761,20 @@ def cmd_atlas(args) -> int:
     size = int(np.prod([len(a.values) for a in args.axis]))
     if size > MAX_SWEEP_POINTS:
         raise ValueError(f"axis: the grid has {size} points; allowed: at most {MAX_SWEEP_POINTS}")
-    return _finish_grid(args, _run_grid(args, setup, list(args.axis)), setup)
+    if args.refine is not None and args.refine not in names:
+        raise ValueError(f"refine = {args.refine!r} is out of range; allowed: one of the axes ({', '.join(names)})")
+    result = _run_grid(args, setup, list(args.axis))
+    if result is not None and args.refine is not None:
+        from . import archive
+        from .continuation import refine_boundaries
+
+        _note(f"refining the class boundaries along {args.refine}")
+        found = refine_boundaries(result, args.refine, rtol=args.refine_rtol, integrator_rtol=args.rtol)
+        result.extras["boundaries"] = {"axis": found.axis, "points": found.points, "below": found.below,
+                                       "above": found.above, "rtol": found.rtol}
+        with exclusive(args.out, "out"):
+            archive.save(result, args.out, force=True)  # the same work, with its boundaries
+    return _finish_grid(args, result, setup)
 
 
 # ------------------------------------------------------------------------------------------------
@@ -1228,6 +1256,12 @@ def build_parser() -> argparse.ArgumentParser:
                    help="one axis of the grid (repeat for each): NAME=START:STOP:NUM (linear), with :log for log "
                         "spacing, or NAME=V1,V2,...; names: kappa, v, M1, M2, K, Kb, Km, alpha and the --set names; "
                         f"at most {MAX_SWEEP_POINTS} points in all; an axis the law does not read is refused")
+    p.add_argument("--refine", default=None, metavar="AXIS",
+                   help="after the grid, locate every class boundary between neighbours along AXIS (one of the "
+                        "--axis names) by bisection, to --refine-rtol, and store the boundary points in the "
+                        "archive (plot draws them); default: no refinement")
+    p.add_argument("--refine-rtol", type=_real("refine-rtol", 1e-12, 1e-2), default=1e-8,
+                   help="relative width of each refined boundary bracket (1e-12..1e-2; default %(default)g)")
     horizon(p)
     tolerance(p)
     parallel(p)

@@ -264,6 +264,11 @@ def plot_atlas(result, *, contours: str | None = None, curves=()):
                 cx, cy = ((curve.closed_form[closed], curve.values[closed]) if ax0.name == "kappa"
                           else (curve.values[closed], curve.closed_form[closed]))
                 ax.plot(cx, cy, color="w", ls="--", lw=1.0, label=r"closed-form $\kappa_c$")
+        boundaries = result.extras.get("boundaries")
+        if boundaries is not None and len(boundaries["points"]):
+            points = np.asarray(boundaries["points"], dtype=float)
+            ax.plot(points[:, 0], points[:, 1], "o", ms=3.5, mfc="k", mec="w", mew=0.6, ls="none",
+                    label=f"boundary refined along {boundaries['axis']} ({float(boundaries['rtol']):g})")
         ax.set_xlim(_edges(ax0.values, ax0.log)[[0, -1]])
         ax.set_ylim(_edges(ax1.values, ax1.log)[[0, -1]])
         _outcome_legend(ax, present, ax.get_legend_handles_labels()[0])

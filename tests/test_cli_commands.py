@@ -499,3 +499,24 @@ def test_bad_input_refused_before_any_work(args, name, tmp_path, monkeypatch, no
     assert name in lines[0]
     assert not (tmp_path / "a.h5").exists() and not (tmp_path / "p.png").exists()
     assert not list(tmp_path.glob("*.lock"))
+
+
+def test_atlas_refine_stores_boundaries_that_match_the_continued_curve(tmp_path):
+    """issue 13.2: the refined kappa_c boundary of a (kappa, v) atlas agrees with kappa_c(v) continued
+    independently, to the refinement's tolerance; the points survive the archive."""
+    out = run_json(["atlas", "--law", "paper", "--axis", "kappa=1e11:1e13:9:log", "--axis", "v=0.5:13:3",
+                    "--refine", "kappa", "--refine-rtol", "1e-9", "--no-progress", "--out", tmp_path / "a.h5"])
+    b = out["boundaries"]
+    assert b["axis"] == "kappa" and len(b["points"]) == 3
+    assert set(b["below"]) == {"permanent-stick"} and set(b["above"]) == {"ratchet-escape"}
+    points = np.asarray(b["points"])
+    curve = continuation.critical_curve(archive.load(tmp_path / "a.h5").grid.base, "paper", "v", points[:, 1])
+    np.testing.assert_allclose(points[:, 0], curve.kappa[curve.requested], rtol=2e-9)
+    stored = archive.load(tmp_path / "a.h5").extras["boundaries"]
+    np.testing.assert_array_equal(np.asarray(stored["points"]), points)
+
+
+def test_atlas_refine_axis_must_be_an_axis():
+    code, _, err = run(["atlas", "--law", "paper", "--axis", "kappa=1e11:1e13:3:log", "--refine", "v",
+                        "--out", "/tmp/never.h5"])
+    assert code == 2 and "refine" in err
