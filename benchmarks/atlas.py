@@ -1,0 +1,99 @@
+"""A 1e6-point (kappa, v) atlas of ``paper``: time and peak memory.
+
+``atlas(seed_parameters(), "paper", {"kappa": geomspace(1e10, 1e15, 1000), "v": geomspace(0.3, 13,
+1000)}, n_jobs=2)`` (threads), each run until its outcome settles. Memory: the growth of the
+process's peak resident set (``resource.getrusage``) over the atlas, per point, against what the
+result's own arrays hold (fixed columns per point, ragged stick points). Issue 9: a 1e6-point
+sweep holds only its columns (about 200 bytes per point plus stick points); counted as met when
+the fixed columns take at most 250 B/point and the peak grows by at most 1.5 times what the
+result's arrays hold (plus 10 MB).
+
+Not run with ``--quick`` (it takes minutes); ``--side`` sets the grid (default 1000 x 1000).
+
+    python benchmarks/atlas.py [--side 1000] [--quick]
+"""
+
+from __future__ import annotations
+
+import argparse
+import resource
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from _common import emit, load, machine, save_section, save_targets, table, target  # noqa: E402
+
+from phaseimpact import seed_parameters  # noqa: E402
+from phaseimpact.continuation import atlas  # noqa: E402
+
+
+def peak_rss() -> int:
+    """Peak resident set of this process, bytes (Linux reports kB)."""
+    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
+
+
+def array_bytes(result) -> tuple[int, int]:
+    """(bytes of the per-point columns, bytes of the ragged stick-point arrays) of a result."""
+    fixed = sum(a.nbytes for a in (result.status, result.outcome, result.stop_reason))
+    fixed += sum(a.nbytes for a in result.values.values())
+    ragged = sum(a.nbytes for a in (result.stick_point, result.stick_t, result.stick_delta, result.stick_dwell))
+    for value in result.extras.values():
+        if isinstance(value, np.ndarray):
+            fixed += value.nbytes
+    return fixed, ragged
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__)
+    ap.add_argument("--quick", action="store_true", help="skip (the atlas takes minutes)")
+    ap.add_argument("--side", type=int, default=1000, help="points per axis")
+    args = ap.parse_args(argv)
+    if args.quick:
+        emit("atlas: not run with --quick (a 1e6-point atlas takes minutes); run `python benchmarks/atlas.py`")
+        return 0
+    start_load = load()
+    n = args.side * args.side
+    emit(f"# Atlas of paper: {args.side} x {args.side} = {n:.3g} points (kappa, v)\n")
+    emit(machine())
+    emit(start_load + "\n")
+    params = seed_parameters()
+    axes = {"kappa": np.geomspace(1e10, 1e15, args.side), "v": np.geomspace(0.3, 13.0, args.side)}
+    atlas(params, "paper", {"kappa": axes["kappa"][::100], "v": axes["v"][::100]}, n_jobs=2)  # warm-up
+    before = peak_rss()
+    start = time.perf_counter()
+    result = atlas(params, "paper", axes, n_jobs=2)
+    wall = time.perf_counter() - start
+    after = peak_rss()
+    fixed, ragged = array_bytes(result)
+    n_sticks = len(result.stick_t)
+    outcomes, counts = np.unique(result.outcome_names(), return_counts=True)
+    grown = after - before
+    rows = [(f"{args.side} x {args.side}", f"{wall:.4g}", f"{n / wall:.4g}", f"{wall / n * 1e6:.3g}",
+             f"{before / 1e6:.0f}", f"{after / 1e6:.0f}", f"{grown / n:.0f}", f"{fixed / n:.0f}",
+             f"{n_sticks} ({ragged / n:.0f} B/point)", int(np.sum(result.failed)),
+             ", ".join(f"{o} {c}" for o, c in zip(outcomes, counts, strict=True)))]
+    end_load = load()
+    header = ("grid (kappa x v)", "time [s]", "points/s", "µs per point (2 threads)", "peak RSS before [MB]",
+              "peak RSS after [MB]", "peak growth per point [B]", "fixed columns per point [B]",
+              "stick points (ragged bytes)", "failed", "outcomes")
+    text = table(header, rows)
+    emit(text)
+    emit(f"\nat the end: {end_load}")
+    save_section("atlas", f"## Atlas of paper (kappa, v)\n\n{machine()}\n\n{start_load} at the start, {end_load} at "
+                          f"the end.\n\n`atlas(seed_parameters(), 'paper', {{'kappa': geomspace(1e10, 1e15, "
+                          f"{args.side}), 'v': geomspace(0.3, 13, {args.side})}}, n_jobs=2)`, each run until settled; "
+                          "memory from `resource.getrusage` (peak RSS) around the call. "
+                          "`python benchmarks/atlas.py`\n\n" + text)
+    save_targets("atlas", [target(f"{n:.0e}-point atlas holds only its columns", "about 200 B/point plus stick points",
+                                  f"peak growth {grown / n:.0f} B/point; columns {fixed / n:.0f} B/point + "
+                                  f"{ragged / n:.0f} B/point of stick points; {wall:.0f} s",
+                                  bool(fixed / n <= 250 and grown <= 1.5 * (fixed + ragged) + 10e6),
+                                  "python benchmarks/atlas.py")])
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
