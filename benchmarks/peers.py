@@ -1,35 +1,34 @@
-"""Peer comparison: phaseimpact's exact integrator against heyoka (Taylor method, LLVM-compiled).
+"""Peer comparison: our compiled driver against heyoka (Taylor method, LLVM-compiled), in heyoka's
+own venv.
 
 What it measures
 ----------------
-The first contact of the seed case under the smooth Hunt-Crossley law (``seed_parameters(v=1,
-kappa=3e9)``), from ``t = 0`` (``delta = 0``, ``x1dot = v``) to separation (``delta`` back to 0)::
+The work-precision problem of ``work_precision.py`` for Hunt-Crossley: seed case
+(``seed_parameters(v=1, kappa=3e9)``), ``t_end = 2e-3`` s, no stop when settled (two contacts
+and the flights after them), errors (a) of the max force (relative) and (b) of the state at
+``t_end`` (positions over the Hertz indentation ``L``, velocities over ``v``), both against the
+scipy oracle (``tests/oracle.py``) at rtol 1e-13, the same reference as ``work_precision.py``.
 
-    P = (K + kappa (v1 - v2)) delta^1.5,   M1 x1'' = -P,   M2 x2'' = -Kb x2 - Km x2^3 + P.
-
-For every tolerance and integrator: the separation time, the maximum contact force, the state at
-separation, their errors against a reference (separation time and max force relative; positions
-relative to the Hertz indentation ``L = (5 M1 v^2 / (4 K))^(2/5)``, velocities relative to ``v``),
-and the wall time of one solve (median of 5 after a warm-up). For heyoka also the one-off JIT cost
-of building ``taylor_adaptive`` (LLVM in-memory cache cleared first).
-
-- ours: ``phaseimpact.simulate(..., stop_on=("separation",))`` over rtol 1e-4..1e-12, and
-  ``simulate_batch([p], ...)`` (it has no ``stop_on``: it runs on to ``t_end = 2e-4`` s, before
-  the next contact, and the separation is read from its event).
-- heyoka: the same equations made dimensionless (``x / L``, ``v / v0``, ``t v0 / L``, since its
-  single tolerance is absolute for O(1) states), a terminal event on ``delta`` (direction
-  negative) and a non-terminal event on ``dP/dt = 0`` (direction negative) for the force peak,
-  over tol 1e-6..1e-15. ``delta^1.5`` is singular at ``delta = 0`` for a Taylor method (its
-  derivatives there are infinite), so heyoka starts at ``t0 = 1e-6 L / v0``, from the leading
-  term of the series of the solution at ``t = 0`` (whose error there is ~1e-20 of the scales).
-- references: ours at rtol 1e-13, heyoka at tol 1e-16, and heyoka in extended precision
-  (``long double``, tol 1e-19); errors are taken against heyoka at 1e-16.
+- ours: ``simulate(params, "hunt-crossley", 2e-3, rtol=r, stop_when_settled=False)``, rtol
+  1e-4..1e-13.
+- heyoka, tol 1e-6..1e-15: dimensionless (``x / L``, ``v / v0``, ``tau = t v0 / L``, since its
+  one tolerance is absolute for O(1) states) and with **runtime parameters** (``hy.par``: the
+  damping ``b = kappa v0 L^1.5 / F`` and the plate's constants), so one compile serves every
+  ``kappa``. Two integrators, switched at the events: the contact phase in the time
+  transformation ``delta = w^2``, ``dt = w ds`` (``delta^1.5`` is singular at ``delta = 0`` for a
+  Taylor method; in ``w`` the equations are polynomial, and a contact starts regularly at
+  ``w = 0``), with a terminal event at ``w = 0`` (separation), one at ``tau = tau_end`` and a
+  non-terminal one at ``dP/ds = 0`` (force peak, read on the dense output); the flight phase
+  in ``tau`` with a terminal event at ``delta = 0`` (contact). Its one-off JIT build of both
+  integrators is reported (cold: heyoka's in-memory and on-disk code caches off).
 
 heyoka is a comparison only, never a dependency: the script installs it (with numpy, scipy and
 phaseimpact in editable mode) into its own venv ``.venv-peers`` at the project root and re-runs
-itself there. If that fails, it writes a "not available" section and exits 0.
+itself there (with its own ``NUMBA_CACHE_DIR``, so it never touches the project's numba cache).
+If that fails or takes more than 10 minutes, it writes a "not available" section and exits 0.
 
-Output: a printed table and ``benchmarks/results/peers.md``.
+Output: a printed table, ``benchmarks/results/peers.md`` and ``results/peers.json`` (the points
+``work_precision.py`` draws in ``figures/work_precision.png``).
 
 Run: ``python benchmarks/peers.py [--quick]``.
 """
@@ -37,7 +36,7 @@ Run: ``python benchmarks/peers.py [--quick]``.
 from __future__ import annotations
 
 import argparse
-import math
+import json
 import os
 import statistics
 import subprocess
@@ -50,11 +49,12 @@ ROOT = HERE.parent
 VENV = ROOT / ".venv-peers"
 VENV_PYTHON = VENV / "bin" / "python"
 LAW = "hunt-crossley"
-T_END = 2e-4
-TAU0 = 1e-6  # heyoka's start, in units of L / v0
-OURS_RTOLS = [10.0**-k for k in range(4, 13)]
+T_END = 2e-3
+KAPPA = 3e9
+OURS_RTOLS = [10.0**-k for k in range(4, 14)]
 HEYOKA_TOLS = [10.0**-k for k in range(6, 16)]
-REPEATS = 5
+INSTALL_LIMIT = 600  # s
+METHOD = "heyoka (Taylor, runtime parameters)"
 
 
 # --------------------------------------------------------------------------------------------
@@ -62,7 +62,7 @@ REPEATS = 5
 # --------------------------------------------------------------------------------------------
 
 def _not_available(reason: str) -> int:
-    text = (f"# Peers: heyoka vs phaseimpact\n\nheyoka not available: {reason}\n\n"
+    text = (f"## Peers: heyoka vs phaseimpact\n\nheyoka not available: {reason}\n\n"
             "Nothing was measured. `python benchmarks/peers.py` installs heyoka into `.venv-peers`; "
             "it needs the package registry.")
     print(text)
@@ -79,14 +79,15 @@ def bootstrap(argv) -> int:
         steps = [[sys.executable, "-m", "venv", str(VENV)],
                  [str(VENV_PYTHON), "-m", "pip", "install", "-q", "heyoka", "numpy", "scipy"],
                  [str(VENV_PYTHON), "-m", "pip", "install", "-q", "-e", str(ROOT)]]
+        deadline = time.monotonic() + INSTALL_LIMIT
         for step in steps:
             try:
-                rc = subprocess.call(step)
-            except OSError as exc:
+                rc = subprocess.call(step, timeout=max(1.0, deadline - time.monotonic()))
+            except (OSError, subprocess.TimeoutExpired) as exc:
                 rc = str(exc)
             if rc != 0:
                 return _not_available(f"`{' '.join(step)}` failed ({rc})")
-    env = {**os.environ, "PHASEIMPACT_PEERS": "1"}
+    env = {**os.environ, "PHASEIMPACT_PEERS": "1", "NUMBA_CACHE_DIR": str(VENV / "numba-cache")}
     return subprocess.call([str(VENV_PYTHON), __file__, *argv], env=env)
 
 
@@ -95,149 +96,135 @@ def bootstrap(argv) -> int:
 # --------------------------------------------------------------------------------------------
 
 def scales(p):
-    """Hertz indentation ``L`` (m), time ``L / v`` (s) and force ``M1 v^2 / L`` (N)."""
-    L = (5 * p.M1 * p.v**2 / (4 * p.K)) ** 0.4
+    """Length ``L`` (the Hertz indentation, m), time ``L / v`` (s) and force ``M1 v^2 / L`` (N)."""
+    L = p.hertz_indentation
     return L, L / p.v, p.M1 * p.v**2 / L
 
 
-class HeyokaRun:
-    """A compiled heyoka integrator of the first contact, reusable across solves.
+def runtime_parameters(p):
+    """``[a, b, kb, km, mu, tau_end]`` of a case (``hy.par[0..5]``)."""
+    L, T, F = scales(p)
+    return [p.K * L**1.5 / F, p.kappa * p.v * L**1.5 / F, p.Kb * T**2 / p.M2, p.Km * L**2 * T**2 / p.M2, p.M1 / p.M2,
+            T_END / T]
 
-    Dimensionless state ``(X1, X2, V1, V2) = (x1 / L, x2 / L, v1 / v, v2 / v)`` in time
-    ``tau = t v / L``; contact force ``p = P / F`` with ``F = M1 v^2 / L``.
-    """
 
-    def __init__(self, p, tol, fp_type=None):
+class PeakRecorder:
+    """Callback of the force-peak event: keeps the dimensionless force at each peak (dense output)."""
+
+    def __init__(self):
+        self.found = []
+
+    def __call__(self, ta, s, d_sgn):
+        ta.update_d_output(s)
+        w, _, v1, v2, _ = ta.d_output
+        a, b = ta.pars[0], ta.pars[1]
+        self.found.append((a + b * (v1 - v2)) * w**3)
+
+
+class Heyoka:
+    """The contact and flight integrators, compiled once for every case (runtime parameters)."""
+
+    def __init__(self, tol):
         import heyoka as hy
         import numpy as np
 
-        self.np, self.fp = np, fp_type or np.float64
-        self.L, self.T, self.F = scales(p)
-        X1, X2, V1, V2 = hy.make_vars("X1", "X2", "V1", "V2")
-        a = p.K * self.L**1.5 / self.F  # = 5/4 by the choice of L
-        b = p.kappa * p.v * self.L**1.5 / self.F
-        kb, km, mu = p.Kb * self.T**2 / p.M2, p.Km * self.L**2 * self.T**2 / p.M2, p.M1 / p.M2
-        self.a, self.b, self.kb, self.km, self.mu = a, b, kb, km, mu
-        D, DD = X1 - X2, V1 - V2
-        force = (a + b * DD) * D * hy.sqrt(D)
-        A1, A2 = -force, -kb * X2 - km * X2**3 + mu * force
-        # dp/dtau / sqrt(D): zero at the force peak, falling through it
-        peak = b * (A1 - A2) * D + 1.5 * (a + b * DD) * DD
-        long = self.fp is not np.float64
-        t_event, nt_event = (hy.t_event_ldbl, hy.nt_event_ldbl) if long else (hy.t_event, hy.nt_event)
-        kw = {"fp_type": self.fp} if long else {}
-        self.y0 = self.initial_state(TAU0)
-        sys_ = [(X1, V1), (X2, V2), (V1, A1), (V2, A2)]
-        t_events = [t_event(D, direction=hy.event_direction.negative)]
-        nt_events = [nt_event(peak, PeakRecorder(a, b), direction=hy.event_direction.negative)]
+        self.hy, self.np = hy, np
+        a, b, kb, km, mu, tau_end = (hy.par[i] for i in range(6))
+        w, X2, V1, V2, tau = hy.make_vars("w", "X2", "V1", "V2", "tau")
+        DD = V1 - V2
+        # products, not powers: heyoka's pow recurrence divides by the value, zero at a contact's start
+        force = (a + b * DD) * (w * w * w)  # P / F with delta = w^2
+        dV1 = -w * force
+        dV2 = w * (mu * force - kb * X2 - km * (X2 * X2 * X2))
+        contact = [(w, DD / 2), (X2, w * V2), (V1, dV1), (V2, dV2), (tau, w)]
+        peak = b * w * (dV1 - dV2) + 1.5 * (a + b * DD) * DD  # dP/ds / (F w^2)
+        X1, Y2, U1, U2 = hy.make_vars("X1", "Y2", "U1", "U2")
+        flight = [(X1, U1), (Y2, U2), (U1, 0.0 * U1), (U2, -kb * Y2 - km * (Y2 * Y2 * Y2))]
+        pars = [1.0] * 6
 
         def build():
             hy.llvm_state.clear_memcache()
             start = time.perf_counter()
-            ta = hy.taylor_adaptive(sys_, self.y0.copy(), time=self.fp(TAU0), tol=self.fp(tol),
-                                    t_events=t_events, nt_events=nt_events, **kw)
-            return ta, time.perf_counter() - start
+            c = hy.taylor_adaptive(contact, [0.0] * 5, tol=tol, pars=pars,
+                                   t_events=[hy.t_event(w, direction=hy.event_direction.negative),
+                                             hy.t_event(tau - tau_end, direction=hy.event_direction.positive)],
+                                   nt_events=[hy.nt_event(peak, PeakRecorder(),
+                                                          direction=hy.event_direction.negative)])
+            f = hy.taylor_adaptive(flight, [0.0] * 4, tol=tol, pars=pars[:4],  # it reads kb, km only
+                                   t_events=[hy.t_event(X1 - Y2, direction=hy.event_direction.positive)])
+            return c, f, time.perf_counter() - start
 
-        # cold JIT: neither the in-memory nor heyoka's on-disk (~/.cache/heyoka) code cache used
         disk = hy.llvm_state.get_diskcache_enabled()
         hy.llvm_state.set_diskcache_enabled(False)
-        self.ta, self.compile_time = build()
-        # warm: the compiled code found in the on-disk cache (a later process, same tol and parameters)
-        hy.llvm_state.set_diskcache_enabled(True)
-        build()
-        self.cached_build_time = build()[1]
-        hy.llvm_state.set_diskcache_enabled(disk)
-        self.hy = hy
-        self.peaks = self.ta.nt_events[0].callback  # heyoka keeps a deep copy of the callback
+        try:
+            self.contact, self.flight, self.compile_time = build()
+        finally:
+            hy.llvm_state.set_diskcache_enabled(disk)
+        self.peaks = self.contact.nt_events[0].callback
+        self.order = self.contact.order
 
-    def initial_state(self, tau):
-        """Leading term of the solution's series at ``tau = 0`` (next terms are ~tau^2.5 smaller)."""
-        c = (self.a + self.b) * tau**2.5
-        return self.np.array([tau - c * tau / 8.75, self.mu * c * tau / 8.75, 1 - c / 2.5, self.mu * c / 2.5],
-                             dtype=self.fp)
-
-    def force(self, y):
-        return self.peaks.force(y)
-
-    def solve(self):
-        """Separation time (s), max force (N), dimensionless state at separation, steps."""
-        ta = self.ta
-        ta.time = self.fp(TAU0)
-        ta.state[:] = self.y0
-        ta.reset_cooldowns()
+    def solve(self, p):
+        """(max force N, state at t_end (x1, x2, v1, v2) in SI, steps) of case ``p`` from eq. 6."""
+        np = self.np
+        L, T, F = scales(p)
+        pars = runtime_parameters(p)
+        tau_end = pars[5]
+        c, f = self.contact, self.flight
+        c.pars[:] = pars
+        f.pars[:] = pars[:4]
         self.peaks.found.clear()
-        outcome = ta.propagate_until(self.fp(1e3))
-        if outcome[0] != self.hy.taylor_outcome(-1):
-            raise RuntimeError(f"heyoka stopped without separation: {outcome[0]}")
-        y = ta.state.copy()
-        p_max = max([self.force(y), *(f for _, f in self.peaks.found)])
-        return float(ta.time) * self.T, float(p_max) * self.F, y.astype(float), int(outcome[3])
-
-
-class PeakRecorder:
-    """Callback of the force-peak event: keeps ``(tau, p)`` at each peak (dense output of the step)."""
-
-    def __init__(self, a, b):
-        self.a, self.b, self.found = a, b, []
-
-    def force(self, y):
-        D, DD = y[0] - y[1], y[2] - y[3]
-        return (self.a + self.b * DD) * D * max(D, 0) ** 0.5
-
-    def __call__(self, ta, tau, d_sgn):
-        ta.update_d_output(tau)
-        self.found.append((tau, self.force(ta.d_output.copy())))
-
-
-# --------------------------------------------------------------------------------------------
-# Ours
-# --------------------------------------------------------------------------------------------
-
-def ours(p, rtol, batch=False):
-    """Same outputs as :meth:`HeyokaRun.solve` from phaseimpact (``simulate`` or ``simulate_batch``)."""
-    import numpy as np
-
-    from phaseimpact import simulate
-    from phaseimpact.integrate import simulate_batch
-
-    if batch:
-        tr = simulate_batch([p], LAW, T_END, rtol=rtol)[0]
-    else:
-        tr = simulate(p, LAW, t_end=T_END, rtol=rtol, stop_on=("separation",))
-    seps = tr.events_of("separation")
-    if not tr.ok or not seps:
-        raise RuntimeError(f"{tr.status}: {tr.message}")
-    if not batch and tr.t_stop != seps[0].t:
-        raise RuntimeError("simulate did not stop at the first separation")
-    L, _, _ = scales(p)
-    return seps[0].t, tr.max_force, seps[0].state[:4] / np.array([L, L, p.v, p.v]), tr.nfev
-
-
-def timed(fn, repeats=REPEATS):
-    fn()  # warm-up
-    times = []
-    for _ in range(repeats):
-        start = time.perf_counter()
-        fn()
-        times.append(time.perf_counter() - start)
-    return statistics.median(times)
-
-
-def errors(result, ref):
-    """Relative errors of separation time and max force, scaled error of the separation state."""
-    import numpy as np
-
-    t, f, y = result[:3]
-    return abs(t / ref[0] - 1), abs(f / ref[1] - 1), float(np.max(np.abs(np.asarray(y) - ref[2])))
+        state = ("contact", 0.0, 1.0, 0.0, 0.0, 0.0)  # phase, X2 (w = 0 at a contact), V1, V2, tau, X1
+        steps = 0
+        for _ in range(1000):
+            phase, X2, V1, V2, tau, X1 = state
+            if phase == "contact":
+                c.time = 0.0
+                c.state[:] = [0.0, X2, V1, V2, tau]
+                c.reset_cooldowns()
+                out = c.propagate_until(1e30)
+                steps += out[3]
+                w, X2, V1, V2, tau = c.state
+                if out[0] == self.hy.taylor_outcome(-1):  # separation
+                    state = ("flight", X2, V1, V2, tau, X2)
+                    continue
+                final = np.array([X2 + w * w, X2, V1, V2])  # tau_end inside the contact
+                break
+            f.time = tau
+            f.state[:] = [X1, X2, V1, V2]
+            f.reset_cooldowns()
+            out = f.propagate_until(tau_end)
+            steps += out[3]
+            X1, X2, V1, V2 = f.state
+            if out[0] == self.hy.taylor_outcome(-1):  # a new contact
+                state = ("contact", X2, V1, V2, float(f.time), X2)
+                continue
+            final = np.array([X1, X2, V1, V2])
+            break
+        else:
+            raise RuntimeError("more than 1000 phases")
+        max_force = max(self.peaks.found, default=0.0) * F
+        return max_force, final * np.array([L, L, p.v, p.v]), steps
 
 
 # --------------------------------------------------------------------------------------------
 # Benchmark
 # --------------------------------------------------------------------------------------------
 
+def timed(fn, repeats):
+    fn()  # warm-up
+    times = []
+    for _ in range(repeats):
+        number, start = 0, time.perf_counter()
+        while number == 0 or time.perf_counter() - start < 0.02:
+            fn()
+            number += 1
+        times.append((time.perf_counter() - start) / number)
+    return statistics.median(times)
+
+
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--quick", action="store_true", help="fewer tolerances, one repeat (no waiting)")
+    parser.add_argument("--quick", action="store_true", help="every other tolerance, 3 repeats")
     args = parser.parse_args(argv)
     if not os.environ.get("PHASEIMPACT_PEERS"):
         return bootstrap(sys.argv[1:])
@@ -246,105 +233,94 @@ def main(argv=None) -> int:
     import numpy as np
 
     sys.path.insert(0, str(HERE))
-    from _common import emit, machine, save_section, table
+    sys.path.insert(0, str(ROOT / "tests"))
+    from _common import emit, load, machine, save_section, table
+    from oracle import oracle
 
-    from phaseimpact import seed_parameters
+    from phaseimpact import seed_parameters, simulate
 
-    global REPEATS
-    rtols, tols = OURS_RTOLS, HEYOKA_TOLS
+    rtols, tols, repeats = OURS_RTOLS, HEYOKA_TOLS, 5
     if args.quick:
-        rtols, tols, REPEATS = rtols[::4], tols[::3], 1
-    p = seed_parameters(v=1.0, kappa=3e9)
-    L, T, _ = scales(p)
-    lines = ["# Peers: phaseimpact vs heyoka (first Hunt-Crossley contact)", "",
-             machine() + f", heyoka {hy.__version__}", "",
-             f"Seed case, v = {p.v} m/s, kappa = {p.kappa:.3g}; L = {L:.6g} m, L/v = {T:.6g} s. "
-             "Errors: separation time and max force relative; state = max over (x1, x2)/L, (v1, v2)/v.", ""]
+        rtols, tols, repeats = rtols[::2], tols[::2], 3
+    start_load = load()
+    p = seed_parameters(v=1.0, kappa=KAPPA)
+    scale = np.array([p.hertz_indentation, p.hertz_indentation, p.v, p.v])
+    emit(f"# Peers: phaseimpact vs heyoka {hy.__version__} ({LAW}, seed case, kappa = {KAPPA:g}, t_end = {T_END:g} s)")
+    emit(machine())
+    emit(start_load)
 
-    # references (no timing)
-    ref_ours = ours(p, 1e-13)
-    ref_hy = HeyokaRun(p, 1e-16).solve()
-    ref_ld = HeyokaRun(p, 1e-19, fp_type=np.longdouble).solve()
-    ref_rows = [["ours rtol=1e-13 vs heyoka tol=1e-16", *errors(ref_ours, ref_hy)],
-                ["heyoka long double tol=1e-19 vs heyoka tol=1e-16", *errors(ref_ld, ref_hy)],
-                ["ours rtol=1e-13 vs heyoka long double", *errors(ref_ours, ref_ld)]]
-    lines += ["## References", "",
-              f"heyoka tol=1e-16: separation at {ref_hy[0]!r} s, max force {ref_hy[1]!r} N.", "",
-              table(["pair", "t_sep", "max force", "state"], ref_rows), ""]
-    emit("\n".join(lines))
+    def reference(q):
+        ref = oracle(q, LAW, T_END, rtol=1e-13, settle=False)
+        return ref.max_force, np.asarray(ref.final_state[:4])
 
-    note = "run alone on the machine (other jobs disturb the timings)"
+    ref_force, ref_state = reference(p)
 
-    rows, runs = [], []  # runs: (solver, setting, seconds, max error)
+    def errors(force, state, rf=ref_force, rs=ref_state):
+        return abs(force / rf - 1), float(np.max(np.abs(np.asarray(state) - rs) / scale))
+
+    rows, points = [], []
     for r in rtols:
-        for batch in (False, True):
-            name = "ours simulate_batch" if batch else "ours simulate"
-            res = ours(p, r, batch)
-            seconds = timed(lambda r=r, batch=batch: ours(p, r, batch))
-            err = errors(res, ref_hy)
-            rows.append([name, f"rtol={r:.0e}", seconds * 1e3, "", f"nfev {res[3]}", *err])
-            runs.append((name, f"rtol={r:.0e}", seconds, max(err), 0.0))
-            emit(f"{name:20s} rtol={r:.0e}  {seconds * 1e3:8.2f} ms  errors {err[0]:.1e} {err[1]:.1e} {err[2]:.1e}")
+        def ours(r=r):
+            tr = simulate(p, LAW, T_END, rtol=r, stop_when_settled=False)
+            return tr.max_force, tr.final_state[:4], tr.nfev
+        seconds = timed(ours, repeats)
+        force, state, nfev = ours()
+        err = errors(force, state)
+        rows.append(["ours (compiled driver)", f"rtol={r:.0e}", f"{seconds * 1e3:.3g}", "-", f"nfev {nfev}", *err])
+        points.append({"law": LAW, "method": "ours (compiled driver, peers venv)", "rtol": r, "time": seconds,
+                       "errors": list(err)})
+        emit(f"ours   rtol={r:.0e} {seconds * 1e3:8.3f} ms  errors {err[0]:.1e} {err[1]:.1e}")
+    other = seed_parameters(v=1.0, kappa=1e11)
+    other_ref = reference(other)
     for tol in tols:
-        run = HeyokaRun(p, tol)
-        res = run.solve()
-        seconds = timed(run.solve)
-        err = errors(res, ref_hy)
-        rows.append(["heyoka", f"tol={tol:.0e}", seconds * 1e3,
-                     f"{run.compile_time * 1e3:.0f} ({run.cached_build_time * 1e3:.1f})",
-                     f"order {run.ta.order}, steps {res[3]}", *err])
-        runs.append(("heyoka", f"tol={tol:.0e}", seconds, max(err), run.compile_time))
-        emit(f"{'heyoka':20s} tol={tol:.0e}   {seconds * 1e3:8.2f} ms  JIT {run.compile_time * 1e3:7.1f} ms  "
-             f"errors {err[0]:.1e} {err[1]:.1e} {err[2]:.1e}")
+        run = Heyoka(tol)
+        seconds = timed(lambda run=run: run.solve(p), repeats)
+        force, state, steps = run.solve(p)
+        err = errors(force, state)
+        f2, s2, _ = run.solve(other)  # the same compiled integrators, another kappa
+        err2 = errors(f2, s2, *other_ref)
+        rows.append(["heyoka", f"tol={tol:.0e}", f"{seconds * 1e3:.3g}", f"{run.compile_time * 1e3:.0f}",
+                     f"order {run.order}, steps {steps}", *err])
+        points.append({"law": LAW, "method": METHOD, "rtol": tol, "time": seconds, "errors": list(err),
+                       "compile": run.compile_time, "kappa_1e11_errors": list(err2)})
+        emit(f"heyoka tol={tol:.0e}  {seconds * 1e3:8.3f} ms  JIT {run.compile_time * 1e3:7.0f} ms  errors "
+             f"{err[0]:.1e} {err[1]:.1e}; same build at kappa 1e11: {err2[0]:.1e} {err2[1]:.1e}")
+    end_load = load()
 
-    header = ["solver", "setting", "solve, ms", "JIT build, ms (disk-cached)", "work", "err t_sep", "err max force",
-              "err state"]
-    lines = ["## Work and precision", "", f"Timings: median of {REPEATS} after a warm-up; {note}.", "",
-             table(header, rows), ""]
-
-    # equal accuracy: the fastest run of each solver whose worst error meets the target
-    floor = max(errors(ref_ld, ref_hy))  # how well the heyoka reference itself is known
     eq_rows = []
-    for target in (1e-4, 1e-6, 1e-8, 1e-10, 1e-12):
-        best = {}
-        for solver, setting, seconds, err, jit in runs:
-            if err <= target and (solver not in best or seconds < best[solver][1]):
-                best[solver] = (setting, seconds, jit)
-        cell = {s: f"{b[1] * 1e3:.3g} ms ({b[0]})" if b else "not reached"
-                for s in ("ours simulate", "ours simulate_batch", "heyoka") for b in [best.get(s)]}
-        ratio = breakeven = float("nan")
-        if "ours simulate" in best and "heyoka" in best:
-            (_, t_ours, _), (_, t_hy, t_jit) = best["ours simulate"], best["heyoka"]
-            ratio, breakeven = t_ours / t_hy, t_jit / (t_ours - t_hy)
-        eq_rows.append([f"{target:.0e}" + (" (below reference spread)" if target < floor else ""),
-                        cell["ours simulate"], cell["ours simulate_batch"], cell["heyoka"], ratio, breakeven])
-    lines += ["## At equal accuracy", "",
-              "Fastest run of each solver whose worst error (of the three columns above) meets the target.", "",
-              table(["worst error <=", "ours simulate", "ours simulate_batch", "heyoka", "ours / heyoka",
-                     "break-even solves (JIT included)"], eq_rows),
-              ""]
-    jit = [r[4] * 1e3 for r in runs if r[0] == "heyoka"]
-    ratios = [rw[4] for rw in eq_rows if rw[4] == rw[4]]
-    breakevens = [rw[5] for rw in eq_rows if rw[5] == rw[5]]
-    if ratios:
-        faster = "heyoka" if statistics.median(ratios) > 1 else "ours (simulate)"
-        lines += [f"**Conclusion.** At equal accuracy {faster} is faster: ours/heyoka time ratio "
-                  f"{min(ratios):.3g}..{max(ratios):.3g} over the targets reached by both. "
-                  f"heyoka's one-off JIT build of `taylor_adaptive` costs {min(jit):.0f}..{max(jit):.0f} ms "
-                  "(cold; it grows with the Taylor order, i.e. with the tolerance, and is paid again for "
-                  "every parameter set, as the constants are compiled in; a few ms when heyoka's on-disk code "
-                  "cache has it): about "
-                  f"{min(breakevens):.1f}..{max(breakevens):.1f} of our solves, so heyoka wins, JIT included, "
-                  f"from {math.ceil(max(breakevens))} solves of the same compiled integrator on.", ""]
-    text = "\n".join(lines)
+    for k, what in enumerate(("max force", "state at t_end")):
+        for goal in (1e-6, 1e-8, 1e-10, 1e-12):
+            best = {}
+            for pt in points:
+                if pt["errors"][k] <= goal and (pt["method"] not in best or pt["time"] < best[pt["method"]][0]):
+                    best[pt["method"]] = (pt["time"], pt["rtol"])
+            o, h = best.get("ours (compiled driver, peers venv)"), best.get(METHOD)
+            eq_rows.append([what, f"{goal:.0e}", f"{o[0] * 1e3:.3g} (rtol {o[1]:.0e})" if o else "not reached",
+                            f"{h[0] * 1e3:.3g} (tol {h[1]:.0e})" if h else "not reached",
+                            f"{o[0] / h[0]:.2f}" if o and h else "-"])
+    hy_points = [pt for pt in points if pt["method"] == METHOD]
+    jit = [pt["compile"] for pt in hy_points]
+    header = ["solver", "setting", "solve [ms]", "JIT build, cold [ms]", "work", "err max force", "err state(t_end)"]
+    text = "\n".join([
+        "## Peers: phaseimpact vs heyoka", "", machine() + f", heyoka {hy.__version__}", "",
+        f"{start_load} at the start, {end_load} at the end. `python benchmarks/peers.py` (own venv `.venv-peers`)",
+        "", f"{LAW}, seed case, kappa = {KAPPA:g}, v = 1 m/s, t_end = {T_END:g} s, no stop when settled. "
+        "Reference: the scipy oracle at rtol 1e-13 (as in work_precision). heyoka takes the case as runtime "
+        "parameters: one JIT build per tolerance serves every kappa (the same build at kappa = 1e11 is checked "
+        "against the oracle there: "
+        f"errors {hy_points[-1]['kappa_1e11_errors'][0]:.1e} (max force), {hy_points[-1]['kappa_1e11_errors'][1]:.1e} "
+        f"(state) at tol {hy_points[-1]['rtol']:.0e}). Times: median "
+        f"of {repeats}, each the mean of calls over 20 ms.", "",
+        "At equal accuracy (fastest run reaching the target):", "",
+        table(["error", "target", "ours [ms]", "heyoka [ms]", "ours / heyoka"], eq_rows), "",
+        f"heyoka's cold JIT build of the two integrators: {min(jit) * 1e3:.0f}..{max(jit) * 1e3:.0f} ms per tolerance.",
+        "", "Every run:", "", table(header, rows)])
+    emit()
     emit(text)
-    if not args.quick:
-        save_section("peers", "\n".join(["# Peers: phaseimpact vs heyoka (first Hunt-Crossley contact)", "",
-                                         machine() + f", heyoka {hy.__version__}", "", note, "",
-                                         "## References", "",
-                                         f"heyoka tol=1e-16: separation at {ref_hy[0]!r} s, "
-                                         f"max force {ref_hy[1]!r} N.", "",
-                                         table(["pair", "t_sep", "max force", "state"], ref_rows), "", text]))
+    name = "peers" + args.quick * "_quick"
+    save_section(name, text)
+    (HERE / "results" / f"{name}.json").write_text(json.dumps(
+        {"load": end_load, "points": hy_points}, indent=0) + "\n")
     return 0
 
 
