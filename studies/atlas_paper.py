@@ -83,7 +83,7 @@ def main(quick=False, jobs=1):
             "printed": ["permanent stick (N = 1)", "N = 2, escape, runaway", "N ≥ 3, escape, runaway", "",
                         "escape after N = 1 (missed re-stick)"],
             "unilateral": ["permanent stick (N = 1)", "N = 2, escape, rebound", "N ≥ 3, escape, rebound",
-                           "escape, energy doubled before separation", "escape after N = 1 (missed re-stick)"],
+                           "escape, stopped by the energy guard", "escape after N = 1 (missed re-stick)"],
         }
         colors = ["#4c72b0", "#dd8452", "#c44e52", "#8172b3", "#999999"]
         cmap = mcolors.ListedColormap(colors)
@@ -109,7 +109,7 @@ def main(quick=False, jobs=1):
         ax.contour(kappas, speeds, e.reshape(shape), levels=[1.0], colors="w", linewidths=1.0)
         fig.colorbar(mesh, ax=ax, label="apparent restitution e (white line: e = 1)")
         overlay(ax, legend=False)
-        ax.set_title("unilateral: restitution of the rebound\n(blank: permanent stick or energy doubled)")
+        ax.set_title("unilateral: restitution of the rebound\n(blank: permanent stick)")
         ax.plot([], [], "w-", label="e = 1")
         out = save(fig, FIGURES / f"{NAME}.png")
     return out

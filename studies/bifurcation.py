@@ -74,8 +74,10 @@ def main(quick=False, jobs=1):
         ok = separated & ~runaway_un & np.isfinite(un.restitution)
         ax.plot(kappas[ok], un.restitution[ok], "o", ms=3, color="C1", label="unilateral: apparent restitution")
         top = np.nanmax(un.restitution[ok]) if ok.any() else 1.5
-        ax.plot(kappas[runaway_un & (kappas > kc)], np.full((runaway_un & (kappas > kc)).sum(), top * 1.05), "x",
-                color="C3", ms=4, label="unilateral: energy doubled before separation")
+        stopped = runaway_un & (kappas > kc)
+        if stopped.any():  # the numerical guard (100 x the initial energy) stopped a run before it separated
+            ax.plot(kappas[stopped], np.full(stopped.sum(), top * 1.05), "x", color="C3", ms=4,
+                    label="unilateral: stopped by the energy guard before separation")
         ax.axhline(1.0, color="k", lw=0.6)
         ax.axvline(kc, color="k", ls="--", lw=0.8)
         ax.set_xlim(kappas[0], kappas[-1])
