@@ -27,7 +27,7 @@ phaseimpact in editable mode) into its own venv ``.venv-peers`` at the project r
 itself there (with its own ``NUMBA_CACHE_DIR``, so it never touches the project's numba cache).
 If that fails or takes more than 10 minutes, it writes a "not available" section and exits 0.
 
-Output: a printed table, ``benchmarks/results/peers.md`` and ``results/peers.json`` (the points
+Output: a printed table, ``benchmarks/results/peers.md`` and ``results/peers_points.json`` (the points
 ``work_precision.py`` draws in ``figures/work_precision.png``).
 
 Run: ``python benchmarks/peers.py [--quick]``.
@@ -319,7 +319,7 @@ def main(argv=None) -> int:
     emit(text)
     name = "peers" + args.quick * "_quick"
     save_section(name, text)
-    (HERE / "results" / f"{name}.json").write_text(json.dumps(
+    (HERE / "results" / f"{name}_points.json").write_text(json.dumps(
         {"load": end_load, "points": hy_points}, indent=0) + "\n")
     return 0
 

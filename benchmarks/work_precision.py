@@ -15,7 +15,7 @@ Contenders:
   its max force is located on the force-peak event;
 - plain scipy: ``solve_ivp`` on the same right-hand side without events (``paper``: eq. 8 read
   literally), max force the largest over its steps;
-- heyoka (``benchmarks/peers.py``, its own venv), drawn when ``results/peers.json`` exists.
+- heyoka (``benchmarks/peers.py``, its own venv), drawn when ``results/peers_points.json`` exists.
 
 Reference: the oracle (DOP853) at rtol 1e-13; the floor row says how far ours at 1e-13 is from
 it. Times: median of repeats; a run slower than the budget ends that method's sweep.
@@ -185,7 +185,7 @@ def main(argv=None) -> int:
                                    "errors": [e_force, e_state]})
                 emit(f"{law:14s} {label:26s} rtol={r:.0e} {seconds * 1e3:9.3f} ms  force {e_force:.1e}  "
                      f"state {e_state:.1e}  nfev {nfev}  {status}")
-    for peers in (RESULTS / "peers.json", RESULTS / "peers_quick.json"):  # heyoka, from benchmarks/peers.py
+    for peers in (RESULTS / "peers_points.json", RESULTS / "peers_quick_points.json"):  # heyoka (peers.py)
         if peers.exists():
             points += json.loads(peers.read_text())["points"]
             break
