@@ -271,7 +271,9 @@ def plot(points) -> None:
                               ms=4, alpha=0.9, label=method)
             ax.set_xlabel(f"relative error of the {err}")
             ax.set_ylabel("time per run [ms]")
-            ax.set_title(f"{law}: {err}")
+            no_peer = any(p["method"].startswith("heyoka") for p in points) and not any(
+                p["method"].startswith("heyoka") and p["law"] == law for p in points)
+            ax.set_title(f"{law}: {err}" + (" (heyoka: not set up for its stick)" if no_peer else ""))
             ax.grid(True, which="both", alpha=0.3)
     handles, labels = [], []
     for ax in axes.flat:
