@@ -106,7 +106,7 @@ _UNITS = {name: unit for name, _, _, unit in SUMMARY_COLUMNS}
 _DTYPES = {name: np.dtype(dtype) for name, _, dtype, _ in SUMMARY_COLUMNS}
 _CODES = {"status": STATUSES, "outcome": OUTCOMES, "stop_reason": STOP_REASONS}
 _LONG_NAMES = {
-    "status": "numerical health of the run", "outcome": "outcome class (REFERENCE section 5)",
+    "status": "numerical health of the run", "outcome": "outcome class (docs/physics.md section 5)",
     "stop_reason": "why the run stopped", "t_stop": "time the run stopped", "max_force": "largest contact force",
     "max_indentation": "largest indentation", "restitution": "coefficient of restitution (first contact)",
     "contact_duration": "duration of the first contact", "dissipated_energy": "energy dissipated",
@@ -571,7 +571,7 @@ def _write_curve(f, c: CriticalCurve, created: str) -> None:
         d = f.create_dataset(name, data=np.asarray(getattr(c, name), dtype=float))
         d.attrs["_FillValue"] = np.float64(np.nan)
         d.attrs["units"] = kappa_units(alpha)
-        d.attrs["long_name"] = {"kappa": c.what, "closed_form": "closed-form kappa_c (REFERENCE section 5)",
+        d.attrs["long_name"] = {"kappa": c.what, "closed_form": "closed-form kappa_c (docs/physics.md section 5)",
                                 "predicted": "the continuation's prediction"}[name]
         d.dims[0].attach_scale(values)
     d = f.create_dataset("requested", data=np.asarray(c.requested, dtype=bool).astype(np.int8))

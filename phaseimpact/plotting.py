@@ -153,7 +153,7 @@ def save_h5(path, datasets: dict, attrs: dict | None = None):
 # Figures of archives and portraits (the command line's plot and portrait)
 # ------------------------------------------------------------------------------------------------
 
-#: One colour per outcome class, the same in every figure (REFERENCE §5's classes).
+#: One colour per outcome class, the same in every figure (docs/physics.md §5's classes).
 OUTCOME_COLOURS = {
     "permanent-stick": "#4477aa",
     "ratchet-escape": "#ee7733",
@@ -335,7 +335,7 @@ def _geometric(values) -> bool:
 
 def plot_curve(curve):
     """A continued curve: ``kappa`` (``kappa_c``, ``kappa_2`` or a grazing value) against its parameter,
-    the values asked for as dots (intermediate continuation steps as small dots), REFERENCE §5's closed
+    the values asked for as dots (intermediate continuation steps as small dots), the closed
     form dashed where it exists."""
     x = np.asarray(curve.values, dtype=float)
     y = np.asarray(curve.kappa, dtype=float)
@@ -352,7 +352,7 @@ def plot_curve(curve):
         closed = np.isfinite(curve.closed_form)
         if np.any(closed):
             ax.plot(x[closed], curve.closed_form[closed], "k--", lw=1.0,
-                    label=r"closed-form $\kappa_c$ (REFERENCE §5)")
+                    label=r"closed-form $\kappa_c$ (docs/physics.md §5)")
         if np.any(~finite):
             ax.plot(x[~finite], np.full(np.count_nonzero(~finite), np.nanmin(y) if np.any(finite) else 1.0), "rx",
                     label="lost")
