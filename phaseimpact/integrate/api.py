@@ -6,9 +6,9 @@ from __future__ import annotations
 
 import math
 import numbers
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 
-import numba
 import numpy as np
 from scipy.special import gamma
 
@@ -245,14 +245,17 @@ def run_batch(batch: Batch, *, rtol: float, settle: bool = True, stop_on=None, n
     summary = np.empty((n, d.N_SUMMARY))
     st = np.empty((3, n, capacity))
     count = np.empty(n, np.int64)
-    previous = numba.get_num_threads()
-    numba.set_num_threads(max(1, min(int(n_threads), numba.config.NUMBA_NUM_THREADS)))
-    try:
-        d.run_many(batch.law.code, batch.C, batch.Y0, batch.t_end, rtol, batch.atol, batch.max_step, settle,
-                   stop_kind, stop_count, MAX_STEPS, MAX_EVENTS, 0.0, capacity, summary, st[0], st[1], st[2],
-                   count)
-    finally:
-        numba.set_num_threads(previous)
+    args = (batch.law.code, batch.C, batch.Y0, batch.t_end, rtol, batch.atol, batch.max_step, settle, stop_kind,
+            stop_count, MAX_STEPS, MAX_EVENTS, 0.0)
+    outputs = (summary, st[0], st[1], st[2], count)
+    threads = max(1, min(int(n_threads), n))
+    if threads == 1:
+        d.run_block(*args, 0, n, *outputs)
+    else:  # blocks small enough to balance the load; the driver releases the GIL
+        size = max(1, min(256, -(-n // (8 * threads))))
+        with ThreadPoolExecutor(threads) as pool:
+            list(pool.map(lambda start: d.run_block(*args, start, min(start + size, n), *outputs),
+                          range(0, n, size)))
     parts_t, parts_delta, parts_dwell = [], [], []
     for i in range(n):
         k = int(count[i])

@@ -628,14 +628,15 @@ def stick_points(n_ev, ev_t, ev_kind, ev_y, t_stop, permanent, out_t, out_delta,
     return n
 
 
-@numba.njit(cache=True, parallel=True)
-def run_many(code, C, Y0, t_end, rtol, ATOL, max_step, settle, stop_kind, stop_count, max_steps, max_events,
-             rk4_step, capacity, summary, st_t, st_delta, st_dwell, st_count):
-    """Many runs in parallel (one thread per run; each run's numbers do not depend on the others
-    or on the thread count). Fills ``summary`` (n, N_SUMMARY) and the first ``capacity`` stick
-    points of each run; ``st_count`` holds each run's full number of stick points."""
+@numba.njit(cache=True, nogil=True)
+def run_block(code, C, Y0, t_end, rtol, ATOL, max_step, settle, stop_kind, stop_count, max_steps, max_events,
+              rk4_step, start, stop, summary, st_t, st_delta, st_dwell, st_count):
+    """Runs ``start..stop-1`` of a batch, without the GIL (callers run blocks in threads; each run's
+    numbers depend on nothing else). Fills ``summary`` (n, N_SUMMARY) and the first ``capacity``
+    stick points of each run; ``st_count`` holds each run's full number of stick points. Threads
+    over blocks, not a compiled parallel loop: that would compile the driver a second time."""
     empty = np.empty(0)
-    for i in numba.prange(C.shape[0]):
+    for i in range(start, stop):
         out = run(code, C[i], Y0[i], t_end[i], rtol, ATOL[i], max_step[i], settle, stop_kind, stop_count,
                   SAVE_SUMMARY, empty, max_steps, max_events, rk4_step, 1)
         s = out[0]
