@@ -15,7 +15,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..case import SETTABLE, Case
-from ..integrate.api import Batch, _atol, _initial, check_rtol, scales
+from ..integrate.api import Batch, check_rtol, pack_batch, scales
 from ..model.laws import ContactLaw
 from ..model.rhs import ALPHA_, DAMP_, K_, M1_, pack
 from ..parameters import PARAMETER_NAMES, Parameters
@@ -169,17 +169,5 @@ class Grid:
             else:  # the horizon scales with the contact time, which scales with the indentation over v
                 T = s.horizon * (indentation / v) / (base.hertz_indentation / base.v)
             return Batch(self.law, C, Y0, T, A, np.full(n, s.max_step))
-        C = np.empty((n, 9))
-        Y0 = np.empty((n, 5))
-        T = np.empty(n)
-        A = np.empty((n, 5))
-        S = np.empty(n)
-        for i in range(n):
-            p = self.parameters_at({k: v[i] for k, v in columns.items()})
-            s = scales(p)
-            C[i] = pack(p, self.law)
-            Y0[i] = _initial(p, None)
-            T[i] = s.horizon if t_end is None else t_end
-            A[i] = _atol(p, rtol, None)
-            S[i] = s.max_step
-        return Batch(self.law, C, Y0, T, A, S)
+        points = (self.parameters_at({k: v[i] for k, v in columns.items()}) for i in range(n))
+        return pack_batch(points, self.law, t_end, rtol)

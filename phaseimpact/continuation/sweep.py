@@ -20,7 +20,7 @@ from .. import __version__
 from ..case import Case
 from ..integrate import driver as drv
 from ..integrate.api import check_real, check_rtol
-from ..integrate.result import SUMMARY_COLUMNS
+from ..integrate.result import SUMMARY_COLUMNS, ColumnAccess
 from ..model.laws import ContactLaw, as_law
 from ..parameters import Parameters
 from ._parallel import check_jobs, run_chunks
@@ -34,7 +34,7 @@ CHUNK_THREADS, CHUNK_MIN, CHUNK_MAX = 4096, 256, 65536
 
 
 @dataclass
-class SweepResult:
+class SweepResult(ColumnAccess):
     """Columns of a grid of runs (points in C order over ``grid.axes``).
 
     Attributes
@@ -81,12 +81,6 @@ class SweepResult:
                             ("stick_dwell", float)):
             if getattr(self, name) is None:
                 setattr(self, name, np.empty(0, dtype=dtype))
-
-    def __getattr__(self, name):
-        values = self.__dict__.get("values")
-        if values is not None and name in values:
-            return values[name]
-        raise AttributeError(name)
 
     @property
     def law(self) -> ContactLaw:

@@ -210,9 +210,6 @@ class Batch:
     def __len__(self) -> int:
         return len(self.C)
 
-    def take(self, idx) -> Batch:
-        return Batch(self.law, self.C[idx], self.Y0[idx], self.t_end[idx], self.atol[idx], self.max_step[idx])
-
 
 def pack_batch(params_seq, law: ContactLaw, t_end, rtol: float, initial=None) -> Batch:
     """Pack a sequence of :class:`Parameters` (one law) for :func:`run_batch`."""

@@ -260,8 +260,18 @@ SUMMARY_COLUMNS = (
 )
 
 
+class ColumnAccess:
+    """Summary columns read as attributes (``result.max_force``) from a ``values`` dict."""
+
+    def __getattr__(self, name):
+        values = self.__dict__.get("values")
+        if values is not None and name in values:
+            return values[name]
+        raise AttributeError(name)
+
+
 @dataclass
-class Columns:
+class Columns(ColumnAccess):
     """Many runs as a struct of arrays (one entry per run); NaN where a quantity is undefined.
 
     Attributes
@@ -286,12 +296,6 @@ class Columns:
 
     def __len__(self) -> int:
         return len(self.status)
-
-    def __getattr__(self, name):
-        values = self.__dict__.get("values")
-        if values is not None and name in values:
-            return values[name]
-        raise AttributeError(name)
 
     @property
     def cut(self) -> np.ndarray:
