@@ -186,3 +186,10 @@ def test_stick_counts_do_not_depend_on_the_tolerance(kappa):
     counts = {simulate(seed_parameters(v=1.0, kappa=float(kappa)), "paper", rtol=r).n_stick
               for r in (1e-8, 1e-10, 1e-12)}
     assert counts == {2}
+
+
+def test_unrolled_dop853_is_scipys_tableau():
+    """The committed straight-line step is what the generator writes from scipy's tableau today."""
+    from phaseimpact.integrate import _dop853_codegen
+
+    assert _dop853_codegen.TARGET.read_text() == _dop853_codegen.generate_source()
