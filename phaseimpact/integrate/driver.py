@@ -69,10 +69,18 @@ _TINY = np.finfo(np.float64).tiny
 _EPS = np.finfo(np.float64).eps
 
 
+# Copies go element by element on purpose: a slice or row assignment makes numba compile its
+# shape-mismatch error messages (string formatting), which was half of the first-ever compile.
+@numba.njit(cache=True)
+def _copy(src, dst, n):
+    for j in range(n):
+        dst[j] = src[j]
+
+
 @numba.njit(cache=True)
 def _grow(a, n):
     b = np.empty((max(2 * a.shape[0], 16),) + a.shape[1:], a.dtype)
-    b[:n] = a[:n]
+    _copy(a.ravel(), b.ravel(), n * (a.size // max(a.shape[0], 1)))
     return b
 
 
@@ -85,7 +93,7 @@ def _push_event(ev_t, ev_kind, ev_mode, ev_y, ev_force, n, t, kind, mode, y, for
     ev_t[n] = t
     ev_kind[n] = kind
     ev_mode[n] = mode
-    ev_y[n] = y
+    _copy(y, ev_y[n], 5)
     ev_force[n] = force
     return ev_t, ev_kind, ev_mode, ev_y, ev_force, n + 1
 
@@ -96,7 +104,7 @@ def _push_sample(s_t, s_y, s_mode, s_force, n, t, y, mode, force):
     if n == s_t.shape[0]:
         s_t, s_y, s_mode, s_force = _grow(s_t, n), _grow(s_y, n), _grow(s_mode, n), _grow(s_force, n)
     s_t[n] = t
-    s_y[n] = y
+    _copy(y, s_y[n], 5)
     s_mode[n] = mode
     s_force[n] = force
     return s_t, s_y, s_mode, s_force, n + 1
@@ -294,13 +302,13 @@ def run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count,
         ev_t[0] = 0.0
         ev_kind[0] = CONTACT
         ev_mode[0] = mode
-        ev_y[0] = y
+        _copy(y, ev_y[0], 5)
         ev_force[0] = force
         n_ev = 1
         counts[CONTACT] += 1
     if save_kind == SAVE_STEPS:
         s_t[0] = 0.0
-        s_y[0] = y
+        _copy(y, s_y[0], 5)
         s_mode[0] = mode
         s_force[0] = force
         n_s = 1
@@ -383,7 +391,9 @@ def run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count,
                 s_t[:n_s], s_y[:n_s], s_mode[:n_s], s_force[:n_s], y)
 
     # ---- adaptive DOP853 with events ----
-    quiet = DELTA
+    # integer constants passed to compiled callees go as np.int64: a literal argument would compile
+    # a second copy of the callee (and of everything it calls) specialised on that value
+    quiet = np.int64(DELTA)
     event_values(code, c, y, f, force, mode, energy_limit, g_old)
     _quiet_start(quiet, y, mode, g_old)
     h_abs = dop853.initial_step(code, c, mode, y, f, rtol, atol, t_end, max_step, tmp, f_new)
@@ -418,7 +428,7 @@ def run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count,
             any_fired = any_fired or fired[col]
         have_dense = False
         stop_record = -1.0
-        restart_col = -1
+        restart_col = np.int64(-1)
         t_restart = math.inf
         if any_fired:
             dop853.dense_coefficients(code, c, mode, y, f, y_new, f_new, h, K, F, tmp)
@@ -440,17 +450,17 @@ def run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count,
             if fired[DELTADOT] and not fired[DELTA]:
                 # an extreme of delta inside the step on the other side of zero: a contact (or
                 # separation) and its return both fell inside the step
-                d_ext = _event_at(code, c, mode, energy_limit, DELTA, F, y, t, h, roots[DELTADOT], ys, fs, gs)
+                d_ext = _event_at(code, c, mode, energy_limit, np.int64(DELTA), F, y, t, h, roots[DELTADOT], ys, fs, gs)
                 if d_ext * g_old[DELTA] < 0:
                     fired[DELTA] = True
-                    roots[DELTA] = _brent(code, c, mode, energy_limit, DELTA, F, y, t, h, t, roots[DELTADOT],
+                    roots[DELTA] = _brent(code, c, mode, energy_limit, np.int64(DELTA), F, y, t, h, t, roots[DELTADOT],
                                           g_old[DELTA], d_ext, ys, fs, gs)
             for col in range(N_EVENTS):
                 if fired[col] and (restarts(code, col, mode, settle) or col == ENERGY) and roots[col] < t_restart:
                     restart_col, t_restart = col, roots[col]
             # recorded events before the restart, in time order
             while True:
-                best = -1
+                best = np.int64(-1)
                 for col in range(N_EVENTS):
                     if fired[col] and not (restarts(code, col, mode, settle) or col == ENERGY) \
                             and roots[col] <= t_restart and (best < 0 or roots[col] < roots[best]):
@@ -476,7 +486,7 @@ def run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count,
             if stop_record > t:
                 dop853.step(code, c, mode, y, f, stop_record - t, K, y_r, f_r, tmp)
                 nfev += 12
-                y[:] = y_r
+                _copy(y_r, y, 5)
                 t = stop_record
             reason = ASKED_STOP
             break
@@ -499,10 +509,10 @@ def run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count,
                 dop853.step(code, c, mode, y, f, h_r, K, y_r, f_r, tmp)
                 nfev += 12
             else:
-                y_r[:] = y
+                _copy(y, y_r, 5)
             kind, mode, action = transition(code, c, restart_col, y_r, mode, settle)
             t = t_restart
-            y[:] = y_r
+            _copy(y_r, y, 5)
             force = rhs(code, c, y, mode, f)
             nfev += 1
             if kind == SILENT:  # a restart only (the pair at its centre): nothing to log
@@ -638,9 +648,9 @@ def run_block(code, C, Y0, t_end, rtol, ATOL, max_step, settle, stop_kind, stop_
     empty = np.empty(0)
     for i in range(start, stop):
         out = run(code, C[i], Y0[i], t_end[i], rtol, ATOL[i], max_step[i], settle, stop_kind, stop_count,
-                  SAVE_SUMMARY, empty, max_steps, max_events, rk4_step, 1)
+                  np.int64(SAVE_SUMMARY), empty, max_steps, max_events, rk4_step, np.int64(1))
         s = out[0]
-        summary[i] = s
+        _copy(s, summary[i], N_SUMMARY)
         permanent = s[S_OUTCOME] == PERMANENT_STICK
         st_count[i] = stick_points(out[1].shape[0], out[1], out[2], out[4], s[S_T_STOP], permanent,
                                    st_t[i], st_delta[i], st_dwell[i])
