@@ -302,10 +302,11 @@ def test_a_failed_trajectory_is_reported_with_exit_1(monkeypatch):
     real = integrate.simulate
 
     def failing(*args, **kwargs):
-        return dataclasses.replace(real(*args, **kwargs), status="step-size-collapse", message="collapsed")
+        return dataclasses.replace(real(*args, **kwargs), status="step-size-collapse")
 
     monkeypatch.setattr(integrate, "simulate", failing)
     code, out, err = run(["simulate", "--json"])
     assert code == 1
     assert json.loads(out)["status"] == "step-size-collapse"  # the result is still printed
     assert "numerical failure: step-size-collapse" in err and "Traceback" not in err
+    assert "the step size collapsed" in err  # the message follows the status

@@ -4,6 +4,7 @@ derive horizons and tolerances from the case's own scales, and call the one comp
 
 from __future__ import annotations
 
+import functools
 import math
 import numbers
 from concurrent.futures import ThreadPoolExecutor
@@ -17,7 +18,7 @@ from ..model.rhs import initial_state, pack
 from ..parameters import Parameters
 from . import driver as d
 from .events import EVENT_KINDS
-from .result import Columns, Trajectory, run_message
+from .result import Columns, Trajectory
 
 __all__ = ["simulate", "simulate_many", "Scales", "scales", "INTEGRATORS", "RTOL_RANGE"]
 
@@ -38,6 +39,8 @@ def is_real(value) -> bool:
 
 def check_real(name: str, value, allowed: str, ok) -> float:
     """``value`` as a float if it is a real number and ``ok(value)``; else ``ValueError``."""
+    if type(value) is float and math.isfinite(value) and ok(value):  # the common case, without the ABC check
+        return value
     if not is_real(value) or not math.isfinite(value) or not ok(float(value)):
         raise ValueError(f"{name} = {value!r} is out of range; allowed: {allowed}")
     return float(value)
@@ -45,6 +48,8 @@ def check_real(name: str, value, allowed: str, ok) -> float:
 
 def check_rtol(rtol) -> float:
     lo, hi = RTOL_RANGE
+    if type(rtol) is float and lo <= rtol <= hi:  # the common case, without formatting the range
+        return rtol
     return check_real("rtol", rtol, f"{lo:g} <= rtol <= {hi:g}", lambda x: lo <= x <= hi)
 
 
@@ -73,8 +78,9 @@ class Scales:
     max_step: float
 
 
+@functools.lru_cache(maxsize=1024)
 def scales(params: Parameters) -> Scales:
-    """The time and length scales of ``params``."""
+    """The time and length scales of ``params`` (cached: a sweep asks for the same case often)."""
     a = params.alpha
     tau = math.sqrt(math.pi) * gamma(1 + 1 / (a + 1)) / gamma(0.5 + 1 / (a + 1))  # 1.4716 for Hertz
     indentation = params.hertz_indentation
@@ -92,6 +98,13 @@ def _atol(params: Parameters, rtol: float, atol) -> np.ndarray:
         return np.full(5, check_real("atol", atol, "a number > 0", lambda x: x > 0))
     s = params.hertz_indentation
     return rtol * np.array([s, s, params.v, params.v, 0.5 * params.M1 * params.v**2])
+
+
+@functools.lru_cache(maxsize=1024)
+def _packed(params: Parameters, law: ContactLaw, rtol: float) -> tuple[np.ndarray, np.ndarray]:
+    """The driver's coefficient array and default absolute tolerances (cached; the driver never
+    writes to them and they are not handed out)."""
+    return pack(params, law), _atol(params, rtol, None)
 
 
 def _initial(params: Parameters, initial) -> np.ndarray:
@@ -180,8 +193,10 @@ def simulate(params: Parameters, law: ContactLaw | str = "paper", t_end: float |
         if horizon / rk4_step > max_steps:
             raise ValueError(f"step = {rk4_step!r} needs {horizon / rk4_step:.3g} steps; allowed: at most "
                              f"max_steps = {max_steps}")
-    out = d.run(law.code, pack(params, law), y0, horizon, rtol, _atol(params, rtol, atol), s.max_step, settle,
-                stop_kind, stop_count, save_kind, times, int(max_steps), MAX_EVENTS, rk4_step, int(every))
+    c, default_atol = _packed(params, law, rtol)
+    out = d.run(law.code, c, y0, horizon, rtol, default_atol if atol is None else _atol(params, rtol, atol),
+                s.max_step, settle, stop_kind, stop_count, save_kind, times, int(max_steps), MAX_EVENTS, rk4_step,
+                int(every))
     summary, ev_t, ev_kind, ev_mode, ev_y, ev_force, s_t, s_y, s_mode, s_force, y_final = out
     status = d.STATUSES[int(summary[d.S_STATUS])]
     reason = d.STOP_REASONS[int(summary[d.S_REASON])]
@@ -190,9 +205,7 @@ def simulate(params: Parameters, law: ContactLaw | str = "paper", t_end: float |
     return Trajectory(
         t=s_t, y=s_y, force=s_force, mode=s_mode, event_t=ev_t, event_kind=ev_kind, event_mode=ev_mode,
         event_y=ev_y, event_force=ev_force, params=params, law=law, initial_state=y0, final_state=y_final,
-        t_end=horizon, status=status, stop_reason=reason, outcome=outcome,
-        message=run_message(status, reason, float(summary[d.S_T_STOP]), outcome), summary=summary,
-        integrator=name)
+        t_end=horizon, status=status, stop_reason=reason, outcome=outcome, summary=summary, integrator=name)
 
 
 @dataclass(frozen=True)

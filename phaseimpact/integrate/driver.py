@@ -65,6 +65,8 @@ SAVE_SUMMARY, SAVE_STEPS, SAVE_TIMES = range(3)
  S_FIRST_STICK_MARGIN, S_FIRST_STICK_T, S_NSTEPS, S_NFEV, S_MODE) = range(19)
 N_SUMMARY = 19
 
+#: Smallest step reduction after a rejection when the observed order is used (else MIN_FACTOR).
+OBSERVED_MIN_FACTOR = 0.01
 _TINY = np.finfo(np.float64).tiny
 _EPS = np.finfo(np.float64).eps
 
@@ -227,6 +229,7 @@ def _advance(code, c, mode, t, t_end, y, f, force, h_abs, rtol, atol, max_step, 
             return _ADV_LIMIT, t, h, h_abs, h_next, force, force_new, steps, evaluations
         h_abs = min(h_abs, max_step)
         rejected = False
+        h_rejected = err_rejected = 0.0
         while True:
             if h_abs < 10.0 * (np.nextafter(t, np.inf) - t):
                 return _ADV_COLLAPSE, t, h, h_abs, h_next, force, force_new, steps, evaluations
@@ -242,7 +245,16 @@ def _advance(code, c, mode, t, t_end, y, f, force, h_abs, rtol, atol, max_step, 
                     factor = min(1.0, factor)
                 h_next = h * factor
                 break
-            h_abs = h * max(dop853.MIN_FACTOR, dop853.SAFETY * err**dop853.ERROR_EXPONENT)
+            factor = max(dop853.MIN_FACTOR, dop853.SAFETY * err**dop853.ERROR_EXPONENT)
+            if rejected and err < err_rejected:
+                # a second rejection at the same point: the error falls with the step more slowly than
+                # the method's order says (delta^alpha at a contact onset goes as h^2.5); shrink by the
+                # observed order instead of rejecting again and again
+                observed = math.log(err_rejected / err) / math.log(h_rejected / h)
+                if 0.0 < observed < dop853.ORDER:
+                    factor = min(factor, max(OBSERVED_MIN_FACTOR, (0.5 / err) ** (1.0 / observed)))
+            h_rejected, err_rejected = h, err
+            h_abs = h * factor
             rejected = True
         steps += 1
         event_values(code, c, y_new, f_new, force_new, mode, energy_limit, g_new)

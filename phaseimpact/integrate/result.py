@@ -122,9 +122,13 @@ class Trajectory:
     status: str
     stop_reason: str
     outcome: str
-    message: str
     summary: np.ndarray = field(repr=False)
     integrator: str = "exact"
+
+    @property
+    def message(self) -> str:
+        """A sentence on how the run ended."""
+        return run_message(self.status, self.stop_reason, self.t_stop, self.outcome)
 
     @property
     def ok(self) -> bool:

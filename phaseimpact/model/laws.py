@@ -31,6 +31,7 @@ tests (``tests/test_laws.py``) pick it up from :func:`law_variants`.
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 
@@ -309,7 +310,16 @@ class ContactLaw:
 
 def as_law(law) -> ContactLaw:
     """Accept a :class:`ContactLaw` or a law name."""
-    return law if isinstance(law, ContactLaw) else ContactLaw(law)
+    if isinstance(law, ContactLaw):
+        return law
+    if isinstance(law, str) and law in REGISTRY:
+        return _named_law(law)
+    return ContactLaw(law)  # raises the usual error
+
+
+@functools.cache
+def _named_law(name: str) -> ContactLaw:
+    return ContactLaw(name)
 
 
 def law_variants() -> list[ContactLaw]:
