@@ -107,7 +107,7 @@ def run_plain(params, law, rtol, method):
     with warnings.catch_warnings(), np.errstate(all="ignore"):  # the chattering runs overflow their Jacobians
         warnings.simplefilter("ignore", RuntimeWarning)
         sol = solve_ivp(fun, (0.0, T_END), api._initial(params, None), method=method, rtol=rtol,
-                        atol=api._atol(params, rtol, None))
+                        atol=api._atol(params, rtol, None)[:5])
     out = np.empty(5)
     force = max(rhs(law.code, c, sol.y[:, i], mode, out) for i in range(sol.y.shape[1]))
     return force, sol.y[:4, -1], sol.nfev, "success" if sol.success else sol.message

@@ -65,7 +65,7 @@ def oracle(params, law, t_end=None, *, rtol=1e-12, method="DOP853", settle=True,
     c = pack(params, law)
     s = scales(params)
     horizon = s.horizon if t_end is None else t_end
-    atol = _atol(params, rtol, None)
+    atol = _atol(params, rtol, None)[:5]  # the physical state (x1, x2, x1dot, x2dot, W)
     y = np.array([0.0, 0.0, params.v, 0.0, 0.0])
     if initial is not None:
         y[:4] = initial

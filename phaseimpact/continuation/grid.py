@@ -15,7 +15,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..case import SETTABLE, Case
-from ..integrate.api import Batch, check_rtol, pack_batch, scales
+from ..integrate.api import Batch, check_rtol, hertz_contact_time, pack_batch, scales, state_tolerances
 from ..model.laws import ContactLaw
 from ..model.rhs import ALPHA_, DAMP_, K_, M1_, pack
 from ..parameters import PARAMETER_NAMES, Parameters
@@ -161,7 +161,7 @@ class Grid:
             alpha = C[0, ALPHA_]
             # the same expressions as Parameters.hertz_indentation and scales(), on arrays
             indentation = ((alpha + 1) * base.reduced_mass * v**2 / (2 * C[0, K_])) ** (1 / (alpha + 1))
-            A = rtol * np.column_stack([indentation, indentation, v, v, 0.5 * C[:, M1_] * v**2])
+            A = state_tolerances(rtol, indentation, v, C[:, M1_], hertz_contact_time(alpha, indentation, v))
             if t_end is not None:
                 T = np.full(n, t_end)
             elif math.isfinite(s.plate_period):

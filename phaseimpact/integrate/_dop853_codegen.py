@@ -17,7 +17,7 @@ from pathlib import Path
 from scipy.integrate._ivp import dop853_coefficients as tableau
 
 TARGET = Path(__file__).with_name("_dop853_stages.py")
-N = 5  # state size
+N = 6  # integration state: (x1 or w, x2, x1dot, x2dot, W, t)
 
 
 def _sum(coefficients, stages) -> str:
@@ -30,10 +30,10 @@ def _stages(first: int, last: int, out: str) -> list[str]:
     """Stages ``first..last-1``: the argument from the earlier stages, then the right-hand side."""
     lines = []
     for s in range(first, last):
-        lines += ["    for j in range(5):",
+        lines += [f"    for j in range({N}):",
                   f"        tmp[j] = y[j] + h * ({_sum(tableau.A[s], range(s))})",
-                  f"    rhs(code, c, tmp, mode, {out})",
-                  "    for j in range(5):",
+                  f"    rhs_integration(code, c, tmp, mode, side, {out})",
+                  f"    for j in range({N}):",
                   f"        K[{s}, j] = {out}[j]"]
     return lines
 
@@ -49,20 +49,20 @@ def generate_source() -> str:
         "",
         "import numba",
         "",
-        "from ..model.rhs import rhs",
+        "from ..model.rhs import rhs_integration",
         "",
         "",
         "@numba.njit(cache=True)",
-        "def step(code, c, mode, y, f, h, K, y_new, f_new, tmp):",
+        "def step(code, c, mode, side, y, f, h, K, y_new, f_new, tmp):",
         '    """One step of size ``h`` from ``(y, f)``: fills stages ``K[0..12]``, ``y_new``, ``f_new``;',
         '    returns the contact force at ``y_new``."""',
-        "    for j in range(5):",
+        f"    for j in range({N}):",
         "        K[0, j] = f[j]",
         *_stages(1, n, "f_new"),
-        "    for j in range(5):",
+        f"    for j in range({N}):",
         f"        y_new[j] = y[j] + h * ({_sum(tableau.B, range(n))})",
-        "    force = rhs(code, c, y_new, mode, f_new)",
-        "    for j in range(5):",
+        "    force = rhs_integration(code, c, y_new, mode, side, f_new)",
+        f"    for j in range({N}):",
         f"        K[{n}, j] = f_new[j]",
         "    return force",
         "",
@@ -72,7 +72,7 @@ def generate_source() -> str:
         '    """scipy\'s DOP853 error measure of the last step (< 1: accept); inf for a non-finite step."""',
         "    e5 = 0.0",
         "    e3 = 0.0",
-        "    for j in range(5):",
+        f"    for j in range({N}):",
         "        scale = atol[j] + max(abs(y[j]), abs(y_new[j])) * rtol",
         f"        e5 += (({_sum(tableau.E5, range(n + 1))}) / scale) ** 2",
         f"        e3 += (({_sum(tableau.E3, range(n + 1))}) / scale) ** 2",
@@ -80,14 +80,14 @@ def generate_source() -> str:
         "        return math.inf",
         "    if e5 == 0.0 and e3 == 0.0:",
         "        return 0.0",
-        "    return abs(h) * e5 / math.sqrt((e5 + 0.01 * e3) * 5.0)",
+        f"    return abs(h) * e5 / math.sqrt((e5 + 0.01 * e3) * {float(N)})",
         "",
         "",
         "@numba.njit(cache=True)",
-        "def dense_coefficients(code, c, mode, y, f, y_new, f_new, h, K, F, tmp):",
-        '    """The interpolant of the last step (three extra stages): fills ``F`` (7, 5)."""',
+        "def dense_coefficients(code, c, mode, side, y, f, y_new, f_new, h, K, F, tmp):",
+        '    """The interpolant of the last step (three extra stages): fills ``F`` (7, 6)."""',
         *_stages(n + 1, tableau.N_STAGES_EXTENDED, "F[0]"),
-        "    for j in range(5):",
+        f"    for j in range({N}):",
         "        dy = y_new[j] - y[j]",
         "        F[0, j] = dy",
         "        F[1, j] = h * f[j] - dy",

@@ -6,74 +6,74 @@ import math
 
 import numba
 
-from ..model.rhs import rhs
+from ..model.rhs import rhs_integration
 
 
 @numba.njit(cache=True)
-def step(code, c, mode, y, f, h, K, y_new, f_new, tmp):
+def step(code, c, mode, side, y, f, h, K, y_new, f_new, tmp):
     """One step of size ``h`` from ``(y, f)``: fills stages ``K[0..12]``, ``y_new``, ``f_new``;
     returns the contact force at ``y_new``."""
-    for j in range(5):
+    for j in range(6):
         K[0, j] = f[j]
-    for j in range(5):
+    for j in range(6):
         tmp[j] = y[j] + h * (0.05260015195876773 * K[0, j])
-    rhs(code, c, tmp, mode, f_new)
-    for j in range(5):
+    rhs_integration(code, c, tmp, mode, side, f_new)
+    for j in range(6):
         K[1, j] = f_new[j]
-    for j in range(5):
+    for j in range(6):
         tmp[j] = y[j] + h * (0.0197250569845379 * K[0, j] + 0.0591751709536137 * K[1, j])
-    rhs(code, c, tmp, mode, f_new)
-    for j in range(5):
+    rhs_integration(code, c, tmp, mode, side, f_new)
+    for j in range(6):
         K[2, j] = f_new[j]
-    for j in range(5):
+    for j in range(6):
         tmp[j] = y[j] + h * (0.02958758547680685 * K[0, j] + 0.08876275643042054 * K[2, j])
-    rhs(code, c, tmp, mode, f_new)
-    for j in range(5):
+    rhs_integration(code, c, tmp, mode, side, f_new)
+    for j in range(6):
         K[3, j] = f_new[j]
-    for j in range(5):
+    for j in range(6):
         tmp[j] = y[j] + h * (0.2413651341592667 * K[0, j] + -0.8845494793282861 * K[2, j] + 0.924834003261792 * K[3, j])
-    rhs(code, c, tmp, mode, f_new)
-    for j in range(5):
+    rhs_integration(code, c, tmp, mode, side, f_new)
+    for j in range(6):
         K[4, j] = f_new[j]
-    for j in range(5):
+    for j in range(6):
         tmp[j] = y[j] + h * (0.037037037037037035 * K[0, j] + 0.17082860872947386 * K[3, j] + 0.12546768756682242 * K[4, j])
-    rhs(code, c, tmp, mode, f_new)
-    for j in range(5):
+    rhs_integration(code, c, tmp, mode, side, f_new)
+    for j in range(6):
         K[5, j] = f_new[j]
-    for j in range(5):
+    for j in range(6):
         tmp[j] = y[j] + h * (0.037109375 * K[0, j] + 0.17025221101954405 * K[3, j] + 0.06021653898045596 * K[4, j] + -0.017578125 * K[5, j])
-    rhs(code, c, tmp, mode, f_new)
-    for j in range(5):
+    rhs_integration(code, c, tmp, mode, side, f_new)
+    for j in range(6):
         K[6, j] = f_new[j]
-    for j in range(5):
+    for j in range(6):
         tmp[j] = y[j] + h * (0.03709200011850479 * K[0, j] + 0.17038392571223998 * K[3, j] + 0.10726203044637328 * K[4, j] + -0.015319437748624402 * K[5, j] + 0.008273789163814023 * K[6, j])
-    rhs(code, c, tmp, mode, f_new)
-    for j in range(5):
+    rhs_integration(code, c, tmp, mode, side, f_new)
+    for j in range(6):
         K[7, j] = f_new[j]
-    for j in range(5):
+    for j in range(6):
         tmp[j] = y[j] + h * (0.6241109587160757 * K[0, j] + -3.3608926294469414 * K[3, j] + -0.868219346841726 * K[4, j] + 27.59209969944671 * K[5, j] + 20.154067550477894 * K[6, j] + -43.48988418106996 * K[7, j])
-    rhs(code, c, tmp, mode, f_new)
-    for j in range(5):
+    rhs_integration(code, c, tmp, mode, side, f_new)
+    for j in range(6):
         K[8, j] = f_new[j]
-    for j in range(5):
+    for j in range(6):
         tmp[j] = y[j] + h * (0.47766253643826434 * K[0, j] + -2.4881146199716677 * K[3, j] + -0.590290826836843 * K[4, j] + 21.230051448181193 * K[5, j] + 15.279233632882423 * K[6, j] + -33.28821096898486 * K[7, j] + -0.020331201708508627 * K[8, j])
-    rhs(code, c, tmp, mode, f_new)
-    for j in range(5):
+    rhs_integration(code, c, tmp, mode, side, f_new)
+    for j in range(6):
         K[9, j] = f_new[j]
-    for j in range(5):
+    for j in range(6):
         tmp[j] = y[j] + h * (-0.9371424300859873 * K[0, j] + 5.186372428844064 * K[3, j] + 1.0914373489967295 * K[4, j] + -8.149787010746927 * K[5, j] + -18.52006565999696 * K[6, j] + 22.739487099350505 * K[7, j] + 2.4936055526796523 * K[8, j] + -3.0467644718982196 * K[9, j])
-    rhs(code, c, tmp, mode, f_new)
-    for j in range(5):
+    rhs_integration(code, c, tmp, mode, side, f_new)
+    for j in range(6):
         K[10, j] = f_new[j]
-    for j in range(5):
+    for j in range(6):
         tmp[j] = y[j] + h * (2.273310147516538 * K[0, j] + -10.53449546673725 * K[3, j] + -2.0008720582248625 * K[4, j] + -17.9589318631188 * K[5, j] + 27.94888452941996 * K[6, j] + -2.8589982771350235 * K[7, j] + -8.87285693353063 * K[8, j] + 12.360567175794303 * K[9, j] + 0.6433927460157636 * K[10, j])
-    rhs(code, c, tmp, mode, f_new)
-    for j in range(5):
+    rhs_integration(code, c, tmp, mode, side, f_new)
+    for j in range(6):
         K[11, j] = f_new[j]
-    for j in range(5):
+    for j in range(6):
         y_new[j] = y[j] + h * (0.054293734116568765 * K[0, j] + 4.450312892752409 * K[5, j] + 1.8915178993145003 * K[6, j] + -5.801203960010585 * K[7, j] + 0.3111643669578199 * K[8, j] + -0.1521609496625161 * K[9, j] + 0.20136540080403034 * K[10, j] + 0.04471061572777259 * K[11, j])
-    force = rhs(code, c, y_new, mode, f_new)
-    for j in range(5):
+    force = rhs_integration(code, c, y_new, mode, side, f_new)
+    for j in range(6):
         K[12, j] = f_new[j]
     return force
 
@@ -83,7 +83,7 @@ def error_norm(K, h, y, y_new, rtol, atol):
     """scipy's DOP853 error measure of the last step (< 1: accept); inf for a non-finite step."""
     e5 = 0.0
     e3 = 0.0
-    for j in range(5):
+    for j in range(6):
         scale = atol[j] + max(abs(y[j]), abs(y_new[j])) * rtol
         e5 += ((0.01312004499419488 * K[0, j] + -1.2251564463762044 * K[5, j] + -0.4957589496572502 * K[6, j] + 1.6643771824549864 * K[7, j] + -0.35032884874997366 * K[8, j] + 0.3341791187130175 * K[9, j] + 0.08192320648511571 * K[10, j] + -0.022355307863886294 * K[11, j]) / scale) ** 2
         e3 += ((-0.18980075407240762 * K[0, j] + 4.450312892752409 * K[5, j] + 1.8915178993145003 * K[6, j] + -5.801203960010585 * K[7, j] + -0.4226823213237919 * K[8, j] + -0.1521609496625161 * K[9, j] + 0.20136540080403034 * K[10, j] + 0.02265179219836082 * K[11, j]) / scale) ** 2
@@ -91,28 +91,28 @@ def error_norm(K, h, y, y_new, rtol, atol):
         return math.inf
     if e5 == 0.0 and e3 == 0.0:
         return 0.0
-    return abs(h) * e5 / math.sqrt((e5 + 0.01 * e3) * 5.0)
+    return abs(h) * e5 / math.sqrt((e5 + 0.01 * e3) * 6.0)
 
 
 @numba.njit(cache=True)
-def dense_coefficients(code, c, mode, y, f, y_new, f_new, h, K, F, tmp):
-    """The interpolant of the last step (three extra stages): fills ``F`` (7, 5)."""
-    for j in range(5):
+def dense_coefficients(code, c, mode, side, y, f, y_new, f_new, h, K, F, tmp):
+    """The interpolant of the last step (three extra stages): fills ``F`` (7, 6)."""
+    for j in range(6):
         tmp[j] = y[j] + h * (0.056167502283047954 * K[0, j] + 0.25350021021662483 * K[6, j] + -0.2462390374708025 * K[7, j] + -0.12419142326381637 * K[8, j] + 0.15329179827876568 * K[9, j] + 0.00820105229563469 * K[10, j] + 0.007567897660545699 * K[11, j] + -0.008298 * K[12, j])
-    rhs(code, c, tmp, mode, F[0])
-    for j in range(5):
+    rhs_integration(code, c, tmp, mode, side, F[0])
+    for j in range(6):
         K[13, j] = F[0][j]
-    for j in range(5):
+    for j in range(6):
         tmp[j] = y[j] + h * (0.03183464816350214 * K[0, j] + 0.028300909672366776 * K[5, j] + 0.053541988307438566 * K[6, j] + -0.05492374857139099 * K[7, j] + -0.00010834732869724932 * K[10, j] + 0.0003825710908356584 * K[11, j] + -0.00034046500868740456 * K[12, j] + 0.1413124436746325 * K[13, j])
-    rhs(code, c, tmp, mode, F[0])
-    for j in range(5):
+    rhs_integration(code, c, tmp, mode, side, F[0])
+    for j in range(6):
         K[14, j] = F[0][j]
-    for j in range(5):
+    for j in range(6):
         tmp[j] = y[j] + h * (-0.42889630158379194 * K[0, j] + -4.697621415361164 * K[5, j] + 7.683421196062599 * K[6, j] + 4.06898981839711 * K[7, j] + 0.3567271874552811 * K[8, j] + -0.0013990241651590145 * K[12, j] + 2.9475147891527724 * K[13, j] + -9.15095847217987 * K[14, j])
-    rhs(code, c, tmp, mode, F[0])
-    for j in range(5):
+    rhs_integration(code, c, tmp, mode, side, F[0])
+    for j in range(6):
         K[15, j] = F[0][j]
-    for j in range(5):
+    for j in range(6):
         dy = y_new[j] - y[j]
         F[0, j] = dy
         F[1, j] = h * f[j] - dy

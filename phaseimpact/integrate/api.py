@@ -78,26 +78,38 @@ class Scales:
     max_step: float
 
 
+def hertz_contact_time(alpha: float, indentation, v):
+    """Duration of the undamped impact, ``2 tau delta_max / v`` (s; scalars or arrays)."""
+    tau = math.sqrt(math.pi) * gamma(1 + 1 / (alpha + 1)) / gamma(0.5 + 1 / (alpha + 1))  # 1.4716 for Hertz
+    return 2 * tau * indentation / v
+
+
 @functools.lru_cache(maxsize=1024)
 def scales(params: Parameters) -> Scales:
     """The time and length scales of ``params`` (cached: a sweep asks for the same case often)."""
-    a = params.alpha
-    tau = math.sqrt(math.pi) * gamma(1 + 1 / (a + 1)) / gamma(0.5 + 1 / (a + 1))  # 1.4716 for Hertz
     indentation = params.hertz_indentation
-    contact_time = 2 * tau * indentation / params.v
+    contact_time = hertz_contact_time(params.alpha, indentation, params.v)
     period = params.target_period
     slow = period if math.isfinite(period) else contact_time
     max_step = period / 8 if math.isfinite(period) else math.inf
     return Scales(indentation, contact_time, period, HORIZON_CAP_PERIODS * slow, max_step)
 
 
+def state_tolerances(rtol: float, indentation, v, M1, contact_time) -> np.ndarray:
+    """Absolute tolerances of ``(x1, x2, x1dot, x2dot, W, t, w)`` from the state scales (scalars
+    or arrays): positions by the Hertz indentation, velocities by the impact speed, the work by
+    the impact energy, the time by the contact time and ``w = sqrt(|delta|)`` (the position of a
+    regularised contact phase) by the square root of the indentation."""
+    columns = np.broadcast_arrays(indentation, indentation, v, v, 0.5 * np.asarray(M1) * np.asarray(v) ** 2,
+                                  contact_time, np.sqrt(indentation))
+    return rtol * np.stack(columns, axis=-1)
+
+
 def _atol(params: Parameters, rtol: float, atol) -> np.ndarray:
-    """Absolute tolerances from the state scales: positions by the Hertz indentation,
-    velocities by the impact speed, the work by the impact energy."""
+    """The driver's absolute tolerances: ``atol`` for every component, or from the case's scales."""
     if atol is not None:
-        return np.full(5, check_real("atol", atol, "a number > 0", lambda x: x > 0))
-    s = params.hertz_indentation
-    return rtol * np.array([s, s, params.v, params.v, 0.5 * params.M1 * params.v**2])
+        return np.full(7, check_real("atol", atol, "a number > 0", lambda x: x > 0))
+    return state_tolerances(rtol, params.hertz_indentation, params.v, params.M1, scales(params).contact_time)
 
 
 @functools.lru_cache(maxsize=1024)
@@ -211,7 +223,7 @@ def simulate(params: Parameters, law: ContactLaw | str = "paper", t_end: float |
 @dataclass(frozen=True)
 class Batch:
     """Packed inputs of many runs of one law: coefficients (n, 9), initial states (n, 5),
-    horizons, absolute tolerances (n, 5) and step caps (n,)."""
+    horizons, absolute tolerances (n, 7, see :func:`state_tolerances`) and step caps (n,)."""
 
     law: ContactLaw
     C: np.ndarray
@@ -234,7 +246,7 @@ def pack_batch(params_seq, law: ContactLaw, t_end, rtol: float, initial=None) ->
     C = np.empty((n, 9))
     Y0 = np.empty((n, 5))
     T = np.empty(n)
-    A = np.empty((n, 5))
+    A = np.empty((n, 7))
     S = np.empty(n)
     for i, p in enumerate(params_seq):
         s = scales(p)

@@ -15,7 +15,7 @@ import numba
 import numpy as np
 from scipy.integrate._ivp import dop853_coefficients as _tableau
 
-from ..model.rhs import rhs
+from ..model.rhs import rhs_integration
 from ._dop853_stages import dense_coefficients, error_norm, step  # noqa: F401  (the step's API)
 
 N_STAGES = _tableau.N_STAGES  # 12
@@ -25,6 +25,7 @@ C = np.ascontiguousarray(_tableau.C, dtype=np.float64)
 E3 = np.ascontiguousarray(_tableau.E3, dtype=np.float64)
 E5 = np.ascontiguousarray(_tableau.E5, dtype=np.float64)
 D = np.ascontiguousarray(_tableau.D, dtype=np.float64)
+N_STATE = 6  # the integration state (see model.rhs.rhs_integration)
 ORDER = 8
 ERROR_EXPONENT = -1.0 / 8.0  # error estimator of order 7
 SAFETY, MIN_FACTOR, MAX_FACTOR = 0.9, 0.2, 10.0
@@ -34,7 +35,7 @@ SAFETY, MIN_FACTOR, MAX_FACTOR = 0.9, 0.2, 10.0
 def dense_eval(F, y, t_old, h, t, out):
     """State at ``t`` on the interpolant ``F`` of the step ``[t_old, t_old + h]`` from ``y``."""
     x = (t - t_old) / h if h != 0 else 0.0
-    for j in range(5):
+    for j in range(N_STATE):
         acc = 0.0
         for i in range(6, -1, -1):
             acc += F[i, j]
@@ -43,26 +44,26 @@ def dense_eval(F, y, t_old, h, t, out):
 
 
 @numba.njit(cache=True)
-def initial_step(code, c, mode, y, f, rtol, atol, interval, max_step, tmp, f1):
+def initial_step(code, c, mode, side, y, f, rtol, atol, interval, max_step, tmp, f1):
     """scipy's ``select_initial_step`` (Hairer, Norsett & Wanner, II.4), one extra evaluation."""
     d0 = 0.0
     d1 = 0.0
-    for j in range(5):
+    for j in range(N_STATE):
         scale = atol[j] + abs(y[j]) * rtol
         d0 += (y[j] / scale) ** 2
         d1 += (f[j] / scale) ** 2
-    d0 = math.sqrt(d0 / 5.0)
-    d1 = math.sqrt(d1 / 5.0)
+    d0 = math.sqrt(d0 / N_STATE)
+    d1 = math.sqrt(d1 / N_STATE)
     h0 = 1e-6 * interval if (d0 < 1e-5 or d1 < 1e-5) else 0.01 * d0 / d1
     h0 = min(h0, interval)
-    for j in range(5):
+    for j in range(N_STATE):
         tmp[j] = y[j] + h0 * f[j]
-    rhs(code, c, tmp, mode, f1)
+    rhs_integration(code, c, tmp, mode, side, f1)
     d2 = 0.0
-    for j in range(5):
+    for j in range(N_STATE):
         scale = atol[j] + abs(y[j]) * rtol
         d2 += ((f1[j] - f[j]) / scale) ** 2
-    d2 = math.sqrt(d2 / 5.0) / h0
+    d2 = math.sqrt(d2 / N_STATE) / h0
     if d1 <= 1e-15 and d2 <= 1e-15:
         h1 = max(1e-6 * interval, h0 * 1e-3)
     else:

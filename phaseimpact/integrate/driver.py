@@ -20,8 +20,9 @@ import numba
 import numpy as np
 
 from ..model.laws import PLAIN, STUCK
-from ..model.rhs import V1, V2, WORK, X1, X2, energy, rhs, stick_margin
+from ..model.rhs import V1, V2, WORK, X1, X2, contact_side, energy, rhs, rhs_integration, stick_margin
 from . import dop853
+from .dop853 import N_STATE
 from .events import (
     CONTACT,
     DELTA,
@@ -65,6 +66,8 @@ SAVE_SUMMARY, SAVE_STEPS, SAVE_TIMES = range(3)
  S_FIRST_STICK_MARGIN, S_FIRST_STICK_T, S_NSTEPS, S_NFEV, S_MODE) = range(19)
 N_SUMMARY = 19
 
+TIME = 5  # the physical time in the integration state u
+TIME_COLUMN = N_EVENTS  # a pseudo event column: the physical time minus a target
 #: Smallest step reduction after a rejection when the observed order is used (else MIN_FACTOR).
 OBSERVED_MIN_FACTOR = 0.01
 _TINY = np.finfo(np.float64).tiny
@@ -113,16 +116,60 @@ def _push_sample(s_t, s_y, s_mode, s_force, n, t, y, mode, force):
 
 
 @numba.njit(cache=True)
-def _event_at(code, c, mode, energy_limit, column, F, y0, t0, h, s, ys, fs, gs):
-    """Event function ``column`` at time ``s`` on the dense output of the step."""
-    dop853.dense_eval(F, y0, t0, h, s, ys)
-    force = rhs(code, c, ys, mode, fs)
-    event_values(code, c, ys, fs, force, mode, energy_limit, gs)
+def _regularised(side):
+    """A contact phase integrated in w = sqrt(|delta|) and dt = w ds (side +-1)."""
+    return side == 1 or side == -1
+
+
+@numba.njit(cache=True)
+def _physical(code, c, mode, side, u, y, f):
+    """Physical state ``y`` and ``dy/dt`` (``f``) at the integration state ``u``; returns the force."""
+    y[X1] = u[X1] if not _regularised(side) else u[X2] + side * u[0] * u[0]
+    for j in range(1, 5):
+        y[j] = u[j]
+    return rhs(code, c, y, mode, f)
+
+
+@numba.njit(cache=True)
+def _integration_state(side, y, t, u):
+    """The integration state of a phase on ``side`` (see :func:`~phaseimpact.model.rhs.rhs_integration`)."""
+    u[X1] = y[X1] if not _regularised(side) else math.sqrt(abs(y[X1] - y[X2]))
+    for j in range(1, 5):
+        u[j] = y[j]
+    u[TIME] = t
+
+
+@numba.njit(cache=True)
+def _phase_tolerances(side, atol, out):
+    """Absolute tolerances of the integration state: ``atol`` is (x1, x2, v1, v2, W, t, w)."""
+    out[0] = atol[0] if not _regularised(side) else atol[6]
+    for j in range(1, 6):
+        out[j] = atol[j]
+
+
+@numba.njit(cache=True)
+def _events(code, c, mode, side, energy_limit, u, y, f, force, g):
+    """Event values at ``u`` (physical ``y``, ``f``, ``force``) into ``g``."""
+    event_values(code, c, y, f, force, mode, energy_limit, g)
+    if _regularised(side):
+        g[DELTA] = side * u[0]  # delta = side w^2 keeps its sign through its root; w changes sign there
+
+
+@numba.njit(cache=True)
+def _event_at(code, c, mode, side, energy_limit, target, column, F, u0, s0, h, s, us, ys, fs, gs):
+    """Event function ``column`` at ``s`` on the dense output of the step; the pseudo column
+    ``TIME_COLUMN`` is the physical time minus ``target`` (horizon and output times of a
+    regularised phase, where ``t`` is a component of the state)."""
+    dop853.dense_eval(F, u0, s0, h, s, us)
+    if column == TIME_COLUMN:
+        return us[TIME] - target
+    force = _physical(code, c, mode, side, us, ys, fs)
+    _events(code, c, mode, side, energy_limit, us, ys, fs, force, gs)
     return gs[column]
 
 
 @numba.njit(cache=True)
-def _brent(code, c, mode, energy_limit, column, F, y0, t0, h, xa, xb, fa, fb, ys, fs, gs):
+def _brent(code, c, mode, side, energy_limit, target, column, F, u0, s0, h, xa, xb, fa, fb, us, ys, fs, gs):
     """Zero of event ``column`` in ``[xa, xb]`` (signs of ``fa``, ``fb`` differ): scipy's brentq."""
     xpre, xcur, fpre, fcur = xa, xb, fa, fb
     xblk = fblk = spre = scur = 0.0
@@ -153,13 +200,13 @@ def _brent(code, c, mode, energy_limit, column, F, y0, t0, h, xa, xb, fa, fb, ys
             spre = scur = sbis
         xpre, fpre = xcur, fcur
         xcur += scur if abs(scur) > tol else (tol if sbis > 0 else -tol)
-        fcur = _event_at(code, c, mode, energy_limit, column, F, y0, t0, h, xcur, ys, fs, gs)
+        fcur = _event_at(code, c, mode, side, energy_limit, target, column, F, u0, s0, h, xcur, us, ys, fs, gs)
     return xcur
 
 
 @numba.njit(cache=True)
-def _locate(code, c, mode, energy_limit, column, F, y0, t0, h, t1, g_start, g_end, ys, fs, gs):
-    """Time of the first zero of event ``column`` in ``[t0, t1]`` on the dense output.
+def _locate(code, c, mode, side, energy_limit, column, F, u0, s0, h, s1, g_start, g_end, us, ys, fs, gs):
+    """The first zero of event ``column`` in ``[s0, s1]`` on the dense output.
 
     A run that restarts on this event's zero (``g_start`` a signed tiny number) may leave it
     and come back within one step, as a brief slip does near a grazing stick break: the dense
@@ -167,28 +214,44 @@ def _locate(code, c, mode, energy_limit, column, F, y0, t0, h, t1, g_start, g_en
     bracketed from there.
     """
     expected = 1.0 if g_start > 0 else -1.0
-    a, ga, b, gb = t0, g_start, t1, g_end
-    g0 = _event_at(code, c, mode, energy_limit, column, F, y0, t0, h, t0, ys, fs, gs)
+    a, ga, b, gb = s0, g_start, s1, g_end
+    g0 = _event_at(code, c, mode, side, energy_limit, 0.0, column, F, u0, s0, h, s0, us, ys, fs, gs)
     if g0 * expected <= 0:
         found_away = False
-        prev = t0
+        prev = s0
         for i in range(1, 33):
-            s = t0 + (t1 - t0) * i / 32.0
-            gv = _event_at(code, c, mode, energy_limit, column, F, y0, t0, h, s, ys, fs, gs)
+            s = s0 + (s1 - s0) * i / 32.0
+            gv = _event_at(code, c, mode, side, energy_limit, 0.0, column, F, u0, s0, h, s, us, ys, fs, gs)
             if not found_away:
                 if gv * expected > 0:
                     found_away = True
                     a, ga = s, gv
             elif gv * expected <= 0:
                 a, b, gb = prev, s, gv
-                ga = _event_at(code, c, mode, energy_limit, column, F, y0, t0, h, a, ys, fs, gs)
+                ga = _event_at(code, c, mode, side, energy_limit, 0.0, column, F, u0, s0, h, a, us, ys, fs, gs)
                 break
             prev = s
         if not found_away:
             return -math.inf  # the excursion is below what the step resolves: the caller shrinks it
     if gb == 0 or ga * gb > 0:
         return b
-    return _brent(code, c, mode, energy_limit, column, F, y0, t0, h, a, b, ga, gb, ys, fs, gs)
+    return _brent(code, c, mode, side, energy_limit, 0.0, column, F, u0, s0, h, a, b, ga, gb, us, ys, fs, gs)
+
+
+@numba.njit(cache=True)
+def _s_at_time(code, c, mode, side, F, u0, s0, h, time, us, ys, fs, gs):
+    """Where on the step the physical time is ``time`` (it lies within the step): ``s`` itself in
+    a plain phase, a root of ``t(s)`` on the dense output in a regularised one."""
+    if not _regularised(side):
+        return time
+    s1 = s0 + h
+    fa = u0[TIME] - time
+    if fa >= 0:
+        return s0
+    fb = _event_at(code, c, mode, side, 0.0, time, TIME_COLUMN, F, u0, s0, h, s1, us, ys, fs, gs)
+    if fb <= 0:
+        return s1
+    return _brent(code, c, mode, side, 0.0, time, TIME_COLUMN, F, u0, s0, h, s0, s1, fa, fb, us, ys, fs, gs)
 
 
 _ADV_END, _ADV_STEP, _ADV_COLLAPSE, _ADV_LIMIT = range(4)
@@ -209,35 +272,37 @@ def _quiet_start(quiet, y, mode, g):
 
 
 @numba.njit(cache=True)
-def _advance(code, c, mode, t, t_end, y, f, force, h_abs, rtol, atol, max_step, energy_limit, next_sample,
-             steps_left, g_old, g_new, fired, K, y_new, f_new, tmp, stats):
-    """Take DOP853 steps from ``(t, y)`` while nothing happens: no event crosses and no sample
-    falls inside. Accepted steps update ``y, f, g_old`` and the running extremes ``stats``.
+def _advance(code, c, mode, side, s, t_end, u, fu, y, f, force, h_abs, rtol, atol, max_step, w_floor, energy_limit,
+             next_sample, steps_left, g_old, g_new, fired, K, u_new, fu_new, y_new, f_new, tmp, stats):
+    """Take DOP853 steps in ``s`` from ``(s, u)`` while nothing happens: no event crosses, no
+    sample and (regularised phase) not the horizon falls inside. Accepted steps update ``u, fu,
+    y, f, g_old`` and the running extremes ``stats``.
 
-    Returns ``(result, t, h, h_abs, h_next, force, force_new, steps, evaluations)``: ``_ADV_STEP``
-    leaves the last step (``h``, ``y_new``, ``f_new``, ``g_new``, ``fired``) for the caller to look
-    at; ``_ADV_END`` means ``t_end`` was reached. The hot loop is kept small on purpose: the
-    compiler optimises it as a whole.
+    Returns ``(result, s, h, h_abs, h_next, force, force_new, steps, evaluations)``: ``_ADV_STEP``
+    leaves the last step (``h``, ``u_new``, ``fu_new``, ``y_new``, ``f_new``, ``g_new``, ``fired``)
+    for the caller to look at; ``_ADV_END`` means ``t_end`` was reached. The hot loop is kept small
+    on purpose: the compiler optimises it as a whole.
     """
     steps = 0
     evaluations = 0
     h = 0.0
     h_next = h_abs
     force_new = force
-    while t < t_end:
+    while u[TIME] < t_end:
         if steps >= steps_left:
-            return _ADV_LIMIT, t, h, h_abs, h_next, force, force_new, steps, evaluations
-        h_abs = min(h_abs, max_step)
+            return _ADV_LIMIT, s, h, h_abs, h_next, force, force_new, steps, evaluations
+        # a regularised phase advances the time by w ds: its cap on the time step is one on s
+        h_abs = min(h_abs, max_step if not _regularised(side) else max_step / max(abs(u[0]), w_floor))
         rejected = False
         h_rejected = err_rejected = 0.0
         while True:
-            if h_abs < 10.0 * (np.nextafter(t, np.inf) - t):
-                return _ADV_COLLAPSE, t, h, h_abs, h_next, force, force_new, steps, evaluations
-            t_new = min(t + h_abs, t_end)
-            h = t_new - t
-            force_new = dop853.step(code, c, mode, y, f, h, K, y_new, f_new, tmp)
+            if h_abs < 10.0 * (np.nextafter(s, np.inf) - s):
+                return _ADV_COLLAPSE, s, h, h_abs, h_next, force, force_new, steps, evaluations
+            s_new = min(s + h_abs, t_end) if not _regularised(side) else s + h_abs  # a plain phase ends on the horizon
+            h = s_new - s
+            force_new = dop853.step(code, c, mode, side, u, fu, h, K, u_new, fu_new, tmp)
             evaluations += 12
-            err = dop853.error_norm(K, h, y, y_new, rtol, atol)
+            err = dop853.error_norm(K, h, u, u_new, rtol, atol)
             if err < 1.0:
                 factor = dop853.MAX_FACTOR if err == 0 else min(dop853.MAX_FACTOR,
                                                                dop853.SAFETY * err**dop853.ERROR_EXPONENT)
@@ -257,24 +322,42 @@ def _advance(code, c, mode, t, t_end, y, f, force, h_abs, rtol, atol, max_step, 
             h_abs = h * factor
             rejected = True
         steps += 1
-        event_values(code, c, y_new, f_new, force_new, mode, energy_limit, g_new)
+        if not _regularised(side):
+            u_new[TIME] = s_new  # t' = 1: the time is s itself, without the sum's rounding
+            for j in range(5):
+                y_new[j] = u_new[j]
+                f_new[j] = fu_new[j]
+        else:
+            force_new = _physical(code, c, mode, side, u_new, y_new, f_new)
+            evaluations += 1
+        _events(code, c, mode, side, energy_limit, u_new, y_new, f_new, force_new, g_new)
         any_fired = False
         for col in range(N_EVENTS):
             fired[col] = crossed(col, g_old, g_new)
             any_fired = any_fired or fired[col]
-        if any_fired or t + h >= next_sample:
-            return _ADV_STEP, t, h, h_abs, h_next, force, force_new, steps, evaluations
-        t = t + h
-        for j in range(5):
-            y[j] = y_new[j]
-            f[j] = f_new[j]
-        for col in range(N_EVENTS):
-            g_old[col] = g_new[col]
+        if any_fired or u_new[TIME] >= next_sample or (_regularised(side) and u_new[TIME] >= t_end):
+            return _ADV_STEP, s, h, h_abs, h_next, force, force_new, steps, evaluations
+        s = s_new
+        _copy(u_new, u, N_STATE)
+        _copy(fu_new, fu, N_STATE)
+        _copy(y_new, y, 5)
+        _copy(f_new, f, 5)
+        _copy(g_new, g_old, N_EVENTS)
         force = force_new
         h_abs = h_next
         stats[0] = max(stats[0], force)
         stats[1] = max(stats[1], y[X1] - y[X2])
-    return _ADV_END, t, h, h_abs, h_next, force, force_new, steps, evaluations
+    return _ADV_END, s, h, h_abs, h_next, force, force_new, steps, evaluations
+
+
+@numba.njit(cache=True)
+def _phase_step(code, c, mode, side, u, fu, rtol, atol, t_end, max_step, w_floor, tmp, f1):
+    """Initial step of a phase (scipy's rule), in its own independent variable."""
+    interval = t_end - u[TIME]
+    if _regularised(side):
+        interval /= max(abs(u[0]), w_floor)
+    return dop853.initial_step(code, c, mode, side, u, fu, rtol, atol, interval,
+                               max_step if not _regularised(side) else max_step / max(abs(u[0]), w_floor), tmp, f1)
 
 
 @numba.njit(cache=True)
@@ -332,8 +415,6 @@ def run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count,
 
     status = SUCCESS
     reason = HORIZON
-    K = np.empty((16, 5))
-    F = np.empty((7, 5))
     tmp = np.empty(5)
     y_new = np.empty(5)
     f_new = np.empty(5)
@@ -403,25 +484,45 @@ def run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count,
                 s_t[:n_s], s_y[:n_s], s_mode[:n_s], s_force[:n_s], y)
 
     # ---- adaptive DOP853 with events ----
-    # integer constants passed to compiled callees go as np.int64: a literal argument would compile
-    # a second copy of the callee (and of everything it calls) specialised on that value
+    # Plain phases integrate u = (x1, x2, v1, v2, W, t) in s = t; regularised contact phases
+    # (side = +-1) integrate u = (w, x2, v1, v2, W, t) in s with dt = w ds (model.rhs.rhs_integration).
+    # Integer constants passed to compiled callees go as np.int64: a literal argument would compile
+    # a second copy of the callee (and of everything it calls) specialised on that value.
+    u = np.empty(N_STATE)
+    fu = np.empty(N_STATE)
+    u_new = np.empty(N_STATE)
+    fu_new = np.empty(N_STATE)
+    u_r = np.empty(N_STATE)
+    fu_r = np.empty(N_STATE)
+    us = np.empty(N_STATE)
+    tmp6 = np.empty(N_STATE)
+    atol_u = np.empty(N_STATE)
+    K6 = np.empty((16, N_STATE))
+    F6 = np.empty((7, N_STATE))
+    w_floor = atol[6] / rtol  # the scale of w = sqrt(|delta|)
+    side = contact_side(code, c, y, mode)
+    _integration_state(side, y, 0.0, u)
+    _phase_tolerances(side, atol, atol_u)
+    s = 0.0
+    rhs_integration(code, c, u, mode, side, fu)
+    nfev += 1
     quiet = np.int64(DELTA)
-    event_values(code, c, y, f, force, mode, energy_limit, g_old)
+    _events(code, c, mode, side, energy_limit, u, y, f, force, g_old)
     _quiet_start(quiet, y, mode, g_old)
-    h_abs = dop853.initial_step(code, c, mode, y, f, rtol, atol, t_end, max_step, tmp, f_new)
+    h_abs = _phase_step(code, c, mode, side, u, fu, rtol, atol_u, t_end, max_step, w_floor, tmp6, fu_new)
     nfev += 1
 
     stats = np.empty(2)
-    while t < t_end:
+    while u[TIME] < t_end:
         if nsteps >= max_steps or n_ev >= max_events:
             status, reason = TOO_MANY_STEPS, FAILED_STOP
             break
-        next_sample = t if save_kind == SAVE_STEPS else (
+        next_sample = u[TIME] if save_kind == SAVE_STEPS else (
             times[i_time] if save_kind == SAVE_TIMES and i_time < times.shape[0] else math.inf)
         stats[0], stats[1] = max_force, max_indentation
-        result, t, h, h_abs, h_next, force, force_new, d_steps, d_fev = _advance(
-            code, c, mode, t, t_end, y, f, force, h_abs, rtol, atol, max_step, energy_limit, next_sample,
-            max_steps - nsteps, g_old, g_new, fired, K, y_new, f_new, tmp, stats)
+        result, s, h, h_abs, h_next, force, force_new, d_steps, d_fev = _advance(
+            code, c, mode, side, s, t_end, u, fu, y, f, force, h_abs, rtol, atol_u, max_step, w_floor, energy_limit,
+            next_sample, max_steps - nsteps, g_old, g_new, fired, K6, u_new, fu_new, y_new, f_new, tmp6, stats)
         max_force, max_indentation = stats[0], stats[1]
         nsteps += d_steps
         nfev += d_fev
@@ -433,60 +534,71 @@ def run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count,
         if result == _ADV_LIMIT:
             status, reason = TOO_MANY_STEPS, FAILED_STOP
             break
-        # a step to look at (an event fired in it, or a sample falls in it); not accepted yet
-        t_new = t + h
+        # a step to look at (an event fired in it, a sample or the horizon falls in it); not accepted yet
+        s_new = s + h
         any_fired = False
         for col in range(N_EVENTS):
             any_fired = any_fired or fired[col]
         have_dense = False
         stop_record = -1.0
         restart_col = np.int64(-1)
-        t_restart = math.inf
-        if any_fired:
-            dop853.dense_coefficients(code, c, mode, y, f, y_new, f_new, h, K, F, tmp)
+        s_restart = math.inf
+        s_horizon = math.inf
+        if _regularised(side) and u_new[TIME] >= t_end:
+            dop853.dense_coefficients(code, c, mode, side, u, fu, u_new, fu_new, h, K6, F6, tmp6)
             nfev += 3
             have_dense = True
+            s_horizon = _s_at_time(code, c, mode, side, F6, u, s, h, t_end, us, ys, fs, gs)
+        if any_fired:
+            if not have_dense:
+                dop853.dense_coefficients(code, c, mode, side, u, fu, u_new, fu_new, h, K6, F6, tmp6)
+                nfev += 3
+                have_dense = True
             unresolved = False
             for col in range(N_EVENTS):
                 if fired[col]:
-                    roots[col] = _locate(code, c, mode, energy_limit, col, F, y, t, h, t_new, g_old[col],
-                                         g_new[col], ys, fs, gs)
+                    roots[col] = _locate(code, c, mode, side, energy_limit, col, F6, u, s, h, s_new, g_old[col],
+                                         g_new[col], us, ys, fs, gs)
                     if roots[col] == -math.inf:
-                        if h > 1e3 * (np.nextafter(t, np.inf) - t):
+                        if h > 1e3 * (np.nextafter(s, np.inf) - s):
                             unresolved = True
                         else:  # nothing smaller to try: the excursion did not happen
                             fired[col] = False
+                    elif roots[col] > s_horizon:
+                        fired[col] = False  # after the horizon
             if unresolved:
                 h_abs = h / 32.0  # an event left and re-crossed zero inside the step: resolve it
                 continue
             if fired[DELTADOT] and not fired[DELTA]:
                 # an extreme of delta inside the step on the other side of zero: a contact (or
                 # separation) and its return both fell inside the step
-                d_ext = _event_at(code, c, mode, energy_limit, np.int64(DELTA), F, y, t, h, roots[DELTADOT], ys, fs, gs)
+                d_ext = _event_at(code, c, mode, side, energy_limit, 0.0, np.int64(DELTA), F6, u, s, h,
+                                  roots[DELTADOT], us, ys, fs, gs)
                 if d_ext * g_old[DELTA] < 0:
                     fired[DELTA] = True
-                    roots[DELTA] = _brent(code, c, mode, energy_limit, np.int64(DELTA), F, y, t, h, t, roots[DELTADOT],
-                                          g_old[DELTA], d_ext, ys, fs, gs)
+                    roots[DELTA] = _brent(code, c, mode, side, energy_limit, 0.0, np.int64(DELTA), F6, u, s, h, s,
+                                          roots[DELTADOT], g_old[DELTA], d_ext, us, ys, fs, gs)
             for col in range(N_EVENTS):
-                if fired[col] and (restarts(code, col, mode, settle) or col == ENERGY) and roots[col] < t_restart:
-                    restart_col, t_restart = col, roots[col]
+                if fired[col] and (restarts(code, col, mode, settle) or col == ENERGY) and roots[col] < s_restart:
+                    restart_col, s_restart = col, roots[col]
             # recorded events before the restart, in time order
             while True:
                 best = np.int64(-1)
                 for col in range(N_EVENTS):
                     if fired[col] and not (restarts(code, col, mode, settle) or col == ENERGY) \
-                            and roots[col] <= t_restart and (best < 0 or roots[col] < roots[best]):
+                            and roots[col] <= s_restart and (best < 0 or roots[col] < roots[best]):
                         best = col
                 if best < 0:
                     break
                 fired[best] = False
-                _event_at(code, c, mode, energy_limit, best, F, y, t, h, roots[best], ys, fs, gs)
-                f_ev = rhs(code, c, ys, mode, fs)
+                _event_at(code, c, mode, side, energy_limit, 0.0, best, F6, u, s, h, roots[best], us, ys, fs, gs)
+                f_ev = _physical(code, c, mode, side, us, ys, fs)
                 kind = FORCE_PEAK if best == FORCE_RATE else REVERSAL
                 if best == REACH:
                     kind = SETTLED  # recorded only: the run goes on
+                t_ev = us[TIME] if _regularised(side) else roots[best]
                 ev_t, ev_kind, ev_mode, ev_y, ev_force, n_ev = _push_event(
-                    ev_t, ev_kind, ev_mode, ev_y, ev_force, n_ev, roots[best], kind, mode, ys, f_ev)
+                    ev_t, ev_kind, ev_mode, ev_y, ev_force, n_ev, t_ev, kind, mode, ys, f_ev)
                 counts[kind] += 1
                 max_force = max(max_force, f_ev)
                 max_indentation = max(max_indentation, ys[X1] - ys[X2])
@@ -495,43 +607,76 @@ def run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count,
                     break
         if stop_record >= 0:
             # stopped at a recorded event: the state there from a fresh step that ends at it
-            if stop_record > t:
-                dop853.step(code, c, mode, y, f, stop_record - t, K, y_r, f_r, tmp)
+            if stop_record > s:
+                dop853.step(code, c, mode, side, u, fu, stop_record - s, K6, u_r, fu_r, tmp6)
                 nfev += 12
-                _copy(y_r, y, 5)
-                t = stop_record
+                _copy(u_r, u, N_STATE)
+                if not _regularised(side):
+                    u[TIME] = stop_record
+            force = _physical(code, c, mode, side, u, y, f)
             reason = ASKED_STOP
             break
-        t_seg = t_restart if restart_col >= 0 else t_new
         if save_kind == SAVE_TIMES:
+            # samples up to where this step's motion stands: its end, the restart or the horizon
+            t_seg = u_new[TIME]
+            if restart_col >= 0:
+                dop853.dense_eval(F6, u, s, h, s_restart, us)
+                t_seg = s_restart if not _regularised(side) else us[TIME]
+            elif s_horizon < math.inf:
+                t_seg = t_end
             while i_time < times.shape[0] and times[i_time] <= t_seg:
                 if not have_dense:
-                    dop853.dense_coefficients(code, c, mode, y, f, y_new, f_new, h, K, F, tmp)
+                    dop853.dense_coefficients(code, c, mode, side, u, fu, u_new, fu_new, h, K6, F6, tmp6)
                     nfev += 3
                     have_dense = True
-                dop853.dense_eval(F, y, t, h, times[i_time], ys)
+                dop853.dense_eval(F6, u, s, h, _s_at_time(code, c, mode, side, F6, u, s, h, times[i_time], us, ys,
+                                                          fs, gs), us)
+                f_i = _physical(code, c, mode, side, us, ys, fs)
                 s_t, s_y, s_mode, s_force, n_s = _push_sample(s_t, s_y, s_mode, s_force, n_s, times[i_time], ys,
-                                                              mode, rhs(code, c, ys, mode, fs))
+                                                              mode, f_i)
                 i_time += 1
+        if restart_col < 0 and s_horizon < math.inf:
+            # a regularised phase reaches the horizon inside the step: the state there from a fresh step
+            dop853.step(code, c, mode, side, u, fu, s_horizon - s, K6, u_r, fu_r, tmp6)
+            nfev += 12
+            _copy(u_r, u, N_STATE)
+            u[TIME] = t_end  # without the root finder's residue
+            force = _physical(code, c, mode, side, u, y, f)
+            max_force = max(max_force, force)
+            max_indentation = max(max_indentation, y[X1] - y[X2])
+            if save_kind == SAVE_STEPS:
+                s_t, s_y, s_mode, s_force, n_s = _push_sample(s_t, s_y, s_mode, s_force, n_s, t_end, y, mode, force)
+            break
         if restart_col >= 0:
-            # the state at the root from a fresh step that ends there (|delta|^alpha is only C^1
-            # at delta = 0, and the stages beyond the root spoil the interpolant there)
-            h_r = t_restart - t
+            # the state at the root from a fresh step that ends there (the stages beyond the root
+            # belong to the continuation, not to the motion)
+            h_r = s_restart - s
             if h_r > 0:
-                dop853.step(code, c, mode, y, f, h_r, K, y_r, f_r, tmp)
+                dop853.step(code, c, mode, side, u, fu, h_r, K6, u_r, fu_r, tmp6)
                 nfev += 12
             else:
-                _copy(y, y_r, 5)
+                _copy(u, u_r, N_STATE)
+            t = s_restart if not _regularised(side) else u_r[TIME]
+            _physical(code, c, mode, side, u_r, y_r, f_r)
             kind, mode, action = transition(code, c, restart_col, y_r, mode, settle)
-            t = t_restart
             _copy(y_r, y, 5)
             force = rhs(code, c, y, mode, f)
-            nfev += 1
+            new_side = contact_side(code, c, y, mode)
+            _integration_state(new_side, y, t, u)
+            s = t if not _regularised(new_side) else 0.0
+            rhs_integration(code, c, u, mode, new_side, fu)
+            nfev += 2
+            if new_side != side:  # the independent variable changes: a fresh initial step
+                side = new_side
+                _phase_tolerances(side, atol, atol_u)
+                h_abs = _phase_step(code, c, mode, side, u, fu, rtol, atol_u, t_end, max_step, w_floor, tmp6, fu_new)
+                nfev += 1
+            else:
+                h_abs = max(h_next, h_r)
             if kind == SILENT:  # a restart only (the pair at its centre): nothing to log
                 quiet = restart_col
-                event_values(code, c, y, f, force, mode, energy_limit, g_old)
+                _events(code, c, mode, side, energy_limit, u, y, f, force, g_old)
                 _quiet_start(quiet, y, mode, g_old)
-                h_abs = max(h_next, h_r)
                 continue
             ev_t, ev_kind, ev_mode, ev_y, ev_force, n_ev = _push_event(
                 ev_t, ev_kind, ev_mode, ev_y, ev_force, n_ev, t, kind, mode, y, force)
@@ -551,24 +696,25 @@ def run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count,
                 reason = ASKED_STOP
                 break
             quiet = restart_col
-            event_values(code, c, y, f, force, mode, energy_limit, g_old)
+            _events(code, c, mode, side, energy_limit, u, y, f, force, g_old)
             _quiet_start(quiet, y, mode, g_old)
-            h_abs = max(h_next, h_r)
             continue
         # the whole step stands
-        t = t_new
-        for j in range(5):
-            y[j] = y_new[j]
-            f[j] = f_new[j]
+        s = s_new
+        _copy(u_new, u, N_STATE)
+        _copy(fu_new, fu, N_STATE)
+        _copy(y_new, y, 5)
+        _copy(f_new, f, 5)
         force = force_new
-        for col in range(N_EVENTS):
-            g_old[col] = g_new[col]
+        _copy(g_new, g_old, N_EVENTS)
         h_abs = h_next
         max_force = max(max_force, force)
         max_indentation = max(max_indentation, y[X1] - y[X2])
         if save_kind == SAVE_STEPS:
-            s_t, s_y, s_mode, s_force, n_s = _push_sample(s_t, s_y, s_mode, s_force, n_s, t, y,
+            s_t, s_y, s_mode, s_force, n_s = _push_sample(s_t, s_y, s_mode, s_force, n_s, u[TIME], y,
                                                             mode, force)
+
+    t = u[TIME]
 
     summary = _summarize(code, c, y0, y, mode, status, reason, t, max_force, max_indentation, counts,
                          n_ev, ev_t, ev_kind, ev_y, nsteps, nfev)

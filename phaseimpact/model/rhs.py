@@ -21,11 +21,12 @@ import numba
 import numpy as np
 
 from ..parameters import Parameters
-from .laws import STUCK, ContactLaw, as_law, contact_force, contact_potential, force_partials, hertz_power
+from .laws import PLAIN, STUCK, ContactLaw, as_law, contact_force, contact_potential, force_partials, hertz_power
 
 __all__ = [
     "X1", "X2", "V1", "V2", "WORK", "pack", "N_COEF",
-    "rhs", "energy", "stick_force", "stick_orbit", "stick_margin", "stick_break_distance",
+    "rhs", "rhs_integration", "contact_side", "PLAIN_PHASE", "FLIGHT", "energy", "stick_force", "stick_orbit",
+    "stick_margin", "stick_break_distance",
     "jacobian", "contact_force_of_states", "energy_of_states", "initial_state",
 ]
 
@@ -74,6 +75,73 @@ def rhs(code, c, y, mode, out):
     out[V1] = -force / c[M1_]
     out[V2] = 0.0 if c[RIGID_] > 0 else (force - spring_force(c, x2)) / c[M2_]
     out[WORK] = force * (v1 - v2)
+    return force
+
+
+#: Phase kinds of the integration (:func:`contact_side`): plain, free flight, or a regularised
+#: contact on the side +1 / -1 of ``delta``.
+PLAIN_PHASE, FLIGHT = 0, 2
+
+
+@numba.njit(cache=True)
+def contact_side(code, c, y, mode):
+    """How the driver integrates the phase that starts at ``y`` in ``mode``.
+
+    ``+1`` or ``-1`` (the sign of ``delta``, or of ``deltadot`` at ``delta = 0``) while a Hertz
+    power law (``alpha = 3/2``) acts: a regularised contact, where the driver integrates
+    ``u = (w, x2, x1dot, x2dot, W, t)`` with ``delta = side w^2`` in the time ``s`` with
+    ``dt = w ds`` (:func:`rhs_integration`): the ``delta^(3/2)`` singularity at the contact's onset
+    and end, which forces an explicit method into tiny and rejected steps, becomes a polynomial.
+    :data:`FLIGHT` for a unilateral law on the side ``delta < 0``: no force, continued without one
+    past the contact (the contact event ends the phase there). :data:`PLAIN_PHASE` otherwise
+    (stuck, the seed's literal reading, other exponents).
+    """
+    if mode == STUCK or mode == PLAIN:
+        return PLAIN_PHASE
+    delta = y[X1] - y[X2]
+    deltadot = y[V1] - y[V2]
+    side = 1 if delta > 0 else (-1 if delta < 0 else (1 if deltadot > 0 else (-1 if deltadot < 0 else 0)))
+    if side < 0 and contact_force(code, -1.0, 0.0, mode, c[K_], 0.0, c[ALPHA_]) == 0.0:
+        return FLIGHT  # a unilateral law
+    if side == 0 or c[ALPHA_] != 1.5:
+        return PLAIN_PHASE
+    return side
+
+
+@numba.njit(cache=True)
+def rhs_integration(code, c, u, mode, side, out):
+    """Write ``du/ds`` into ``out`` (shape (6,)) for a phase of kind ``side`` (:func:`contact_side`);
+    return the contact force, N.
+
+    Plain and flight phases: ``u = (x1, x2, v1, v2, W, t)`` and ``s = t`` (flight: without a
+    contact force, also past ``delta = 0``). Regularised contact: ``u[0] = w`` with
+    ``delta = side w^2`` and ``dt = w ds``; past ``w = 0`` (where the phase ends on an event) the
+    force continues as an odd function of ``w``, so the equations stay smooth across the root.
+    """
+    if side == PLAIN_PHASE:
+        force = rhs(code, c, u, mode, out)
+        out[5] = 1.0
+        return force
+    x2, v1, v2 = u[X2], u[V1], u[V2]
+    if side == FLIGHT:
+        out[X1] = v1
+        out[X2] = v2
+        out[V1] = 0.0
+        out[V2] = 0.0 if c[RIGID_] > 0 else -spring_force(c, x2) / c[M2_]
+        out[WORK] = 0.0
+        out[5] = 1.0
+        return 0.0
+    w = u[0]
+    deltadot = v1 - v2
+    force = contact_force(code, side * w * w, deltadot, mode, c[K_], c[DAMP_], c[ALPHA_])
+    if w < 0:
+        force = -force
+    out[0] = 0.5 * side * deltadot
+    out[X2] = w * v2
+    out[V1] = -w * force / c[M1_]
+    out[V2] = 0.0 if c[RIGID_] > 0 else w * (force - spring_force(c, x2)) / c[M2_]
+    out[WORK] = w * force * deltadot
+    out[5] = w
     return force
 
 
