@@ -42,8 +42,6 @@ from dataclasses import dataclass, field
 from importlib import resources
 from pathlib import Path
 
-from scipy.special import gamma
-
 if sys.version_info >= (3, 11):
     import tomllib
 else:  # pragma: no cover - Python 3.10
@@ -503,7 +501,7 @@ def _tau(alpha: float) -> float:
     ``sqrt(pi) Gamma(7/5) / Gamma(9/10) = 1.4716376...`` (docs/physics.md §4).
     """
     p = alpha + 1.0
-    return math.sqrt(math.pi) * float(gamma(1.0 + 1.0 / p)) / float(gamma(1.0 / p + 0.5))
+    return math.sqrt(math.pi) * math.gamma(1.0 + 1.0 / p) / math.gamma(1.0 / p + 0.5)
 
 
 def hertz_scales(params: Parameters, plate_material: Material | None = None) -> dict:

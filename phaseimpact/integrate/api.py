@@ -11,7 +11,6 @@ from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.special import gamma
 
 from ..model.laws import ContactLaw, as_law
 from ..model.rhs import initial_state, pack
@@ -80,7 +79,7 @@ class Scales:
 
 def hertz_contact_time(alpha: float, indentation, v):
     """Duration of the undamped impact, ``2 tau delta_max / v`` (s; scalars or arrays)."""
-    tau = math.sqrt(math.pi) * gamma(1 + 1 / (alpha + 1)) / gamma(0.5 + 1 / (alpha + 1))  # 1.4716 for Hertz
+    tau = math.sqrt(math.pi) * math.gamma(1 + 1 / (alpha + 1)) / math.gamma(0.5 + 1 / (alpha + 1))  # 1.4716: Hertz
     return 2 * tau * indentation / v
 
 

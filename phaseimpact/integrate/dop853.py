@@ -12,19 +12,10 @@ from __future__ import annotations
 import math
 
 import numba
-import numpy as np
-from scipy.integrate._ivp import dop853_coefficients as _tableau
 
 from ..model.rhs import rhs_integration
 from ._dop853_stages import dense_coefficients, error_norm, step  # noqa: F401  (the step's API)
 
-N_STAGES = _tableau.N_STAGES  # 12
-A = np.ascontiguousarray(_tableau.A, dtype=np.float64)
-B = np.ascontiguousarray(_tableau.B, dtype=np.float64)
-C = np.ascontiguousarray(_tableau.C, dtype=np.float64)
-E3 = np.ascontiguousarray(_tableau.E3, dtype=np.float64)
-E5 = np.ascontiguousarray(_tableau.E5, dtype=np.float64)
-D = np.ascontiguousarray(_tableau.D, dtype=np.float64)
 N_STATE = 6  # the integration state (see model.rhs.rhs_integration)
 ORDER = 8
 ERROR_EXPONENT = -1.0 / 8.0  # error estimator of order 7

@@ -5,8 +5,6 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from scipy.optimize import brentq
-from scipy.special import lambertw
 
 from ..parameters import Parameters, require
 
@@ -23,6 +21,8 @@ def hunt_crossley_restitution(a):
     ``e = (1 + W0(-(1+a) exp(-(1+a)))) / a``. Next to ``a = 0`` the argument of ``W0`` sits on
     its branch point and rounding costs ``eps/a^2``; there the Taylor series is used instead.
     """
+    from scipy.special import lambertw  # here, not at import: scipy.special costs 0.3 s of start-up
+
     a = np.asarray(a, dtype=float)
     safe = np.where(a >= _SERIES_BELOW, a, 1.0)
     w = lambertw(-(1 + safe) * np.exp(-(1 + safe)), 0).real
@@ -39,6 +39,8 @@ def kappa_for_restitution(e: float, params: Parameters) -> float:
     require("restitution", e, "a number with 1e-6 <= e <= 1", math.isfinite(e) and 1e-6 <= e <= 1)
     if e == 1:
         return 0.0
+    from scipy.optimize import brentq  # here, not at import (start-up)
+
     a = brentq(lambda a: float(hunt_crossley_restitution(a)) - e, 1e-12, 1e12,
                xtol=1e-300, rtol=4 * np.finfo(float).eps, maxiter=500)
     return a * params.K / params.v
