@@ -209,3 +209,19 @@ def test_regularised_contact_agrees_with_the_plain_integration(law):
     np.testing.assert_allclose(np.sort(regularised.event_t), np.sort(plain.event_t), rtol=1e-6, atol=1e-13)
     assert regularised.max_force == pytest.approx(plain.max_force, rel=1e-9)
     np.testing.assert_allclose(regularised.final_state, plain.final_state, rtol=1e-7, atol=1e-12)
+
+
+def test_a_horizon_on_an_event_ends_there():
+    """A run whose horizon is exactly the time of the event that changes its phase (found by a
+    first run, as the staircase study does) stops there with a status, not an exception: the
+    phase that would start there has no time left for a first step (it divided by zero)."""
+    from phaseimpact.continuation import critical_damping
+
+    kappa_c = critical_damping(SEED, "paper").kappa_c
+    for eps in (8.545432152652092e-06, 2.080083823051906e-05, 5.0632298444724275e-05, 3e-4):
+        p = SEED.replace(kappa=kappa_c * (1 + eps))
+        first = simulate(p, "paper", rtol=1e-13, atol=1e-22, stop_on=("stick", 2))
+        t0 = first.events_of("slip")[0].t
+        t1 = next(e.t for e in first.events if e.t > t0 and e.kind in ("stick", "reversal"))
+        tr = simulate(p, "paper", t1, rtol=1e-13, atol=1e-22, save=np.linspace(t0, t1, 41)[1:-1])
+        assert tr.ok and tr.t_stop == pytest.approx(t1, rel=1e-12) and len(tr.t) == 39

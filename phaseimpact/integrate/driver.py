@@ -311,7 +311,7 @@ def _advance(code, c, mode, side, s, t_end, u, fu, y, f, force, h_abs, rtol, ato
                 h_next = h * factor
                 break
             factor = max(dop853.MIN_FACTOR, dop853.SAFETY * err**dop853.ERROR_EXPONENT)
-            if rejected and err < err_rejected:
+            if rejected and err < err_rejected and h < h_rejected:
                 # a second rejection at the same point: the error falls with the step more slowly than
                 # the method's order says (delta^alpha at a contact onset goes as h^2.5); shrink by the
                 # observed order instead of rejecting again and again
@@ -354,6 +354,8 @@ def _advance(code, c, mode, side, s, t_end, u, fu, y, f, force, h_abs, rtol, ato
 def _phase_step(code, c, mode, side, u, fu, rtol, atol, t_end, max_step, w_floor, tmp, f1):
     """Initial step of a phase (scipy's rule), in its own independent variable."""
     interval = t_end - u[TIME]
+    if interval <= 0:
+        return 0.0  # the phase starts on the horizon (an event at t_end): no step follows
     if _regularised(side):
         interval /= max(abs(u[0]), w_floor)
     return dop853.initial_step(code, c, mode, side, u, fu, rtol, atol, interval,
