@@ -21,10 +21,11 @@ test: $(STAMP)
 	$(BIN)/ruff check .
 	$(BIN)/python -m pytest -q
 
-# Time stamps in archives come from the last commit (SOURCE_DATE_EPOCH), so regenerating unchanged
-# results leaves git clean; QUICK=1 previews go to figures/preview/ (git-ignored), never over figures/.
+# Time stamps in archives come from the last commit of the code that makes them (SOURCE_DATE_EPOCH),
+# so regenerating unchanged results leaves git clean, also after a commit of the results themselves;
+# QUICK=1 previews go to figures/preview/ (git-ignored), never over figures/.
 reproduce: $(STAMP)
-	SOURCE_DATE_EPOCH=$${SOURCE_DATE_EPOCH:-$$(git log -1 --format=%ct 2>/dev/null)} \
+	SOURCE_DATE_EPOCH=$${SOURCE_DATE_EPOCH:-$$(git log -1 --format=%ct -- phaseimpact studies 2>/dev/null)} \
 		$(BIN)/python studies/run_all.py $(if $(QUICK),--quick) --jobs $(JOBS)
 
 lint: $(STAMP)

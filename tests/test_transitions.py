@@ -40,6 +40,17 @@ def test_kappa_c_against_the_closed_form(v):
     assert found.kappa_c == pytest.approx(closed_form_kappa_c(p), rel=0.0025)
 
 
+@pytest.mark.parametrize("v", [1.0, 13.0])
+def test_kappa_c_at_the_default_tolerance_is_converged(v):
+    """kappa_c with the integrator at its default rtol 1e-10 against rtol 1e-13: with the contact
+    regularised the first stick's state is accurate to 8e-11 (v = 1) and 3e-10 (v = 13) in
+    kappa_c; the plain integration was off by 7e-10 at v = 1."""
+    p = seed_parameters(v=v)
+    default = critical_damping(p, "paper").kappa_c
+    converged = critical_damping(p, "paper", integrator_rtol=1e-13).kappa_c
+    assert default == pytest.approx(converged, rel=5e-10)
+
+
 def test_kappa_c_is_the_root_of_the_margin_and_the_count_changes_there(critical):
     kc = critical.kappa_c
     assert first_stick_margin(SEED.replace(kappa=kc * (1 - 1e-9)), "paper") > 0
