@@ -208,7 +208,10 @@ def test_regularised_contact_agrees_with_the_plain_integration(law):
     assert sorted(regularised.event_kind) == sorted(plain.event_kind)
     np.testing.assert_allclose(np.sort(regularised.event_t), np.sort(plain.event_t), rtol=1e-6, atol=1e-13)
     assert regularised.max_force == pytest.approx(plain.max_force, rel=1e-9)
-    np.testing.assert_allclose(regularised.final_state, plain.final_state, rtol=1e-7, atol=1e-12)
+    np.testing.assert_allclose(regularised.final_state[:4], plain.final_state[:4], rtol=1e-7, atol=1e-12)
+    # the work W is a quadrature outside the step control (as in CVODES): compared on the impact energy
+    impact_energy = 0.5 * p.M1 * p.v**2
+    assert abs(regularised.final_state[4] - plain.final_state[4]) < 1e-9 * impact_energy
 
 
 def test_a_horizon_on_an_event_ends_there():
