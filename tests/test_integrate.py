@@ -228,3 +228,53 @@ def test_a_horizon_on_an_event_ends_there():
         t1 = next(e.t for e in first.events if e.t > t0 and e.kind in ("stick", "reversal"))
         tr = simulate(p, "paper", t1, rtol=1e-13, atol=1e-22, save=np.linspace(t0, t1, 41)[1:-1])
         assert tr.ok and tr.t_stop == pytest.approx(t1, rel=1e-12) and len(tr.t) == 39
+
+
+STIFF_CREEP = seed_parameters(v=6.35, kappa=1.6e14)  # the inward slip creeps, damped at ~5e6 /s
+
+
+def test_a_stiff_creep_goes_on_with_radau_and_matches_the_oracle():
+    """Far above kappa_c the inward slip is a creep held by the damper: DOP853 sits at its
+    stability limit there, Radau IIA takes over. Both agree with scipy's Radau at rtol 1e-13."""
+    ref = oracle(STIFF_CREEP, "paper", rtol=1e-13, method="Radau")
+    stiff = simulate(STIFF_CREEP, "paper")
+    explicit = simulate(STIFF_CREEP, "paper", stiff=False)
+    assert stiff.integrator.startswith("exact[DOP853+Radau5") and explicit.integrator.startswith("exact[DOP853,")
+    assert stiff.nsteps < explicit.nsteps / 3  # 161 against 858 steps
+    for tr in (stiff, explicit):
+        assert [e.kind for e in tr.events] == ref.kinds
+        assert tr.outcome == "ratchet-escape"
+        ref_sticks = [s[0] - s[1] for _, s in ref.of("stick")]
+        np.testing.assert_allclose(tr.stick_points()[1], ref_sticks, rtol=1e-9)
+        # stick breaks are transversal; the stick times end a creep that comes slowly to rest
+        np.testing.assert_allclose(tr.events_of("slip")[-1].t, ref.of("slip")[-1][0], rtol=1e-9)
+        # the anti-damped escape amplifies what came before: 6e-9 at rtol 1e-10 for either method
+        np.testing.assert_allclose(tr.events_of("runaway")[0].t, ref.of("runaway")[0][0], rtol=2e-8)
+
+
+def test_radau_converges_with_the_tolerance():
+    """The second stick depth (the end of the creep, integrated by Radau) approaches the oracle's
+    as rtol falls: the internal tolerance 0.01 rtol^(2/3) delivers about rtol."""
+    ref = [s[0] - s[1] for _, s in oracle(STIFF_CREEP, "paper", rtol=1e-13, method="Radau").of("stick")][1]
+    errors = [abs(simulate(STIFF_CREEP, "paper", rtol=r).stick_points()[1][1] / ref - 1) for r in (1e-7, 1e-9, 1e-11)]
+    assert errors[0] > errors[1] > errors[2]
+    assert errors[1] < 1e-8 and errors[2] < 1e-10
+
+
+def test_the_stiff_switch_keeps_the_columns():
+    """Over an atlas-like spread of damping and speed, runs with Radau for stiff stretches and runs
+    with DOP853 throughout give the same classes and counts, and the same numbers to ~1e-8."""
+    points = [SEED.replace(kappa=float(k), v=float(v)) for k in np.geomspace(1e10, 1e15, 6) for v in (0.4, 2.0, 9.0)]
+    stiff = simulate_many(points, "paper")
+    explicit = simulate_many(points, "paper", stiff=False)
+    np.testing.assert_array_equal(stiff.outcome, explicit.outcome)
+    np.testing.assert_array_equal(stiff.n_stick, explicit.n_stick)
+    assert np.sum(stiff.values["nsteps"]) < 0.5 * np.sum(explicit.values["nsteps"])
+    np.testing.assert_allclose(stiff.stick_delta, explicit.stick_delta, rtol=1e-8)
+    for name in ("max_force", "dissipated_energy", "t_run", "first_stick_delta"):
+        np.testing.assert_allclose(stiff.values[name], explicit.values[name], rtol=1e-7, equal_nan=True)
+
+
+def test_stiff_must_be_a_bool():
+    with pytest.raises(ValueError, match="stiff"):
+        simulate(SEED, "paper", stiff="yes")

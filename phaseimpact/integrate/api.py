@@ -16,6 +16,7 @@ from ..model.laws import ContactLaw, as_law
 from ..model.rhs import initial_state, pack
 from ..parameters import Parameters
 from . import driver as d
+from . import radau5
 from .events import EVENT_KINDS
 from .result import Columns, Trajectory
 
@@ -153,10 +154,17 @@ def _save(save):
     return d.SAVE_TIMES, times
 
 
+def _stiff_after(stiff) -> np.int64:
+    """The driver's switch: DOP853 steps at the stability limit before Radau takes over (0: never)."""
+    if not isinstance(stiff, bool | np.bool_):
+        raise ValueError(f"stiff = {stiff!r} is out of range; allowed: True or False")
+    return np.int64(radau5.STIFF_STEPS if stiff else 0)
+
+
 def simulate(params: Parameters, law: ContactLaw | str = "paper", t_end: float | None = None, *,
              integrator: str = "exact", save="summary", stop_when_settled: bool | None = None,
              rtol: float = 1e-10, atol: float | None = None, step: float | None = None, every: int = 1,
-             initial=None, stop_on=None, max_steps: int = MAX_STEPS) -> Trajectory:
+             initial=None, stop_on=None, max_steps: int = MAX_STEPS, stiff: bool = True) -> Trajectory:
     """Integrate one impact from seed eq. 6 (``x1dot = v`` at ``x1 = x2 = 0``) or ``initial``.
 
     Parameters
@@ -183,12 +191,17 @@ def simulate(params: Parameters, law: ContactLaw | str = "paper", t_end: float |
         ``(x1, x2, x1dot, x2dot)`` to start from instead of eq. 6.
     stop_on : str or (str, int), optional
         Stop at the n-th event of a kind (``"stick"``, ``("stick", 2)``).
+    stiff : bool
+        ``exact`` only: a phase whose DOP853 steps stay at their stability limit (a creep held by
+        a strong damper) goes on with Radau IIA (order 5, :mod:`.radau5`); False keeps DOP853
+        throughout (for comparisons).
     """
     law = as_law(law)
     if not isinstance(params, Parameters):
         raise ValueError(f"params = {params!r} is out of range; allowed: a Parameters instance")
     if integrator not in INTEGRATORS:
         raise ValueError(f"integrator = {integrator!r} is out of range; allowed: one of {', '.join(INTEGRATORS)}")
+    stiff_after = _stiff_after(stiff)
     s = scales(params)
     horizon = s.horizon if t_end is None else check_real("t_end", t_end, "a finite number > 0", lambda x: x > 0)
     rtol = check_rtol(rtol)
@@ -207,12 +220,13 @@ def simulate(params: Parameters, law: ContactLaw | str = "paper", t_end: float |
     c, default_atol = _packed(params, law, rtol)
     out = d.run(law.code, c, y0, horizon, rtol, default_atol if atol is None else _atol(params, rtol, atol),
                 s.max_step, settle, stop_kind, stop_count, save_kind, times, int(max_steps), MAX_EVENTS, rk4_step,
-                int(every))
+                int(every), stiff_after)
     summary, ev_t, ev_kind, ev_mode, ev_y, ev_force, s_t, s_y, s_mode, s_force, y_final = out
     status = d.STATUSES[int(summary[d.S_STATUS])]
     reason = d.STOP_REASONS[int(summary[d.S_REASON])]
     outcome = d.OUTCOMES[int(summary[d.S_OUTCOME])]
-    name = f"rk4[step={rk4_step:.3g}]" if rk4_step else f"exact[DOP853, rtol={rtol:g}]"
+    method = "DOP853+Radau5" if stiff else "DOP853"
+    name = f"rk4[step={rk4_step:.3g}]" if rk4_step else f"exact[{method}, rtol={rtol:g}]"
     return Trajectory(
         t=s_t, y=s_y, force=s_force, mode=s_mode, event_t=ev_t, event_kind=ev_kind, event_mode=ev_mode,
         event_y=ev_y, event_force=ev_force, params=params, law=law, initial_state=y0, final_state=y_final,
@@ -258,16 +272,17 @@ def pack_batch(params_seq, law: ContactLaw, t_end, rtol: float, initial=None) ->
 
 
 def run_batch(batch: Batch, *, rtol: float, settle: bool = True, stop_on=None, n_threads: int = 1,
-              capacity: int = 32) -> Columns:
+              capacity: int = 32, stiff: bool = True) -> Columns:
     """Run a packed batch in ``n_threads`` threads; each run is independent of the others, so
     the columns do not depend on the thread count or on how a sweep was cut into batches."""
     stop_kind, stop_count = _stop_on(stop_on)
+    stiff_after = _stiff_after(stiff)
     n = len(batch)
     summary = np.empty((n, d.N_SUMMARY))
     st = np.empty((3, n, capacity))
     count = np.empty(n, np.int64)
     args = (batch.law.code, batch.C, batch.Y0, batch.t_end, rtol, batch.atol, batch.max_step, settle, stop_kind,
-            stop_count, MAX_STEPS, MAX_EVENTS, 0.0)
+            stop_count, MAX_STEPS, MAX_EVENTS, 0.0, stiff_after)
     outputs = (summary, st[0], st[1], st[2], count)
     threads = max(1, min(int(n_threads), n))
     if threads == 1:
@@ -288,7 +303,7 @@ def run_batch(batch: Batch, *, rtol: float, settle: bool = True, stop_on=None, n
         # more stick phases than the buffer holds (near kappa_c): rerun this one for all of them
         out = d.run(batch.law.code, batch.C[i], batch.Y0[i], batch.t_end[i], rtol, batch.atol[i],
                     batch.max_step[i], settle, stop_kind, stop_count, d.SAVE_SUMMARY, np.empty(0), MAX_STEPS,
-                    MAX_EVENTS, 0.0, 1)
+                    MAX_EVENTS, 0.0, 1, stiff_after)
         full = np.empty((3, k))
         s = out[0]
         d.stick_points(len(out[1]), out[1], out[2], out[4], s[d.S_T_STOP], s[d.S_OUTCOME] == d.PERMANENT_STICK,
@@ -305,7 +320,7 @@ def run_batch(batch: Batch, *, rtol: float, settle: bool = True, stop_on=None, n
 
 def simulate_many(params_seq, law: ContactLaw | str = "paper", t_end: float | None = None, *,
                   rtol: float = 1e-10, stop_when_settled: bool = True, stop_on=None, initial=None,
-                  n_threads: int = 1) -> Columns:
+                  n_threads: int = 1, stiff: bool = True) -> Columns:
     """Many impacts (one per :class:`Parameters` of ``params_seq``), summaries only, as columns.
 
     Same driver and arguments as :func:`simulate`; runs go in ``n_threads`` threads inside this
@@ -317,5 +332,6 @@ def simulate_many(params_seq, law: ContactLaw | str = "paper", t_end: float | No
         t_end = check_real("t_end", t_end, "a finite number > 0", lambda x: x > 0)
     if not (isinstance(n_threads, numbers.Integral) and n_threads >= 1):
         raise ValueError(f"n_threads = {n_threads!r} is out of range; allowed: an integer >= 1")
+    _stiff_after(stiff)
     batch = pack_batch(params_seq, law, t_end, rtol, initial)
-    return run_batch(batch, rtol=rtol, settle=stop_when_settled, stop_on=stop_on, n_threads=n_threads)
+    return run_batch(batch, rtol=rtol, settle=stop_when_settled, stop_on=stop_on, n_threads=n_threads, stiff=stiff)

@@ -20,8 +20,8 @@ import numba
 import numpy as np
 
 from ..model.laws import PLAIN, STUCK
-from ..model.rhs import V1, V2, WORK, X1, X2, contact_side, energy, rhs, rhs_integration, stick_margin
-from . import dop853
+from ..model.rhs import V1, V2, WORK, X1, X2, contact_side, damping_rate, energy, rhs, rhs_integration, stick_margin
+from . import dop853, radau5
 from .dop853 import N_STATE
 from .events import (
     CONTACT,
@@ -278,11 +278,49 @@ def _quiet_start(quiet, y, mode, g):
 
 
 @numba.njit(cache=True)
+def _dop853_attempt(code, c, mode, side, s, s_bound, u, fu, h_abs, rtol, atol, K, u_new, fu_new, tmp):
+    """One accepted DOP853 step from ``(s, u)`` (at most to ``s_bound``), first try ``h_abs``.
+
+    Returns ``(ok, s_new, h_next, force_new, evaluations)``; ``ok`` False when the step size
+    collapsed. The stages stay in ``K`` for the interpolant.
+    """
+    evaluations = 0
+    rejected = False
+    h_rejected = err_rejected = 0.0
+    while True:
+        if h_abs < 10.0 * (np.nextafter(s, np.inf) - s):
+            return False, s, h_abs, 0.0, evaluations
+        s_new = min(s + h_abs, s_bound)
+        h = s_new - s
+        force_new = dop853.step(code, c, mode, side, u, fu, h, K, u_new, fu_new, tmp)
+        evaluations += 12
+        err = dop853.error_norm(K, h, u, u_new, rtol, atol)
+        if err < 1.0:
+            factor = dop853.MAX_FACTOR if err == 0 else min(dop853.MAX_FACTOR,
+                                                           dop853.SAFETY * err**dop853.ERROR_EXPONENT)
+            if rejected:
+                factor = min(1.0, factor)
+            return True, s_new, h * factor, force_new, evaluations
+        factor = max(dop853.MIN_FACTOR, dop853.SAFETY * err**dop853.ERROR_EXPONENT)
+        if rejected and err < err_rejected and h < h_rejected:
+            # a second rejection at the same point: the error falls with the step more slowly than
+            # the method's order says (delta^alpha at a contact onset goes as h^2.5); shrink by the
+            # observed order instead of rejecting again and again
+            observed = math.log(err_rejected / err) / math.log(h_rejected / h)
+            if 0.0 < observed < dop853.ORDER:
+                factor = min(factor, max(OBSERVED_MIN_FACTOR, (0.5 / err) ** (1.0 / observed)))
+        h_rejected, err_rejected = h, err
+        h_abs = h * factor
+        rejected = True
+
+
+@numba.njit(cache=True)
 def _advance(code, c, mode, side, s, t_end, u, fu, y, f, force, h_abs, rtol, atol, max_step, w_floor, energy_limit,
-             next_sample, steps_left, g_old, g_new, fired, K, u_new, fu_new, y_new, f_new, tmp, stats):
-    """Take DOP853 steps in ``s`` from ``(s, u)`` while nothing happens: no event crosses, no
-    sample and (regularised phase) not the horizon falls inside. Accepted steps update ``u, fu,
-    y, f, g_old`` and the running extremes ``stats``.
+             next_sample, steps_left, g_old, g_new, fired, K, u_new, fu_new, y_new, f_new, tmp, stats, stiff):
+    """Take steps in ``s`` from ``(s, u)`` while nothing happens: no event crosses, no sample and
+    (regularised phase) not the horizon falls inside. Accepted steps update ``u, fu, y, f, g_old``
+    and the running extremes ``stats``. DOP853 until the phase turns stiff (:mod:`.radau5`), Radau
+    from then on.
 
     Returns ``(result, s, h, h_abs, h_next, force, force_new, steps, evaluations)``: ``_ADV_STEP``
     leaves the last step (``h``, ``u_new``, ``fu_new``, ``y_new``, ``f_new``, ``g_new``, ``fired``)
@@ -294,39 +332,24 @@ def _advance(code, c, mode, side, s, t_end, u, fu, y, f, force, h_abs, rtol, ato
     h = 0.0
     h_next = h_abs
     force_new = force
+    s_bound = t_end if not _regularised(side) else math.inf  # a plain phase ends on the horizon
     while u[TIME] < t_end:
         if steps >= steps_left:
             return _ADV_LIMIT, s, h, h_abs, h_next, force, force_new, steps, evaluations
         # a regularised phase advances the time by w ds: its cap on the time step is one on s
         h_abs = min(h_abs, max_step if not _regularised(side) else max_step / max(abs(u[0]), w_floor))
-        rejected = False
-        h_rejected = err_rejected = 0.0
-        while True:
-            if h_abs < 10.0 * (np.nextafter(s, np.inf) - s):
-                return _ADV_COLLAPSE, s, h, h_abs, h_next, force, force_new, steps, evaluations
-            s_new = min(s + h_abs, t_end) if not _regularised(side) else s + h_abs  # a plain phase ends on the horizon
-            h = s_new - s
-            force_new = dop853.step(code, c, mode, side, u, fu, h, K, u_new, fu_new, tmp)
-            evaluations += 12
-            err = dop853.error_norm(K, h, u, u_new, rtol, atol)
-            if err < 1.0:
-                factor = dop853.MAX_FACTOR if err == 0 else min(dop853.MAX_FACTOR,
-                                                               dop853.SAFETY * err**dop853.ERROR_EXPONENT)
-                if rejected:
-                    factor = min(1.0, factor)
-                h_next = h * factor
-                break
-            factor = max(dop853.MIN_FACTOR, dop853.SAFETY * err**dop853.ERROR_EXPONENT)
-            if rejected and err < err_rejected and h < h_rejected:
-                # a second rejection at the same point: the error falls with the step more slowly than
-                # the method's order says (delta^alpha at a contact onset goes as h^2.5); shrink by the
-                # observed order instead of rejecting again and again
-                observed = math.log(err_rejected / err) / math.log(h_rejected / h)
-                if 0.0 < observed < dop853.ORDER:
-                    factor = min(factor, max(OBSERVED_MIN_FACTOR, (0.5 / err) ** (1.0 / observed)))
-            h_rejected, err_rejected = h, err
-            h_abs = h * factor
-            rejected = True
+        if radau5.due(stiff):  # entered from an accepted state, so that every step has one method
+            evaluations += radau5.enter(code, c, mode, side, u, fu, rtol, atol, stiff)
+        if radau5.active(stiff):
+            ok, s_new, h_next, force_new, spent = radau5.attempt(code, c, mode, side, s, s_bound, u, fu, h_abs,
+                                                                 stiff, u_new, fu_new)
+        else:
+            ok, s_new, h_next, force_new, spent = _dop853_attempt(code, c, mode, side, s, s_bound, u, fu, h_abs,
+                                                                  rtol, atol, K, u_new, fu_new, tmp)
+        evaluations += spent
+        if not ok:
+            return _ADV_COLLAPSE, s, h, h_next, h_next, force, force_new, steps, evaluations
+        h = s_new - s
         steps += 1
         if not _regularised(side):
             u_new[TIME] = s_new  # t' = 1: the time is s itself, without the sum's rounding
@@ -336,6 +359,8 @@ def _advance(code, c, mode, side, s, t_end, u, fu, y, f, force, h_abs, rtol, ato
         else:
             force_new = _physical(code, c, mode, side, u_new, y_new, f_new)
             evaluations += 1
+        if not radau5.active(stiff):
+            radau5.watch(stiff, h * damping_rate(code, c, u_new, mode, side))
         _events(code, c, mode, side, energy_limit, u_new, y_new, f_new, force_new, g_new)
         any_fired = False
         for col in range(N_EVENTS):
@@ -357,6 +382,69 @@ def _advance(code, c, mode, side, s, t_end, u, fu, y, f, force, h_abs, rtol, ato
 
 
 @numba.njit(cache=True)
+def _fresh_step(code, c, mode, side, s, u, fu, h, K, u_new, fu_new, tmp, stiff):
+    """A step of exactly ``h`` from ``(s, u)`` with the phase's current method (the state at a
+    root, a stop or the horizon); returns the evaluations spent."""
+    if radau5.active(stiff):
+        return radau5.fixed_step(code, c, mode, side, s, u, fu, h, stiff, u_new, fu_new)
+    dop853.step(code, c, mode, side, u, fu, h, K, u_new, fu_new, tmp)
+    return 12
+
+
+@numba.njit(cache=True)
+def _polish_root(code, c, mode, side, energy_limit, column, s, u, fu, s_end, g_start, g_end, x, K, u_r, fu_r, tmp,
+                 stiff, ys, fs, gs):
+    """Refine the root ``x`` of event ``column`` (found on the step's interpolant) on steps from
+    ``s`` that end at the trial points (Illinois' regula falsi in ``[s, s_end]``).
+
+    Radau's collocation polynomial is of order 3 between its end points: where an event crosses
+    slowly (a creep coming to rest) its root could lie several per cent of the phase away. The
+    end point of a step carries the method's full order. Returns ``(root, evaluations)``.
+    """
+    evaluations = 0
+    a, fa, b, fb = s, g_start, s_end, g_end
+    if not (fa * fb < 0 and a < x < b):
+        return x, evaluations
+    best, f_best = x, math.inf
+    kept = 0
+    for _ in range(40):
+        evaluations += _fresh_step(code, c, mode, side, s, u, fu, x - s, K, u_r, fu_r, tmp, stiff)
+        force = _physical(code, c, mode, side, u_r, ys, fs)
+        _events(code, c, mode, side, energy_limit, u_r, ys, fs, force, gs)
+        fx = gs[column]
+        if abs(fx) < f_best:
+            best, f_best = x, abs(fx)
+        if fx == 0:
+            break
+        if (fx < 0) == (fa < 0):
+            a, fa = x, fx
+            if kept == -1:
+                fb *= 0.5  # the same end kept twice: Illinois' halving keeps the secant moving
+            kept = -1
+        else:
+            b, fb = x, fx
+            if kept == 1:
+                fa *= 0.5
+            kept = 1
+        if b - a <= 1e-12 * (s_end - s) + 4.0 * _EPS * abs(b):
+            break
+        x = (a * fb - b * fa) / (fb - fa)
+        if not (a < x < b):
+            x = 0.5 * (a + b)
+    return best, evaluations
+
+
+@numba.njit(cache=True)
+def _interpolant(code, c, mode, side, u, fu, u_new, fu_new, h, K, F, tmp, stiff):
+    """The last step's interpolant into ``F``; returns the evaluations spent."""
+    if radau5.active(stiff):
+        radau5.dense_coefficients(stiff, F)
+        return 0
+    dop853.dense_coefficients(code, c, mode, side, u, fu, u_new, fu_new, h, K, F, tmp)
+    return 3
+
+
+@numba.njit(cache=True)
 def _phase_step(code, c, mode, side, u, fu, rtol, atol, t_end, max_step, w_floor, tmp, f1):
     """Initial step of a phase (scipy's rule), in its own independent variable."""
     interval = t_end - u[TIME]
@@ -370,7 +458,7 @@ def _phase_step(code, c, mode, side, u, fu, rtol, atol, t_end, max_step, w_floor
 
 @numba.njit(cache=True)
 def run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count, save_kind, times,
-        max_steps, max_events, rk4_step, rk4_every):
+        max_steps, max_events, rk4_step, rk4_every, stiff_after):
     """Integrate one trajectory. See :func:`phaseimpact.integrate.simulate` for the meaning.
 
     Returns ``(summary, ev_t, ev_kind, ev_mode, ev_y, ev_force, s_t, s_y, s_mode, s_force, y_final)``
@@ -521,6 +609,7 @@ def run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count,
     nfev += 1
 
     stats = np.empty(2)
+    stiff = radau5.workspace(stiff_after)
     while u[TIME] < t_end:
         if nsteps >= max_steps or n_ev >= max_events:
             status, reason = TOO_MANY_STEPS, FAILED_STOP
@@ -530,7 +619,7 @@ def run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count,
         stats[0], stats[1] = max_force, max_indentation
         result, s, h, h_abs, h_next, force, force_new, d_steps, d_fev = _advance(
             code, c, mode, side, s, t_end, u, fu, y, f, force, h_abs, rtol, atol_u, max_step, w_floor, energy_limit,
-            next_sample, max_steps - nsteps, g_old, g_new, fired, K6, u_new, fu_new, y_new, f_new, tmp6, stats)
+            next_sample, max_steps - nsteps, g_old, g_new, fired, K6, u_new, fu_new, y_new, f_new, tmp6, stats, stiff)
         max_force, max_indentation = stats[0], stats[1]
         nsteps += d_steps
         nfev += d_fev
@@ -553,14 +642,12 @@ def run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count,
         s_restart = math.inf
         s_horizon = math.inf
         if _regularised(side) and u_new[TIME] >= t_end:
-            dop853.dense_coefficients(code, c, mode, side, u, fu, u_new, fu_new, h, K6, F6, tmp6)
-            nfev += 3
+            nfev += _interpolant(code, c, mode, side, u, fu, u_new, fu_new, h, K6, F6, tmp6, stiff)
             have_dense = True
             s_horizon = _s_at_time(code, c, mode, side, F6, u, s, h, t_end, us, ys, fs, gs)
         if any_fired:
             if not have_dense:
-                dop853.dense_coefficients(code, c, mode, side, u, fu, u_new, fu_new, h, K6, F6, tmp6)
-                nfev += 3
+                nfev += _interpolant(code, c, mode, side, u, fu, u_new, fu_new, h, K6, F6, tmp6, stiff)
                 have_dense = True
             unresolved = False
             for col in range(N_EVENTS):
@@ -589,6 +676,11 @@ def run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count,
             for col in range(N_EVENTS):
                 if fired[col] and (restarts(code, col, mode, settle) or col == ENERGY) and roots[col] < s_restart:
                     restart_col, s_restart = col, roots[col]
+            if restart_col >= 0 and radau5.active(stiff):
+                s_restart, spent = _polish_root(code, c, mode, side, energy_limit, restart_col, s, u, fu, s_new,
+                                                g_old[restart_col], g_new[restart_col], s_restart, K6, u_r, fu_r,
+                                                tmp6, stiff, ys, fs, gs)
+                nfev += spent
             # recorded events before the restart, in time order
             while True:
                 best = np.int64(-1)
@@ -599,7 +691,10 @@ def run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count,
                 if best < 0:
                     break
                 fired[best] = False
-                _event_at(code, c, mode, side, energy_limit, 0.0, best, F6, u, s, h, roots[best], us, ys, fs, gs)
+                if radau5.active(stiff):  # the state from a step to the root: the polynomial is of order 3
+                    nfev += _fresh_step(code, c, mode, side, s, u, fu, roots[best] - s, K6, us, fu_r, tmp6, stiff)
+                else:
+                    dop853.dense_eval(F6, u, s, h, roots[best], us)
                 f_ev = _physical(code, c, mode, side, us, ys, fs)
                 kind = FORCE_PEAK if best == FORCE_RATE else REVERSAL
                 if best == REACH:
@@ -616,8 +711,7 @@ def run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count,
         if stop_record >= 0:
             # stopped at a recorded event: the state there from a fresh step that ends at it
             if stop_record > s:
-                dop853.step(code, c, mode, side, u, fu, stop_record - s, K6, u_r, fu_r, tmp6)
-                nfev += 12
+                nfev += _fresh_step(code, c, mode, side, s, u, fu, stop_record - s, K6, u_r, fu_r, tmp6, stiff)
                 _copy(u_r, u, N_STATE)
                 if not _regularised(side):
                     u[TIME] = stop_record
@@ -634,8 +728,7 @@ def run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count,
                 t_seg = t_end
             while i_time < times.shape[0] and times[i_time] <= t_seg:
                 if not have_dense:
-                    dop853.dense_coefficients(code, c, mode, side, u, fu, u_new, fu_new, h, K6, F6, tmp6)
-                    nfev += 3
+                    nfev += _interpolant(code, c, mode, side, u, fu, u_new, fu_new, h, K6, F6, tmp6, stiff)
                     have_dense = True
                 dop853.dense_eval(F6, u, s, h, _s_at_time(code, c, mode, side, F6, u, s, h, times[i_time], us, ys,
                                                           fs, gs), us)
@@ -645,8 +738,7 @@ def run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count,
                 i_time += 1
         if restart_col < 0 and s_horizon < math.inf:
             # a regularised phase reaches the horizon inside the step: the state there from a fresh step
-            dop853.step(code, c, mode, side, u, fu, s_horizon - s, K6, u_r, fu_r, tmp6)
-            nfev += 12
+            nfev += _fresh_step(code, c, mode, side, s, u, fu, s_horizon - s, K6, u_r, fu_r, tmp6, stiff)
             _copy(u_r, u, N_STATE)
             u[TIME] = t_end  # without the root finder's residue
             force = _physical(code, c, mode, side, u, y, f)
@@ -660,8 +752,7 @@ def run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count,
             # belong to the continuation, not to the motion)
             h_r = s_restart - s
             if h_r > 0:
-                dop853.step(code, c, mode, side, u, fu, h_r, K6, u_r, fu_r, tmp6)
-                nfev += 12
+                nfev += _fresh_step(code, c, mode, side, s, u, fu, h_r, K6, u_r, fu_r, tmp6, stiff)
             else:
                 _copy(u, u_r, N_STATE)
             t = s_restart if not _regularised(side) else u_r[TIME]
@@ -674,6 +765,7 @@ def run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count,
             s = t if not _regularised(new_side) else 0.0
             rhs_integration(code, c, u, mode, new_side, fu)
             nfev += 2
+            radau5.reset(stiff)  # a new phase starts explicit
             if new_side != side:  # the independent variable changes: a fresh initial step
                 side = new_side
                 _phase_tolerances(side, atol, atol_u)
@@ -806,7 +898,7 @@ def stick_points(n_ev, ev_t, ev_kind, ev_y, t_stop, permanent, out_t, out_delta,
 
 @numba.njit(cache=True, nogil=True)
 def run_block(code, C, Y0, t_end, rtol, ATOL, max_step, settle, stop_kind, stop_count, max_steps, max_events,
-              rk4_step, start, stop, summary, st_t, st_delta, st_dwell, st_count):
+              rk4_step, stiff_after, start, stop, summary, st_t, st_delta, st_dwell, st_count):
     """Runs ``start..stop-1`` of a batch, without the GIL (callers run blocks in threads; each run's
     numbers depend on nothing else). Fills ``summary`` (n, N_SUMMARY) and the first ``capacity``
     stick points of each run; ``st_count`` holds each run's full number of stick points. Threads
@@ -814,7 +906,7 @@ def run_block(code, C, Y0, t_end, rtol, ATOL, max_step, settle, stop_kind, stop_
     empty = np.empty(0)
     for i in range(start, stop):
         out = run(code, C[i], Y0[i], t_end[i], rtol, ATOL[i], max_step[i], settle, stop_kind, stop_count,
-                  np.int64(SAVE_SUMMARY), empty, max_steps, max_events, rk4_step, np.int64(1))
+                  np.int64(SAVE_SUMMARY), empty, max_steps, max_events, rk4_step, np.int64(1), stiff_after)
         s = out[0]
         _copy(s, summary[i], N_SUMMARY)
         permanent = s[S_OUTCOME] == PERMANENT_STICK

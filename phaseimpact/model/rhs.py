@@ -25,8 +25,8 @@ from .laws import PLAIN, STUCK, ContactLaw, as_law, contact_force, contact_poten
 
 __all__ = [
     "X1", "X2", "V1", "V2", "WORK", "pack", "N_COEF",
-    "rhs", "rhs_integration", "contact_side", "PLAIN_PHASE", "FLIGHT", "energy", "stick_force", "stick_orbit",
-    "stick_margin", "stick_break_distance",
+    "rhs", "rhs_integration", "contact_side", "damping_rate", "PLAIN_PHASE", "FLIGHT", "energy", "stick_force",
+    "stick_orbit", "stick_margin", "stick_break_distance",
     "jacobian", "contact_force_of_states", "energy_of_states", "initial_state",
 ]
 
@@ -143,6 +143,21 @@ def rhs_integration(code, c, u, mode, side, out):
     out[WORK] = w * force * deltadot
     out[5] = w
     return force
+
+
+@numba.njit(cache=True)
+def damping_rate(code, c, u, mode, side):
+    """How fast the contact damps the relative motion at the integration state ``u`` of a phase
+    of kind ``side``: ``dP/d(deltadot) (1/M1 + 1/M2)`` per unit of the phase's independent
+    variable (times ``|w|`` in a regularised contact). Zero when stuck or free; negative where
+    the law feeds the motion (``paper``'s outward slip)."""
+    if mode == STUCK or side == FLIGHT:
+        return 0.0
+    regularised = side == 1 or side == -1
+    delta = side * u[0] * u[0] if regularised else u[X1] - u[X2]
+    partial = force_partials(code, delta, u[V1] - u[V2], mode, c[K_], c[DAMP_], c[ALPHA_])[1]
+    rate = partial * (1.0 / c[M1_] + (0.0 if c[RIGID_] > 0 else 1.0 / c[M2_]))
+    return rate * abs(u[0]) if regularised else rate
 
 
 @numba.njit(cache=True)
