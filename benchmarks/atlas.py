@@ -50,6 +50,7 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__)
     ap.add_argument("--quick", action="store_true", help="skip (the atlas takes minutes)")
     ap.add_argument("--side", type=int, default=1000, help="points per axis")
+    ap.add_argument("--rtol", type=float, default=1e-10, help="integrator tolerance (atlas default 1e-10)")
     args = ap.parse_args(argv)
     if args.quick:
         emit("atlas: not run with --quick (a 1e6-point atlas takes minutes); run `python benchmarks/atlas.py`")
@@ -61,10 +62,10 @@ def main(argv=None) -> int:
     emit(start_load + "\n")
     params = seed_parameters()
     axes = {"kappa": np.geomspace(1e10, 1e15, args.side), "v": np.geomspace(0.3, 13.0, args.side)}
-    atlas(params, "paper", {"kappa": axes["kappa"][::100], "v": axes["v"][::100]}, n_jobs=2)  # warm-up
+    atlas(params, "paper", {"kappa": axes["kappa"][::100], "v": axes["v"][::100]}, n_jobs=2, rtol=args.rtol)  # warm
     before = peak_rss()
     start = time.perf_counter()
-    result = atlas(params, "paper", axes, n_jobs=2)
+    result = atlas(params, "paper", axes, n_jobs=2, rtol=args.rtol)
     wall = time.perf_counter() - start
     after = peak_rss()
     fixed, ragged = array_bytes(result)

@@ -25,9 +25,9 @@ from _common import FIGURES, RESULTS, emit, load, machine  # noqa: E402
 
 #: In run order: peers (heyoka) before work_precision, which draws its points.
 SCRIPTS = ("startup", "trajectory", "throughput", "critical", "peers", "work_precision", "scene_savings", "stress",
-           "atlas")
-SECTIONS = ("trajectory", "throughput", "critical", "startup", "work_precision", "peers", "atlas", "scene_savings",
-            "stress")
+           "stiff", "atlas")
+SECTIONS = ("trajectory", "throughput", "critical", "startup", "work_precision", "peers", "stiff", "atlas",
+            "scene_savings", "stress")
 
 
 def _pick(name: str, suffix: str):

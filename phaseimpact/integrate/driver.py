@@ -904,8 +904,16 @@ def run_block(code, C, Y0, t_end, rtol, ATOL, max_step, settle, stop_kind, stop_
     stick points of each run; ``st_count`` holds each run's full number of stick points. Threads
     over blocks, not a compiled parallel loop: that would compile the driver a second time."""
     empty = np.empty(0)
+    c = np.empty(C.shape[1])
+    y0 = np.empty(Y0.shape[1])
+    atol = np.empty(ATOL.shape[1])
     for i in range(start, stop):
-        out = run(code, C[i], Y0[i], t_end[i], rtol, ATOL[i], max_step[i], settle, stop_kind, stop_count,
+        # the run reads its own copies: a row of the shared batch arrays would share their reference
+        # count, which every compiled call updates, between the threads (a contended cache line)
+        _copy(C[i], c, c.shape[0])
+        _copy(Y0[i], y0, y0.shape[0])
+        _copy(ATOL[i], atol, atol.shape[0])
+        out = run(code, c, y0, t_end[i], rtol, atol, max_step[i], settle, stop_kind, stop_count,
                   np.int64(SAVE_SUMMARY), empty, max_steps, max_events, rk4_step, np.int64(1), stiff_after)
         s = out[0]
         _copy(s, summary[i], N_SUMMARY)
