@@ -18,7 +18,6 @@ import math
 from dataclasses import asdict, dataclass, field
 
 import numpy as np
-from scipy.optimize import brentq, minimize_scalar
 
 from ..integrate import scales, simulate
 from ..integrate.events import EVENT_KINDS
@@ -58,6 +57,7 @@ def _default_range(params: Parameters) -> tuple[float, float]:
 def closed_form_kappa_c(params: Parameters) -> float | None:
     """``kappa_c`` of docs/physics.md §5's closed form (two-body Hunt-Crossley approach, momentum
     conserved during the contact, stuck pair on the springs); None without a plate."""
+    from scipy.optimize import brentq  # imported where used: 0.5 s at start-up
     if params.target != "plate" or params.Kb <= 0:
         return None
     M = params.M1 + params.M2
@@ -176,6 +176,7 @@ def critical_damping(params: Parameters, law: ContactLaw | str = "paper", *, kap
 
 def _critical_damping(params, law, kappa_min, kappa_max, rtol, integrator_rtol, with_kappa_2, with_exponents,
                       closed) -> CriticalDamping:
+    from scipy.optimize import brentq  # imported where used: 0.5 s at start-up
     evaluations = 0
 
     def margin(log_kappa):
@@ -378,6 +379,7 @@ def grazing_transitions(params: Parameters, law: ContactLaw | str, kappa_min: fl
     crossing on the grid (a window narrower than the grid), its root is located by Brent's
     method to ``rtol`` (relative): :func:`delta_extremum` is the smooth defining function.
     """
+    from scipy.optimize import brentq, minimize_scalar  # imported where used: 0.5 s at start-up
     law = as_law(law)
     if law.is_filippov and law.contact == "printed":
         raise ValueError("grazing needs a unilateral law (abrate, the Hunt-Crossley family, or paper with "
