@@ -313,7 +313,7 @@ def _predict(h_abs, h_old, err, err_old):
     return min(1.0, multiplier) * err**-0.25
 
 
-@numba.njit(cache=True, inline="always")
+@numba.njit(cache=True)
 def _solve_stages(code, c, mode, side, s, u, fu, h, stiff):
     """Converge the collocation system for a step ``h`` (new factors, a fresh Jacobian once if the
     old one fails); returns ``(converged, iterations, rate, evaluations)``."""
@@ -338,7 +338,7 @@ def _solve_stages(code, c, mode, side, s, u, fu, h, stiff):
         _guess(s, h, stiff)
 
 
-@numba.njit(cache=True, inline="always")
+@numba.njit(cache=True)
 def _finish(code, c, mode, side, s, s_end, h, u, u_new, fu_new, stiff):
     """``u_new``, ``fu_new`` from the converged stages; the polynomial kept for the next guess.
     Returns the contact force at ``u_new``."""
@@ -418,7 +418,7 @@ def attempt(code, c, mode, side, s, s_bound, u, fu, h_abs, stiff, u_new, fu_new)
     return True, s_new, h * factor, force_new, evaluations
 
 
-@numba.njit(cache=True, inline="always")
+@numba.njit(cache=True)
 def _error(ws):
     """RMS of the error estimate ``ws[ERR_]`` on its scale ``ws[SCALE_]``; inf when not finite."""
     acc = 0.0
