@@ -41,7 +41,7 @@ def _pick(name: str, suffix: str):
 
 
 def targets_table() -> str:
-    lines = ["## Issue 9's targets against what was measured", "",
+    lines = ["## Issue 9's and 13's targets against what was measured", "",
              "Every number comes from the command in its row (the scripts print the alternatives side by side); "
              "medians on a shared 2-core machine, load averages in each section. (quick) marks a number from a "
              "`--quick` run.", "",
