@@ -1,10 +1,11 @@
 """Dormand-Prince 8(5,3) steps and their 7th-order dense output, compiled.
 
-A port of scipy's ``DOP853`` (``scipy/integrate/_ivp/rk.py``): the same tableau (imported from
-scipy, not retyped), error estimate, step-size rule and interpolant, on the packed right-hand
-side of :mod:`phaseimpact.model.rhs`. The driver owns the loop; these functions own one step.
-The step, its error measure and the interpolant's extra stages are the tableau unrolled into
-straight-line code (:mod:`._dop853_stages`, written by :mod:`._dop853_codegen`).
+A port of scipy's ``DOP853`` (``scipy/integrate/_ivp/rk.py``): the same tableau, error estimate,
+step-size rule and interpolant, on the packed right-hand side of :mod:`phaseimpact.model.rhs`.
+The driver owns the loop; these functions own one step. The step, its error measure and the
+interpolant's extra stages are scipy's tableau unrolled into straight-line code
+(:mod:`._dop853_stages`, written by :mod:`._dop853_codegen`, which alone reads scipy; a test checks
+the committed file against it). Stiff stretches of a phase go on with :mod:`.radau5`.
 """
 
 from __future__ import annotations

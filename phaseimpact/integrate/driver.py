@@ -1,12 +1,14 @@
 """The one hybrid (event-driven) loop, compiled: every trajectory of the project runs here.
 
 Between events the right-hand side of the current mode is smooth and a stepper advances it:
-adaptive DOP853 (:mod:`.dop853`) or the seed's fixed-step RK4 (``rk4_step > 0``; eq. 8 read
-literally, no events resolved, so its chattering across ``deltadot = 0`` stays visible). After
-each DOP853 step the event table (:mod:`.events`) is checked for crossings; each crossing is
-located by Brent's method on the step's 7th-order dense output; recorded events are logged, and
-at the first event that changes the phase the state is taken from a fresh step that ends
-exactly at the root, the transition is applied and the run restarts there in the new mode.
+adaptive DOP853 (:mod:`.dop853`), Radau IIA for the rest of a phase whose DOP853 steps stay at
+their stability limit (:mod:`.radau5`), or the seed's fixed-step RK4 (``rk4_step > 0``; eq. 8
+read literally, no events resolved, so its chattering across ``deltadot = 0`` stays visible).
+After each step the event table (:mod:`.events`) is checked for crossings; each crossing is
+located by Brent's method on the step's dense output (Radau's roots then polished on steps);
+recorded events are logged, and at the first event that changes the phase the state is taken
+from a fresh step that ends exactly at the root, the transition is applied and the run restarts
+there in the new mode.
 
 Everything here is scalars and small arrays (numba's subset); strings, objects and messages are
 made outside (:mod:`.api`). The same source runs uncompiled with ``NUMBA_DISABLE_JIT=1``.
