@@ -279,7 +279,7 @@ def _quiet_start(quiet, y, mode, g):
         g[quiet] = departure_sign(quiet, y, mode) * _TINY
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")  # the hot loop's own code: a call costs more than it
 def _dop853_attempt(code, c, mode, side, s, s_bound, u, fu, h_abs, rtol, atol, K, u_new, fu_new, tmp):
     """One accepted DOP853 step from ``(s, u)`` (at most to ``s_bound``), first try ``h_abs``.
 

@@ -196,7 +196,7 @@ def _solve(A, piv, b):
         b[i] = acc * A[i, i]
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")
 def _factorize(h, stiff):
     """LU of the feedback blocks of ``MU_REAL/h I - J`` and ``MU_COMPLEX/h I - J``; False when singular."""
     ws, lu_real, lu_complex, piv = stiff[0], stiff[1], stiff[2], stiff[4]
@@ -338,7 +338,7 @@ def _solve_stages(code, c, mode, side, s, u, fu, h, stiff):
         _guess(s, h, stiff)
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")
 def _finish(code, c, mode, side, s, s_end, h, u, u_new, fu_new, stiff):
     """``u_new``, ``fu_new`` from the converged stages; the polynomial kept for the next guess.
     Returns the contact force at ``u_new``."""
@@ -418,7 +418,7 @@ def attempt(code, c, mode, side, s, s_bound, u, fu, h_abs, stiff, u_new, fu_new)
     return True, s_new, h * factor, force_new, evaluations
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")
 def _error(ws):
     """RMS of the error estimate ``ws[ERR_]`` on its scale ``ws[SCALE_]``; inf when not finite."""
     acc = 0.0

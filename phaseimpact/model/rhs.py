@@ -145,7 +145,7 @@ def rhs_integration(code, c, u, mode, side, out):
     return force
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")
 def damping_rate(code, c, u, mode, side):
     """How fast the contact damps the relative motion at the integration state ``u`` of a phase
     of kind ``side``: ``dP/d(deltadot) (1/M1 + 1/M2)`` per unit of the phase's independent
