@@ -278,3 +278,29 @@ def test_the_stiff_switch_keeps_the_columns():
 def test_stiff_must_be_a_bool():
     with pytest.raises(ValueError, match="stiff"):
         simulate(SEED, "paper", stiff="yes")
+
+
+def test_a_step_to_a_root_that_cannot_converge_is_a_failure_not_a_state():
+    """Radau's step to an event's root (no error control) splits into pieces when Newton fails;
+    if nothing converges it raises the workspace's failure flag (the driver then ends the run with
+    step-size-collapse) instead of handing back a state."""
+    from phaseimpact.integrate import radau5
+    from phaseimpact.model.laws import as_law
+    from phaseimpact.model.rhs import pack, rhs_integration
+
+    law = as_law("paper")
+    c = pack(STIFF_CREEP, law)
+    u = np.array([2e-3, 0.0, 0.1, 0.0, 0.0, 0.0])
+    fu = np.empty(6)
+    rhs_integration(law.code, c, u, 1, 1, fu)
+    atol = np.full(6, 1e-14)
+    atol[4] = np.inf
+    stiff = radau5.workspace(np.int64(5))
+    radau5.enter(law.code, c, 1, 1, u, fu, 1e-10, atol, stiff)
+    good, f_good = np.empty(6), np.empty(6)
+    radau5.fixed_step(law.code, c, 1, 1, 0.0, u, fu, 1e-4, stiff, good, f_good)
+    assert not radau5.failed(stiff) and np.all(np.isfinite(good)) and good[5] > 0
+    broken = u.copy()
+    broken[2] = np.nan
+    radau5.fixed_step(law.code, c, 1, 1, 0.0, broken, fu, 1e-4, stiff, good, f_good)
+    assert radau5.failed(stiff)

@@ -616,6 +616,8 @@ def run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count,
         if nsteps >= max_steps or n_ev >= max_events:
             status, reason = TOO_MANY_STEPS, FAILED_STOP
             break
+        if radau5.failed(stiff):
+            break
         next_sample = u[TIME] if save_kind == SAVE_STEPS else (
             times[i_time] if save_kind == SAVE_TIMES and i_time < times.shape[0] else math.inf)
         stats[0], stats[1] = max_force, max_indentation
@@ -816,6 +818,8 @@ def run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count,
             s_t, s_y, s_mode, s_force, n_s = _push_sample(s_t, s_y, s_mode, s_force, n_s, u[TIME], y,
                                                             mode, force)
 
+    if radau5.failed(stiff):  # a step to a root did not converge: what follows it is not the motion
+        status, reason = STEP_SIZE_COLLAPSE, FAILED_STOP
     t = u[TIME]
 
     summary = _summarize(code, c, y0, y, mode, status, reason, t, max_force, max_indentation, counts,

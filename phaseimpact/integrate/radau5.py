@@ -71,8 +71,8 @@ INNER_SCALE = 0.01
 J_, Z_, F_, W_, DW_, Q_, ERR_, SCALE_, ATOL_ = 0, 6, 9, 12, 15, 18, 21, 22, 23
 WS_ROWS = 24
 # Controller state ctl.
-(ON, COUNT, SWITCH_AFTER, RTOL, H_OLD, ERR_OLD, JAC_CURRENT, LU_H, Q_BASE, Q_S, Q_H, HAVE_Q) = range(12)
-N_CTL = 12
+(ON, COUNT, SWITCH_AFTER, RTOL, H_OLD, ERR_OLD, JAC_CURRENT, LU_H, Q_BASE, Q_S, Q_H, HAVE_Q, FAILED) = range(13)
+N_CTL = 13
 
 
 @numba.njit(cache=True)
@@ -98,6 +98,12 @@ def reset(stiff):
 @numba.njit(cache=True)
 def active(stiff):
     return stiff[5][ON] != 0.0
+
+
+@numba.njit(cache=True)
+def failed(stiff):
+    """True once a step to a root could not be taken (the run must end with a failure status)."""
+    return stiff[5][FAILED] != 0.0
 
 
 @numba.njit(cache=True)
@@ -452,7 +458,10 @@ def fixed_step(code, c, mode, side, s, u, fu, h, stiff, u_new, fu_new):
                 f_start[j] = fu_new[j]
         if converged:
             return evaluations
-    for j in range(N_STATE):  # Newton never converged: the state at the root stays the step's start
+    # Newton never converged, even on 64 pieces: no state at the root; the driver ends the run
+    # with a failure status (radau5.failed)
+    stiff[5][FAILED] = 1.0
+    for j in range(N_STATE):
         u_new[j] = u[j]
         fu_new[j] = fu[j]
     return evaluations
