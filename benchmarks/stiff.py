@@ -5,7 +5,7 @@ Far above kappa_c the inward slip of ``paper`` is a creep held by the damper (da
 relative motion up to ~1e7 /s): DOP853 is held at its stability limit there whatever the
 tolerance. Both methods run the same points at several ``rtol``; errors are against DOP853 at rtol
 1e-13 (a reference from the other method: Radau's own estimate plays no part in it). Times are
-medians of 3 runs of the whole batch in one thread.
+medians of 3 runs of the whole batch in one thread (`_common.timed`).
 
     python benchmarks/stiff.py [--quick]
 """
@@ -13,15 +13,13 @@ medians of 3 runs of the whole batch in one thread.
 from __future__ import annotations
 
 import argparse
-import statistics
 import sys
-import time
 from pathlib import Path
 
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from _common import emit, load, machine, save_section, save_targets, table  # noqa: E402
+from _common import emit, load, machine, save_section, save_targets, table, timed  # noqa: E402
 
 from phaseimpact import seed_parameters  # noqa: E402
 from phaseimpact.integrate.api import pack_batch, run_batch  # noqa: E402
@@ -70,12 +68,8 @@ def main(argv=None) -> int:
         batch = pack_batch(params, "paper", None, rtol)
         for stiff in (False, True):
             run_batch(batch, rtol=rtol, stiff=stiff)  # warm
-            times = []
-            for _ in range(3):
-                start = time.perf_counter()
-                result = run_batch(batch, rtol=rtol, stiff=stiff)
-                times.append(time.perf_counter() - start)
-            per_point = statistics.median(times) / n
+            wall, result = timed(lambda b=batch, r=rtol, st=stiff: run_batch(b, rtol=r, stiff=st), repeats=3, slow=1e9)
+            per_point = wall / n
             err = errors(result, reference)
             mismatches = int(np.sum(result.outcome != reference.outcome) + np.sum(result.n_stick != reference.n_stick))
             method = "DOP853 + Radau IIA" if stiff else "DOP853 throughout"
@@ -91,13 +85,14 @@ def main(argv=None) -> int:
     ratios = ", ".join(f"{summary[(r, False)] / summary[(r, True)]:.2f}x at {r:.0e}" for r in RTOLS)
     end_load = load()
     emit("\n" + text + f"\n\nDOP853 throughout / with Radau: {ratios}")
-    save_section("stiff", f"## Stiff creeps (DOP853 against DOP853 + Radau IIA)\n\n{machine()}\n\n{start_load} at the "
+    name = "stiff" + args.quick * "_quick"
+    save_section(name, f"## Stiff creeps (DOP853 against DOP853 + Radau IIA)\n\n{machine()}\n\n{start_load} at the "
                           f"start, {end_load} at the end.\n\n{n} random points of the atlas benchmark's grid "
                           "(kappa 1e10-1e15, v 0.3-13 m/s, log-spaced 1000 x 1000), each run until settled; errors "
                           "against DOP853 at rtol 1e-13; times are medians of 3 runs of the batch in one thread. "
                           f"`python benchmarks/stiff.py`\n\n{text}\n\nTime of DOP853 throughout over DOP853 + Radau "
                           f"IIA: {ratios}.")
-    save_targets("stiff", [])
+    save_targets(name, [])
     return 0
 
 

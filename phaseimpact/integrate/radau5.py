@@ -229,11 +229,12 @@ def _solve_system(lu, piv, ws, h_over_mu, b):
 
 @numba.njit(cache=True, inline="always")
 def _norm(ws, row, n_rows, scale_row):
+    """RMS of rows ``row..row+n_rows-1`` of ``ws`` on the scale ``ws[scale_row]``; inf when not finite."""
     acc = 0.0
     for i in range(n_rows):
         for j in range(N_STATE):
             acc += (ws[row + i, j] / ws[scale_row, j]) ** 2
-    return math.sqrt(acc / (n_rows * N_STATE))
+    return math.sqrt(acc / (n_rows * N_STATE)) if math.isfinite(acc) else math.inf
 
 
 @numba.njit(cache=True, inline="always")
@@ -391,7 +392,7 @@ def attempt(code, c, mode, side, s, s_bound, u, fu, h_abs, stiff, u_new, fu_new)
             ws[SCALE_, j] = ws[ATOL_, j] + max(abs(u[j]), abs(u[j] + z3)) * rtol  # the error's scale
             ws[ERR_, j] = fu[j] + (E1 * ws[Z_, j] + E2 * ws[Z_ + 1, j] + E3 * z3) / h
         _solve_system(stiff[1], stiff[4][0], ws, h / MU_REAL, ws[ERR_])
-        err = _error(ws)
+        err = _norm(ws, ERR_, 1, SCALE_)
         if rejected and err > 1.0:
             # the estimate after a rejection, filtered once more (Hairer's rule for stiff components)
             tmp, ftmp = stiff[6], stiff[7]
@@ -402,7 +403,7 @@ def attempt(code, c, mode, side, s, s_bound, u, fu, h_abs, stiff, u_new, fu_new)
             for j in range(N_STATE):
                 ws[ERR_, j] = ftmp[j] + (E1 * ws[Z_, j] + E2 * ws[Z_ + 1, j] + E3 * ws[Z_ + 2, j]) / h
             _solve_system(stiff[1], stiff[4][0], ws, h / MU_REAL, ws[ERR_])
-            err = _error(ws)
+            err = _norm(ws, ERR_, 1, SCALE_)
         if err <= 1.0:
             break
         safety = 0.9 * (2 * NEWTON_MAXITER + 1) / (2 * NEWTON_MAXITER + iterations)
@@ -422,15 +423,6 @@ def attempt(code, c, mode, side, s, s_bound, u, fu, h_abs, stiff, u_new, fu_new)
         ctl[LU_H] = 0.0
     ctl[JAC_CURRENT] = 1.0 if recompute_jacobian else 0.0
     return True, s_new, h * factor, force_new, evaluations
-
-
-@numba.njit(cache=True, inline="always")
-def _error(ws):
-    """RMS of the error estimate ``ws[ERR_]`` on its scale ``ws[SCALE_]``; inf when not finite."""
-    acc = 0.0
-    for j in range(N_STATE):
-        acc += (ws[ERR_, j] / ws[SCALE_, j]) ** 2
-    return math.sqrt(acc / N_STATE) if math.isfinite(acc) else math.inf
 
 
 @numba.njit(cache=True)
