@@ -4,12 +4,11 @@ do not edit. The step, its error measure and its dense-output coefficients, unro
 
 import math
 
-import numba
-
+from .._jit import kernel
 from ..model.rhs import rhs_integration
 
 
-@numba.njit(cache=True)
+@kernel
 def step(code, c, mode, side, y, f, h, K, y_new, f_new, tmp):
     """One step of size ``h`` from ``(y, f)``: fills stages ``K[0..12]``, ``y_new``, ``f_new``;
     returns the contact force at ``y_new``."""
@@ -78,7 +77,7 @@ def step(code, c, mode, side, y, f, h, K, y_new, f_new, tmp):
     return force
 
 
-@numba.njit(cache=True)
+@kernel
 def error_norm(K, h, y, y_new, rtol, atol):
     """scipy's DOP853 error measure of the last step (< 1: accept); inf for a non-finite step."""
     e5 = 0.0
@@ -94,7 +93,7 @@ def error_norm(K, h, y, y_new, rtol, atol):
     return abs(h) * e5 / math.sqrt((e5 + 0.01 * e3) * 6.0)
 
 
-@numba.njit(cache=True)
+@kernel
 def dense_coefficients(code, c, mode, side, y, f, y_new, f_new, h, K, F, tmp):
     """The interpolant of the last step (three extra stages): fills ``F`` (7, 6)."""
     for j in range(6):

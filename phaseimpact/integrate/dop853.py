@@ -12,8 +12,7 @@ from __future__ import annotations
 
 import math
 
-import numba
-
+from .._jit import kernel
 from ..model.rhs import rhs_integration
 from ._dop853_stages import dense_coefficients, error_norm, step  # noqa: F401  (the step's API)
 
@@ -23,7 +22,7 @@ ERROR_EXPONENT = -1.0 / 8.0  # error estimator of order 7
 SAFETY, MIN_FACTOR, MAX_FACTOR = 0.9, 0.2, 10.0
 
 
-@numba.njit(cache=True)
+@kernel
 def dense_eval(F, y, t_old, h, t, out):
     """State at ``t`` on the interpolant ``F`` of the step ``[t_old, t_old + h]`` from ``y``."""
     x = (t - t_old) / h if h != 0 else 0.0
@@ -35,7 +34,7 @@ def dense_eval(F, y, t_old, h, t, out):
         out[j] = y[j] + acc
 
 
-@numba.njit(cache=True)
+@kernel
 def initial_step(code, c, mode, side, y, f, rtol, atol, interval, max_step, tmp, f1):
     """scipy's ``select_initial_step`` (Hairer, Norsett & Wanner, II.4), one extra evaluation."""
     d0 = 0.0

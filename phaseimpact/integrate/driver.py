@@ -18,9 +18,9 @@ from __future__ import annotations
 
 import math
 
-import numba
 import numpy as np
 
+from .._jit import allocating, kernel
 from ..model.laws import PLAIN, STUCK
 from ..model.rhs import V1, V2, WORK, X1, X2, contact_side, damping_rate, energy, rhs, rhs_integration, stick_margin
 from . import dop853, radau5
@@ -78,20 +78,20 @@ _EPS = np.finfo(np.float64).eps
 
 # Copies go element by element on purpose: a slice or row assignment makes numba compile its
 # shape-mismatch error messages (string formatting), which was half of the first-ever compile.
-@numba.njit(cache=True)
+@kernel
 def _copy(src, dst, n):
     for j in range(n):
         dst[j] = src[j]
 
 
-@numba.njit(cache=True)
+@allocating
 def _grow(a, n):
     b = np.empty((max(2 * a.shape[0], 16),) + a.shape[1:], a.dtype)
     _copy(a.ravel(), b.ravel(), n * (a.size // max(a.shape[0], 1)))
     return b
 
 
-@numba.njit(cache=True)
+@allocating
 def _push_event(ev_t, ev_kind, ev_mode, ev_y, ev_force, n, t, kind, mode, y, force):
     """Append an event to the log (grown by doubling); returns the arrays and the new length."""
     if n == ev_t.shape[0]:
@@ -105,7 +105,7 @@ def _push_event(ev_t, ev_kind, ev_mode, ev_y, ev_force, n, t, kind, mode, y, for
     return ev_t, ev_kind, ev_mode, ev_y, ev_force, n + 1
 
 
-@numba.njit(cache=True)
+@allocating
 def _push_sample(s_t, s_y, s_mode, s_force, n, t, y, mode, force):
     """Append a sample (grown by doubling); returns the arrays and the new length."""
     if n == s_t.shape[0]:
@@ -117,13 +117,13 @@ def _push_sample(s_t, s_y, s_mode, s_force, n, t, y, mode, force):
     return s_t, s_y, s_mode, s_force, n + 1
 
 
-@numba.njit(cache=True)
+@kernel
 def _regularised(side):
     """A contact phase integrated in w = sqrt(|delta|) and dt = w ds (side +-1)."""
     return side == 1 or side == -1
 
 
-@numba.njit(cache=True)
+@kernel
 def _physical(code, c, mode, side, u, y, f):
     """Physical state ``y`` and ``dy/dt`` (``f``) at the integration state ``u``; returns the force."""
     y[X1] = u[X1] if not _regularised(side) else u[X2] + side * u[0] * u[0]
@@ -132,7 +132,7 @@ def _physical(code, c, mode, side, u, y, f):
     return rhs(code, c, y, mode, f)
 
 
-@numba.njit(cache=True)
+@kernel
 def _integration_state(side, y, t, u):
     """The integration state of a phase on ``side`` (see :func:`~phaseimpact.model.rhs.rhs_integration`)."""
     u[X1] = y[X1] if not _regularised(side) else math.sqrt(abs(y[X1] - y[X2]))
@@ -141,7 +141,7 @@ def _integration_state(side, y, t, u):
     u[TIME] = t
 
 
-@numba.njit(cache=True)
+@kernel
 def _phase_tolerances(side, atol, out):
     """Absolute tolerances of the integration state: ``atol`` is (x1, x2, v1, v2, W, t, w).
 
@@ -155,7 +155,7 @@ def _phase_tolerances(side, atol, out):
     out[WORK] = math.inf
 
 
-@numba.njit(cache=True)
+@kernel
 def _events(code, c, mode, side, energy_limit, u, y, f, force, g):
     """Event values at ``u`` (physical ``y``, ``f``, ``force``) into ``g``."""
     event_values(code, c, y, f, force, mode, energy_limit, g)
@@ -163,7 +163,7 @@ def _events(code, c, mode, side, energy_limit, u, y, f, force, g):
         g[DELTA] = side * u[0]  # delta = side w^2 keeps its sign through its root; w changes sign there
 
 
-@numba.njit(cache=True)
+@kernel
 def _event_at(code, c, mode, side, energy_limit, target, column, F, u0, s0, h, s, us, ys, fs, gs):
     """Event function ``column`` at ``s`` on the dense output of the step; the pseudo column
     ``TIME_COLUMN`` is the physical time minus ``target`` (horizon and output times of a
@@ -176,7 +176,7 @@ def _event_at(code, c, mode, side, energy_limit, target, column, F, u0, s0, h, s
     return gs[column]
 
 
-@numba.njit(cache=True)
+@kernel
 def _brent(code, c, mode, side, energy_limit, target, column, F, u0, s0, h, xa, xb, fa, fb, us, ys, fs, gs):
     """Zero of event ``column`` in ``[xa, xb]`` (signs of ``fa``, ``fb`` differ): scipy's brentq."""
     xpre, xcur, fpre, fcur = xa, xb, fa, fb
@@ -212,7 +212,7 @@ def _brent(code, c, mode, side, energy_limit, target, column, F, u0, s0, h, xa, 
     return xcur
 
 
-@numba.njit(cache=True)
+@kernel
 def _locate(code, c, mode, side, energy_limit, column, F, u0, s0, h, s1, g_start, g_end, us, ys, fs, gs):
     """The first zero of event ``column`` in ``[s0, s1]`` on the dense output.
 
@@ -246,7 +246,7 @@ def _locate(code, c, mode, side, energy_limit, column, F, u0, s0, h, s1, g_start
     return _brent(code, c, mode, side, energy_limit, 0.0, column, F, u0, s0, h, a, b, ga, gb, us, ys, fs, gs)
 
 
-@numba.njit(cache=True)
+@kernel
 def _s_at_time(code, c, mode, side, F, u0, s0, h, time, us, ys, fs, gs):
     """Where on the step the physical time is ``time`` (it lies within the step): ``s`` itself in
     a plain phase, a root of ``t(s)`` on the dense output in a regularised one."""
@@ -265,7 +265,7 @@ def _s_at_time(code, c, mode, side, F, u0, s0, h, time, us, ys, fs, gs):
 _ADV_END, _ADV_STEP, _ADV_COLLAPSE, _ADV_LIMIT = range(4)
 
 
-@numba.njit(cache=True)
+@kernel
 def _quiet_start(quiet, y, mode, g):
     """Event values at a restart: the event the run restarts on, and ``delta`` or ``deltadot``
     when exactly zero, leave zero with a known sign (that of ``deltadot``, of the slip's mode) and
@@ -279,7 +279,7 @@ def _quiet_start(quiet, y, mode, g):
         g[quiet] = departure_sign(quiet, y, mode) * _TINY
 
 
-@numba.njit(cache=True, inline="always")  # the hot loop's own code: a call costs more than it
+@kernel(inline="always")  # the hot loop's own code: a call costs more than it
 def _dop853_attempt(code, c, mode, side, s, s_bound, u, fu, h_abs, rtol, atol, K, u_new, fu_new, tmp):
     """One accepted DOP853 step from ``(s, u)`` (at most to ``s_bound``), first try ``h_abs``.
 
@@ -316,7 +316,7 @@ def _dop853_attempt(code, c, mode, side, s, s_bound, u, fu, h_abs, rtol, atol, K
         rejected = True
 
 
-@numba.njit(cache=True)
+@kernel
 def _advance(code, c, mode, side, s, t_end, u, fu, y, f, force, h_abs, rtol, atol, max_step, w_floor, energy_limit,
              next_sample, steps_left, g_old, g_new, fired, K, u_new, fu_new, y_new, f_new, tmp, stats, stiff):
     """Take steps in ``s`` from ``(s, u)`` while nothing happens: no event crosses, no sample and
@@ -383,7 +383,7 @@ def _advance(code, c, mode, side, s, t_end, u, fu, y, f, force, h_abs, rtol, ato
     return _ADV_END, s, h, h_abs, h_next, force, force_new, steps, evaluations
 
 
-@numba.njit(cache=True)
+@kernel
 def _fresh_step(code, c, mode, side, s, u, fu, h, K, u_new, fu_new, tmp, stiff):
     """A step of exactly ``h`` from ``(s, u)`` with the phase's current method (the state at a
     root, a stop or the horizon); returns the evaluations spent."""
@@ -393,7 +393,7 @@ def _fresh_step(code, c, mode, side, s, u, fu, h, K, u_new, fu_new, tmp, stiff):
     return 12
 
 
-@numba.njit(cache=True)
+@kernel
 def _polish_root(code, c, mode, side, energy_limit, column, s, u, fu, s_end, g_start, g_end, x, K, u_r, fu_r, tmp,
                  stiff, ys, fs, gs):
     """Refine the root ``x`` of event ``column`` (found on the step's interpolant) on steps from
@@ -436,7 +436,7 @@ def _polish_root(code, c, mode, side, energy_limit, column, s, u, fu, s_end, g_s
     return best, evaluations
 
 
-@numba.njit(cache=True)
+@kernel
 def _interpolant(code, c, mode, side, u, fu, u_new, fu_new, h, K, F, tmp, stiff):
     """The last step's interpolant into ``F``; returns the evaluations spent."""
     if radau5.active(stiff):
@@ -446,7 +446,7 @@ def _interpolant(code, c, mode, side, u, fu, u_new, fu_new, h, K, F, tmp, stiff)
     return 3
 
 
-@numba.njit(cache=True)
+@kernel
 def _phase_step(code, c, mode, side, u, fu, rtol, atol, t_end, max_step, w_floor, tmp, f1):
     """Initial step of a phase (scipy's rule), in its own independent variable."""
     interval = t_end - u[TIME]
@@ -458,7 +458,7 @@ def _phase_step(code, c, mode, side, u, fu, rtol, atol, t_end, max_step, w_floor
                                max_step if not _regularised(side) else max_step / max(abs(u[0]), w_floor), tmp, f1)
 
 
-@numba.njit(cache=True)
+@allocating
 def run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count, save_kind, times,
         max_steps, max_events, rk4_step, rk4_every, stiff_after):
     """Integrate one trajectory. See :func:`phaseimpact.integrate.simulate` for the meaning.
@@ -828,7 +828,7 @@ def run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count,
             s_t[:n_s], s_y[:n_s], s_mode[:n_s], s_force[:n_s], y)
 
 
-@numba.njit(cache=True)
+@allocating
 def _summarize(code, c, y0, y, mode, status, reason, t_stop, max_force, max_indentation, counts,
                n_ev, ev_t, ev_kind, ev_y, nsteps, nfev):
     """The summary vector of a run (indices ``S_*``); undefined entries are NaN."""
@@ -880,7 +880,7 @@ def _summarize(code, c, y0, y, mode, status, reason, t_stop, max_force, max_inde
     return s
 
 
-@numba.njit(cache=True)
+@kernel
 def stick_points(n_ev, ev_t, ev_kind, ev_y, t_stop, permanent, out_t, out_delta, out_dwell):
     """Stick phases of a log: time, ``delta*`` and dwell (to the next slip; to ``t_stop``, or
     inf if the last stick is permanent). Writes up to ``len(out_t)``; returns their number."""
@@ -902,7 +902,7 @@ def stick_points(n_ev, ev_t, ev_kind, ev_y, t_stop, permanent, out_t, out_delta,
     return n
 
 
-@numba.njit(cache=True, nogil=True)
+@allocating(nogil=True)
 def run_block(code, C, Y0, t_end, rtol, ATOL, max_step, settle, stop_kind, stop_count, max_steps, max_events,
               rk4_step, stiff_after, start, stop, summary, st_t, st_delta, st_dwell, st_count):
     """Runs ``start..stop-1`` of a batch, without the GIL (callers run blocks in threads; each run's

@@ -25,8 +25,7 @@ from __future__ import annotations
 
 import math
 
-import numba
-
+from .._jit import kernel
 from ..model.laws import ABRATE_BILATERAL, PAPER_PRINTED, PAPER_UNILATERAL, STUCK, force_partials, hertz_power
 from ..model.rhs import (
     ALPHA_,
@@ -68,17 +67,17 @@ RUNAWAY_ENERGY_FACTOR = 2.0
 GUARD_ENERGY_FACTOR = 100.0
 
 
-@numba.njit(cache=True)
+@kernel
 def is_filippov(code):
     return code == PAPER_PRINTED or code == PAPER_UNILATERAL
 
 
-@numba.njit(cache=True)
+@kernel
 def is_unilateral(code):
     return code != ABRATE_BILATERAL and code != PAPER_PRINTED
 
 
-@numba.njit(cache=True)
+@kernel
 def event_values(code, c, y, f, force, mode, energy_limit, g):
     """All event functions at ``y`` (``f`` its derivative, ``force`` its contact force) into ``g``.
 
@@ -109,7 +108,7 @@ def event_values(code, c, y, f, force, mode, energy_limit, g):
         g[REACH] = -(y[X1] + target_reach(c, y))
 
 
-@numba.njit(cache=True)
+@kernel
 def direction(column):
     """+1: the event fires on an increase through zero, -1: on a decrease, 0: on both (the table above).
     A branch, not a lookup in a global array: that costs an array per call in the hot loop."""
@@ -120,7 +119,7 @@ def direction(column):
     return -1
 
 
-@numba.njit(cache=True)
+@kernel
 def crossed(column, g_old, g_new):
     """Whether event ``column`` fires between two evaluations (strict start: a restart at a zero
     is quiet)."""
@@ -130,7 +129,7 @@ def crossed(column, g_old, g_new):
     return d <= 0 and g_old[column] > 0 and g_new[column] <= 0
 
 
-@numba.njit(cache=True)
+@kernel
 def departure_sign(column, y, mode):
     """Sign event ``column`` takes just after a run restarts on its zero at ``y``."""
     if column == DELTA:
@@ -143,7 +142,7 @@ def departure_sign(column, y, mode):
     return 1.0
 
 
-@numba.njit(cache=True)
+@kernel
 def restarts(code, column, mode, settle):
     """Whether an event of ``column`` changes the phase (restart) rather than being recorded."""
     if column == FORCE_RATE:
@@ -155,7 +154,7 @@ def restarts(code, column, mode, settle):
     return True
 
 
-@numba.njit(cache=True)
+@kernel
 def _stick_bound(code, c, y):
     delta = y[X1] - y[X2]
     if code == PAPER_UNILATERAL and delta <= 0:
@@ -163,7 +162,7 @@ def _stick_bound(code, c, y):
     return c[K_] * hertz_power(abs(delta), c[ALPHA_])
 
 
-@numba.njit(cache=True)
+@kernel
 def initial_mode(code, c, y):
     """Mode of a run starting at ``y``: the sign of ``deltadot``, or stuck (``paper``) when the
     relative velocity is zero and the stick bound holds (seed eq. 6 gives +1)."""
@@ -180,7 +179,7 @@ def initial_mode(code, c, y):
     return -1 if required < 0 else 1
 
 
-@numba.njit(cache=True)
+@kernel
 def transition(code, c, column, y, mode, settle):
     """Apply event ``column`` located at ``y`` (corrected in place).
 
@@ -227,7 +226,7 @@ def transition(code, c, column, y, mode, settle):
     return SETTLED, mode, (STOP_SETTLED if settle else GO_ON)
 
 
-@numba.njit(cache=True)
+@kernel
 def energy_limit_of(code, c, y0):
     """Energy at which a run counts as a runaway (a multiple of its own initial energy)."""
     e0 = energy(code, c, y0)

@@ -22,9 +22,9 @@ from __future__ import annotations
 
 import math
 
-import numba
 import numpy as np
 
+from .._jit import allocating, kernel
 from ..model.rhs import rhs_integration
 from .dop853 import N_STATE
 
@@ -75,19 +75,20 @@ WS_ROWS = 24
 N_CTL = 13
 
 
-@numba.njit(cache=True)
+@allocating
 def workspace(switch_after):
     """A fresh ``stiff`` tuple for one run: ``(ws, real LU, complex LU, complex vector, pivots, ctl,
-    state, derivative)``; the last two are the right-hand side's own arguments (whole arrays: a
-    row view passed to a compiled call costs more than the call)."""
+    state, derivative, start, start derivative)``; the last four are scratch states for the
+    right-hand side and :func:`fixed_step` (the kernels allocate nothing)."""
     ctl = np.zeros(N_CTL)
     ctl[SWITCH_AFTER] = switch_after  # 0: never (DOP853 throughout)
     return (np.zeros((WS_ROWS, N_STATE)), np.zeros((N_FEEDBACK, N_FEEDBACK)),
             np.zeros((N_FEEDBACK, N_FEEDBACK), np.complex128), np.zeros(N_STATE, np.complex128),
-            np.zeros((2, N_FEEDBACK), np.int64), ctl, np.zeros(N_STATE), np.zeros(N_STATE))
+            np.zeros((2, N_FEEDBACK), np.int64), ctl, np.zeros(N_STATE), np.zeros(N_STATE),
+            np.zeros(N_STATE), np.zeros(N_STATE))
 
 
-@numba.njit(cache=True)
+@kernel
 def reset(stiff):
     """A new phase starts explicit."""
     ctl = stiff[5]
@@ -95,32 +96,32 @@ def reset(stiff):
     ctl[COUNT] = 0.0
 
 
-@numba.njit(cache=True)
+@kernel
 def active(stiff):
     return stiff[5][ON] != 0.0
 
 
-@numba.njit(cache=True)
+@kernel
 def failed(stiff):
     """True once a step to a root could not be taken (the run must end with a failure status)."""
     return stiff[5][FAILED] != 0.0
 
 
-@numba.njit(cache=True)
+@kernel
 def watch(stiff, h_lambda):
     """Count accepted explicit steps with a large ``h lambda``."""
     ctl = stiff[5]
     ctl[COUNT] = ctl[COUNT] + 1.0 if h_lambda > STIFF_H_LAMBDA else 0.0
 
 
-@numba.njit(cache=True)
+@kernel
 def due(stiff):
     """True when the phase has turned stiff and the next step should be Radau's."""
     ctl = stiff[5]
     return ctl[ON] == 0.0 and ctl[SWITCH_AFTER] > 0.0 and ctl[COUNT] >= ctl[SWITCH_AFTER]
 
 
-@numba.njit(cache=True)
+@kernel
 def enter(code, c, mode, side, u, fu, rtol, atol, stiff):
     """Switch the phase to Radau at ``(u, fu)``; returns the evaluations spent (the Jacobian)."""
     ws, ctl = stiff[0], stiff[5]
@@ -137,7 +138,7 @@ def enter(code, c, mode, side, u, fu, rtol, atol, stiff):
     return jacobian(code, c, mode, side, u, fu, stiff)
 
 
-@numba.njit(cache=True)
+@kernel
 def jacobian(code, c, mode, side, u, fu, stiff):
     """Forward-difference Jacobian columns of the feedback components into ``ws[J_]``."""
     ws, ctl, tmp, ftmp = stiff[0], stiff[5], stiff[6], stiff[7]
@@ -154,7 +155,7 @@ def jacobian(code, c, mode, side, u, fu, stiff):
     return N_FEEDBACK
 
 
-@numba.njit(cache=True, inline="always")
+@kernel(inline="always")
 def _lu(A, piv):
     """In-place LU with partial pivoting (real or complex), the diagonal stored inverted (the
     solves multiply: a complex division costs several multiplications); False when singular."""
@@ -183,7 +184,7 @@ def _lu(A, piv):
     return True
 
 
-@numba.njit(cache=True, inline="always")
+@kernel(inline="always")
 def _solve(A, piv, b):
     """Solve ``A x = b`` in place with the factors of :func:`_lu` (the first ``len(A)`` entries of ``b``)."""
     for k in range(N_FEEDBACK):
@@ -202,7 +203,7 @@ def _solve(A, piv, b):
         b[i] = acc * A[i, i]
 
 
-@numba.njit(cache=True, inline="always")
+@kernel(inline="always")
 def _factorize(h, stiff):
     """LU of the feedback blocks of ``MU_REAL/h I - J`` and ``MU_COMPLEX/h I - J``; False when singular."""
     ws, lu_real, lu_complex, piv = stiff[0], stiff[1], stiff[2], stiff[4]
@@ -215,7 +216,7 @@ def _factorize(h, stiff):
     return _lu(lu_real, piv[0]) and _lu(lu_complex, piv[1])
 
 
-@numba.njit(cache=True, inline="always")
+@kernel(inline="always")
 def _solve_system(lu, piv, ws, h_over_mu, b):
     """Solve ``(mu/h I - J) x = b`` in place: the feedback block by its LU, the quadrature rows
     (whose columns of ``J`` are zero) by substitution."""
@@ -227,7 +228,7 @@ def _solve_system(lu, piv, ws, h_over_mu, b):
         b[q] = acc * h_over_mu
 
 
-@numba.njit(cache=True, inline="always")
+@kernel(inline="always")
 def _norm(ws, row, n_rows, scale_row):
     """RMS of rows ``row..row+n_rows-1`` of ``ws`` on the scale ``ws[scale_row]``; inf when not finite."""
     acc = 0.0
@@ -237,11 +238,11 @@ def _norm(ws, row, n_rows, scale_row):
     return math.sqrt(acc / (n_rows * N_STATE)) if math.isfinite(acc) else math.inf
 
 
-@numba.njit(cache=True, inline="always")
+@kernel(inline="always")
 def _collocation(code, c, mode, side, u, h, newton_tol, stiff):
     """Simplified Newton on the collocation system from the guess in ``ws[Z_]``; returns
     ``(converged, iterations, rate, evaluations)`` with the solution in ``ws[Z_]``."""
-    ws, lu_real, lu_complex, zc, piv, ctl, tmp, ftmp = stiff
+    ws, lu_real, lu_complex, zc, piv, ctl, tmp, ftmp = stiff[:8]
     rtol = ctl[RTOL]
     mu_real = MU_REAL / h
     mu_complex = complex(MU_RE / h, MU_IM / h)
@@ -293,7 +294,7 @@ def _collocation(code, c, mode, side, u, h, newton_tol, stiff):
     return False, NEWTON_MAXITER, rate, evaluations
 
 
-@numba.njit(cache=True, inline="always")
+@kernel(inline="always")
 def _guess(s, h, stiff):
     """Starting stages from the last collocation polynomial when this step starts on it (at its
     end: the next step; at its start: a fresh step to a root inside it); zero otherwise."""
@@ -311,7 +312,7 @@ def _guess(s, h, stiff):
                              + ws[Q_ + 2, j] * (x * x * x - x0 * x0 * x0))
 
 
-@numba.njit(cache=True)
+@kernel
 def _predict(h_abs, h_old, err, err_old):
     """Gustafsson's predictive step factor (scipy's ``predict_factor``) before the safety factor."""
     if err == 0.0:
@@ -320,7 +321,7 @@ def _predict(h_abs, h_old, err, err_old):
     return min(1.0, multiplier) * err**-0.25
 
 
-@numba.njit(cache=True)
+@kernel
 def _solve_stages(code, c, mode, side, s, u, fu, h, stiff):
     """Converge the collocation system for a step ``h`` (new factors, a fresh Jacobian once if the
     old one fails); returns ``(converged, iterations, rate, evaluations)``."""
@@ -345,7 +346,7 @@ def _solve_stages(code, c, mode, side, s, u, fu, h, stiff):
         _guess(s, h, stiff)
 
 
-@numba.njit(cache=True, inline="always")
+@kernel(inline="always")
 def _finish(code, c, mode, side, s, s_end, h, u, u_new, fu_new, stiff):
     """``u_new``, ``fu_new`` from the converged stages; the polynomial kept for the next guess.
     Returns the contact force at ``u_new``."""
@@ -361,7 +362,7 @@ def _finish(code, c, mode, side, s, s_end, h, u, u_new, fu_new, stiff):
     return rhs_integration(code, c, u_new, mode, side, fu_new)
 
 
-@numba.njit(cache=True)
+@kernel
 def attempt(code, c, mode, side, s, s_bound, u, fu, h_abs, stiff, u_new, fu_new):
     """One accepted step from ``(s, u)`` (at most to ``s_bound``), first try ``h_abs``.
 
@@ -425,13 +426,12 @@ def attempt(code, c, mode, side, s, s_bound, u, fu, h_abs, stiff, u_new, fu_new)
     return True, s_new, h * factor, force_new, evaluations
 
 
-@numba.njit(cache=True)
+@kernel
 def fixed_step(code, c, mode, side, s, u, fu, h, stiff, u_new, fu_new):
     """A step of exactly ``h`` (to an event's root) without error control, split into equal
     sub-steps until Newton converges. Returns the evaluations spent."""
     evaluations = 0
-    start = np.empty(N_STATE)
-    f_start = np.empty(N_STATE)
+    start, f_start = stiff[8], stiff[9]
     for pieces in (1, 2, 4, 8, 16, 32, 64):
         part = h / pieces
         for j in range(N_STATE):
@@ -459,7 +459,7 @@ def fixed_step(code, c, mode, side, s, u, fu, h, stiff, u_new, fu_new):
     return evaluations
 
 
-@numba.njit(cache=True)
+@kernel
 def dense_coefficients(stiff, F):
     """The step's collocation polynomial in the driver's interpolant form (:func:`.dop853.dense_eval`:
     ``F0 x + F1 x(1-x) + F2 x^2(1-x)`` with the higher rows zero)."""

@@ -35,9 +35,9 @@ import functools
 import math
 from dataclasses import dataclass
 
-import numba
 import numpy as np
 
+from .._jit import kernel
 from ..parameters import Parameters, require, require_choice
 
 __all__ = [
@@ -52,7 +52,7 @@ STUCK, PLAIN = 0, 2
 CONTACT_READINGS = ("printed", "unilateral")
 
 
-@numba.njit(cache=True, inline="always")
+@kernel(inline="always")
 def hertz_power(ad, alpha):
     """``ad**alpha`` for ``ad >= 0``; Hertz's 3/2 as the cheaper ``ad*sqrt(ad)``."""
     if alpha == 1.5:
@@ -60,12 +60,12 @@ def hertz_power(ad, alpha):
     return ad**alpha
 
 
-@numba.njit(cache=True)
+@kernel
 def _sign(x):
     return 1.0 if x > 0 else (-1.0 if x < 0 else 0.0)
 
 
-@numba.njit(cache=True)
+@kernel
 def contact_force(code, delta, deltadot, mode, K, damping, alpha):
     """Contact force ``P`` (N, positive pushing the bodies apart) while slipping or free.
 
@@ -88,7 +88,7 @@ def contact_force(code, delta, deltadot, mode, K, damping, alpha):
     return (K + damping * deltadot) * hertz_power(abs(delta), alpha) * sign
 
 
-@numba.njit(cache=True)
+@kernel
 def force_partials(code, delta, deltadot, mode, K, damping, alpha):
     """``(dP/ddelta, dP/ddeltadot)`` of :func:`contact_force` (exact; zero where ``P`` is 0).
 
@@ -113,7 +113,7 @@ def force_partials(code, delta, deltadot, mode, K, damping, alpha):
     return sign * (K + damping * deltadot) * stiffness * _sign(delta), sign * damping * hertz_power(ad, alpha)
 
 
-@numba.njit(cache=True)
+@kernel
 def contact_potential(code, delta, K, alpha):
     """Potential of the elastic term, ``K |delta|^(alpha+1)/(alpha+1)`` (J), for the laws whose
     elastic term is conservative; 0 for ``paper``, whose elastic term acts like friction."""

@@ -17,9 +17,9 @@ from __future__ import annotations
 
 import math
 
-import numba
 import numpy as np
 
+from .._jit import kernel
 from ..parameters import Parameters
 from .laws import PLAIN, STUCK, ContactLaw, as_law, contact_force, contact_potential, force_partials, hertz_power
 
@@ -44,19 +44,19 @@ def pack(params: Parameters, law: ContactLaw) -> np.ndarray:
                      1.0 if springs else 0.0, 1.0 if params.target == "rigid" else 0.0])
 
 
-@numba.njit(cache=True)
+@kernel
 def spring_force(c, x2):
     """``S(x2) = Kb x2 + Km x2^3``, N."""
     return (c[KB_] + c[KM_] * x2 * x2) * x2
 
 
-@numba.njit(cache=True)
+@kernel
 def stick_force(c, y):
     """Force that keeps the projectile with the target while stuck, ``F_req``, N."""
     return c[M1_] / (c[M1_] + c[M2_]) * spring_force(c, y[X2])
 
 
-@numba.njit(cache=True)
+@kernel
 def rhs(code, c, y, mode, out):
     """Write ``dy/dt`` into ``out`` (shape (5,)); return the contact force ``P``, N."""
     x2, v1, v2 = y[X2], y[V1], y[V2]
@@ -83,7 +83,7 @@ def rhs(code, c, y, mode, out):
 PLAIN_PHASE, FLIGHT = 0, 2
 
 
-@numba.njit(cache=True)
+@kernel
 def contact_side(code, c, y, mode):
     """How the driver integrates the phase that starts at ``y`` in ``mode``.
 
@@ -108,7 +108,7 @@ def contact_side(code, c, y, mode):
     return side
 
 
-@numba.njit(cache=True)
+@kernel
 def rhs_integration(code, c, u, mode, side, out):
     """Write ``du/ds`` into ``out`` (shape (6,)) for a phase of kind ``side`` (:func:`contact_side`);
     return the contact force, N.
@@ -145,7 +145,7 @@ def rhs_integration(code, c, u, mode, side, out):
     return force
 
 
-@numba.njit(cache=True, inline="always")
+@kernel(inline="always")
 def damping_rate(code, c, u, mode, side):
     """How fast the contact damps the relative motion at the integration state ``u`` of a phase
     of kind ``side``: ``dP/d(deltadot) (1/M1 + 1/M2)`` per unit of the phase's independent
@@ -160,7 +160,7 @@ def damping_rate(code, c, u, mode, side):
     return rate * abs(u[0]) if regularised else rate
 
 
-@numba.njit(cache=True)
+@kernel
 def energy(code, c, y):
     """Mechanical energy (docs/physics.md §4), J: kinetic + target springs + the contact potential
     of laws whose elastic term is conservative."""
@@ -171,7 +171,7 @@ def energy(code, c, y):
     return kinetic + springs + contact_potential(code, y[X1] - x2, c[K_], c[ALPHA_])
 
 
-@numba.njit(cache=True)
+@kernel
 def _orbit_amplitude(c, x2, v, mass):
     """Turning point of an oscillator of ``mass`` on the springs ``S`` through ``(x2, v)``, m."""
     orbit_energy = 0.5 * mass * v * v + (0.5 * c[KB_] + 0.25 * c[KM_] * x2 * x2) * x2 * x2
@@ -181,13 +181,13 @@ def _orbit_amplitude(c, x2, v, mass):
     return math.sqrt(4.0 * orbit_energy / (c[KB_] + root))
 
 
-@numba.njit(cache=True)
+@kernel
 def target_reach(c, y):
     """Largest ``|x2|`` the target can reach with its current energy, m."""
     return _orbit_amplitude(c, y[X2], y[V2], c[M2_])
 
 
-@numba.njit(cache=True)
+@kernel
 def stick_orbit(c, y):
     """Amplitude ``A`` of the stuck pair's orbit and the ``|x2|`` at which the stick breaks.
 
@@ -209,7 +209,7 @@ def stick_orbit(c, y):
     return amplitude, x_break
 
 
-@numba.njit(cache=True)
+@kernel
 def stick_margin(c, y):
     """Relative margin of a stick entered at ``y``: ``1 - M1/M S(A) / (K |delta*|^alpha)``.
 
@@ -226,7 +226,7 @@ def stick_margin(c, y):
     return 1.0 - required / bound
 
 
-@numba.njit(cache=True)
+@kernel
 def stick_break_distance(c, y):
     """Stick-break event function, monotone along each half-swing of the stuck pair, m.
 
@@ -274,14 +274,14 @@ def jacobian(y, params: Parameters, law, mode: int = 1) -> np.ndarray:
     return J
 
 
-@numba.njit(cache=True)
+@kernel
 def _force_of_states(code, c, ys, modes, out):
     work = np.empty(5)
     for i in range(ys.shape[0]):
         out[i] = rhs(code, c, ys[i], modes[i], work)
 
 
-@numba.njit(cache=True)
+@kernel
 def _energy_of_states(code, c, ys, out):
     for i in range(ys.shape[0]):
         out[i] = energy(code, c, ys[i])
