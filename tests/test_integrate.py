@@ -304,3 +304,24 @@ def test_a_step_to_a_root_that_cannot_converge_is_a_failure_not_a_state():
     broken[2] = np.nan
     radau5.fixed_step(law.code, c, 1, 1, 0.0, broken, fu, 1e-4, stiff, good, f_good)
     assert radau5.failed(stiff)
+
+
+def test_engine_kernels_are_compiled_without_reference_counting():
+    """Every compiled function of the engine is declared through ``phaseimpact._jit``, and only the
+    few that create arrays keep numba's reference counting: a plain ``numba.njit`` on a helper would
+    bring back an incref and a decref of every array argument at every call (more than half the
+    time of a trajectory)."""
+    from numba.core.registry import CPUDispatcher
+
+    from phaseimpact.integrate import _dop853_stages, dop853, driver, events, radau5
+    from phaseimpact.model import laws
+    from phaseimpact.model import rhs as rhs_module
+
+    counted = set()
+    for module in (laws, rhs_module, events, _dop853_stages, dop853, radau5, driver):
+        for name, obj in vars(module).items():
+            if isinstance(obj, CPUDispatcher) and obj.py_func.__module__ == module.__name__:
+                assert "_nrt" in obj.targetoptions, f"{module.__name__}.{name} is not declared through _jit"
+                if obj.targetoptions["_nrt"]:
+                    counted.add(name)
+    assert counted == {"run", "run_block", "_grow", "_push_event", "_push_sample", "_summarize", "workspace"}
