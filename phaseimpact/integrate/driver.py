@@ -915,7 +915,7 @@ def run_block(code, C, Y0, t_end, rtol, ATOL, max_step, settle, stop_kind, stop_
     atol = np.empty(ATOL.shape[1])
     for i in range(start, stop):
         # the run reads its own copies: a row of the shared batch arrays would share their reference
-        # count, which every compiled call updates, between the threads (a contended cache line)
+        # count, which run (an allocating function) updates, between the threads (a contended cache line)
         _copy(C[i], c, c.shape[0])
         _copy(Y0[i], y0, y0.shape[0])
         _copy(ATOL[i], atol, atol.shape[0])
