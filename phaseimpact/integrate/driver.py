@@ -78,16 +78,22 @@ _EPS = np.finfo(np.float64).eps
 
 # Copies go element by element on purpose: a slice or row assignment makes numba compile its
 # shape-mismatch error messages (string formatting), which was half of the first-ever compile.
+# The length comes from dst, not from an argument: a constant argument (5, N_STATE) would
+# compile a copy of the function for each value.
 @kernel
-def _copy(src, dst, n):
-    for j in range(n):
+def _copy(src, dst):
+    """``dst[:] = src[:len(dst)]``."""
+    for j in range(dst.shape[0]):
         dst[j] = src[j]
 
 
 @allocating
 def _grow(a, n):
+    """``a`` in an array twice as long, its first ``n`` rows kept."""
     b = np.empty((max(2 * a.shape[0], 16),) + a.shape[1:], a.dtype)
-    _copy(a.ravel(), b.ravel(), n * (a.size // max(a.shape[0], 1)))
+    flat_a, flat_b = a.ravel(), b.ravel()
+    for j in range(n * (a.size // max(a.shape[0], 1))):
+        flat_b[j] = flat_a[j]
     return b
 
 
@@ -100,7 +106,7 @@ def _push_event(ev_t, ev_kind, ev_mode, ev_y, ev_force, n, t, kind, mode, y, for
     ev_t[n] = t
     ev_kind[n] = kind
     ev_mode[n] = mode
-    _copy(y, ev_y[n], 5)
+    _copy(y, ev_y[n])
     ev_force[n] = force
     return ev_t, ev_kind, ev_mode, ev_y, ev_force, n + 1
 
@@ -111,7 +117,7 @@ def _push_sample(s_t, s_y, s_mode, s_force, n, t, y, mode, force):
     if n == s_t.shape[0]:
         s_t, s_y, s_mode, s_force = _grow(s_t, n), _grow(s_y, n), _grow(s_mode, n), _grow(s_force, n)
     s_t[n] = t
-    _copy(y, s_y[n], 5)
+    _copy(y, s_y[n])
     s_mode[n] = mode
     s_force[n] = force
     return s_t, s_y, s_mode, s_force, n + 1
@@ -256,10 +262,10 @@ def _s_at_time(code, c, mode, side, F, u0, s0, h, time, us, ys, fs, gs):
     fa = u0[TIME] - time
     if fa >= 0:
         return s0
-    fb = _event_at(code, c, mode, side, 0.0, time, TIME_COLUMN, F, u0, s0, h, s1, us, ys, fs, gs)
+    fb = _event_at(code, c, mode, side, 0.0, time, np.int64(TIME_COLUMN), F, u0, s0, h, s1, us, ys, fs, gs)
     if fb <= 0:
         return s1
-    return _brent(code, c, mode, side, 0.0, time, TIME_COLUMN, F, u0, s0, h, s0, s1, fa, fb, us, ys, fs, gs)
+    return _brent(code, c, mode, side, 0.0, time, np.int64(TIME_COLUMN), F, u0, s0, h, s0, s1, fa, fb, us, ys, fs, gs)
 
 
 _ADV_END, _ADV_STEP, _ADV_COLLAPSE, _ADV_LIMIT = range(4)
@@ -371,11 +377,11 @@ def _advance(code, c, mode, side, s, t_end, u, fu, y, f, force, h_abs, rtol, ato
         if any_fired or u_new[TIME] >= next_sample or (_regularised(side) and u_new[TIME] >= t_end):
             return _ADV_STEP, s, h, h_abs, h_next, force, force_new, steps, evaluations
         s = s_new
-        _copy(u_new, u, N_STATE)
-        _copy(fu_new, fu, N_STATE)
-        _copy(y_new, y, 5)
-        _copy(f_new, f, 5)
-        _copy(g_new, g_old, N_EVENTS)
+        _copy(u_new, u)
+        _copy(fu_new, fu)
+        _copy(y_new, y)
+        _copy(f_new, f)
+        _copy(g_new, g_old)
         force = force_new
         h_abs = h_next
         stats[0] = max(stats[0], force)
@@ -495,13 +501,13 @@ def run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count,
         ev_t[0] = 0.0
         ev_kind[0] = CONTACT
         ev_mode[0] = mode
-        _copy(y, ev_y[0], 5)
+        _copy(y, ev_y[0])
         ev_force[0] = force
         n_ev = 1
         counts[CONTACT] += 1
     if save_kind == SAVE_STEPS:
         s_t[0] = 0.0
-        _copy(y, s_y[0], 5)
+        _copy(y, s_y[0])
         s_mode[0] = mode
         s_force[0] = force
         n_s = 1
@@ -716,7 +722,7 @@ def run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count,
             # stopped at a recorded event: the state there from a fresh step that ends at it
             if stop_record > s:
                 nfev += _fresh_step(code, c, mode, side, s, u, fu, stop_record - s, K6, u_r, fu_r, tmp6, stiff)
-                _copy(u_r, u, N_STATE)
+                _copy(u_r, u)
                 if not _regularised(side):
                     u[TIME] = stop_record
             force = _physical(code, c, mode, side, u, y, f)
@@ -743,7 +749,7 @@ def run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count,
         if restart_col < 0 and s_horizon < math.inf:
             # a regularised phase reaches the horizon inside the step: the state there from a fresh step
             nfev += _fresh_step(code, c, mode, side, s, u, fu, s_horizon - s, K6, u_r, fu_r, tmp6, stiff)
-            _copy(u_r, u, N_STATE)
+            _copy(u_r, u)
             u[TIME] = t_end  # without the root finder's residue
             force = _physical(code, c, mode, side, u, y, f)
             max_force = max(max_force, force)
@@ -758,11 +764,11 @@ def run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count,
             if h_r > 0:
                 nfev += _fresh_step(code, c, mode, side, s, u, fu, h_r, K6, u_r, fu_r, tmp6, stiff)
             else:
-                _copy(u, u_r, N_STATE)
+                _copy(u, u_r)
             t = s_restart if not _regularised(side) else u_r[TIME]
             _physical(code, c, mode, side, u_r, y_r, f_r)
             kind, mode, action = transition(code, c, restart_col, y_r, mode, settle)
-            _copy(y_r, y, 5)
+            _copy(y_r, y)
             force = rhs(code, c, y, mode, f)
             new_side = contact_side(code, c, y, mode)
             _integration_state(new_side, y, t, u)
@@ -805,12 +811,12 @@ def run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count,
             continue
         # the whole step stands
         s = s_new
-        _copy(u_new, u, N_STATE)
-        _copy(fu_new, fu, N_STATE)
-        _copy(y_new, y, 5)
-        _copy(f_new, f, 5)
+        _copy(u_new, u)
+        _copy(fu_new, fu)
+        _copy(y_new, y)
+        _copy(f_new, f)
         force = force_new
-        _copy(g_new, g_old, N_EVENTS)
+        _copy(g_new, g_old)
         h_abs = h_next
         max_force = max(max_force, force)
         max_indentation = max(max_indentation, y[X1] - y[X2])
@@ -916,13 +922,13 @@ def run_block(code, C, Y0, t_end, rtol, ATOL, max_step, settle, stop_kind, stop_
     for i in range(start, stop):
         # the run reads its own copies: a row of the shared batch arrays would share their reference
         # count, which run (an allocating function) updates, between the threads (a contended cache line)
-        _copy(C[i], c, c.shape[0])
-        _copy(Y0[i], y0, y0.shape[0])
-        _copy(ATOL[i], atol, atol.shape[0])
+        _copy(C[i], c)
+        _copy(Y0[i], y0)
+        _copy(ATOL[i], atol)
         out = run(code, c, y0, t_end[i], rtol, atol, max_step[i], settle, stop_kind, stop_count,
                   np.int64(SAVE_SUMMARY), empty, max_steps, max_events, rk4_step, np.int64(1), stiff_after)
         s = out[0]
-        _copy(s, summary[i], N_SUMMARY)
+        _copy(s, summary[i])
         permanent = s[S_OUTCOME] == PERMANENT_STICK
         st_count[i] = stick_points(out[1].shape[0], out[1], out[2], out[4], s[S_T_STOP], permanent,
                                    st_t[i], st_delta[i], st_dwell[i])
