@@ -30,7 +30,7 @@ import numpy as np
 from . import __version__
 from ._atomic import check_target, exclusive
 from .case import SETTABLE
-from .integrate import RTOL_RANGE
+from .integrate import RTOL_RANGE, STATUSES
 from .model import LAWS
 from .parameters import TARGETS
 
@@ -669,8 +669,9 @@ def _grid_summary(result, out_path, setup: Setup) -> dict:
     computed = result.status >= 0
     failed = result.failed
     failures = {}
-    for name in result.status_names()[failed]:
-        failures[str(name)] = failures.get(str(name), 0) + 1
+    for code in result.status[failed]:
+        name = STATUSES[int(code)]
+        failures[name] = failures.get(name, 0) + 1
     axes = [{"name": a.name, "num": len(a.values), "start": float(a.values[0]), "stop": float(a.values[-1]),
              "log": bool(a.log)} for a in result.grid.axes]
     summary = {"out": out_path, **_law_fields(setup), "points": int(result.grid.size),

@@ -146,25 +146,29 @@ class SweepResult(ColumnAccess):
 
     def summary(self) -> dict:
         """Counts of outcomes and failures, for people."""
-        names, counts = np.unique(self.outcome_names(), return_counts=True)
+        names = drv.OUTCOMES + ("not computed",)
+        counts = np.bincount(np.where(self.outcome < 0, len(drv.OUTCOMES), self.outcome), minlength=len(names))
         return {"points": int(self.grid.size), "computed": int(np.count_nonzero(self.status >= 0)),
                 "failed": int(np.count_nonzero(self.failed)), "cut_by_horizon": int(np.count_nonzero(self.cut)),
-                "outcomes": {str(k): int(v) for k, v in zip(names, counts, strict=True)}}
+                "outcomes": {name: int(counts[i]) for i, name in sorted(enumerate(names), key=lambda x: x[1])
+                             if counts[i]}}
 
 
 _STICK_FIELDS = ("stick_point", "stick_t", "stick_delta", "stick_dwell")
 
 
 def _append(array: np.ndarray, part: np.ndarray) -> np.ndarray:
-    """``array`` followed by ``part``, in a buffer grown by doubling: appending chunk after chunk
-    costs time proportional to the data, not to the number of chunks times the data."""
+    """``array`` followed by ``part``, in a buffer grown geometrically: appending chunk after chunk
+    costs time proportional to the data, not to the number of chunks times the data. The factor
+    1.5 (not 2) keeps the spare capacity, and the peak while a buffer is copied, small (a 1e6-point
+    atlas holds 1.6 million stick points, 52 MB)."""
     n, m = len(array), len(part)
     base = array.base if isinstance(array.base, np.ndarray) and array.base.ndim == 1 else None
     if base is not None and base.dtype == array.dtype and len(base) >= n + m \
             and array.__array_interface__["data"][0] == base.__array_interface__["data"][0]:
         buffer = base
     else:
-        buffer = np.empty(max(2 * (n + m), 1024), dtype=array.dtype)
+        buffer = np.empty(max((3 * (n + m)) // 2, 1024), dtype=array.dtype)
         buffer[:n] = array
     buffer[n:n + m] = part
     return buffer[:n + m]
