@@ -263,12 +263,13 @@ def _slab_chunks(shape, target: int) -> tuple:
     return tuple(chunks)
 
 
-def _fixed(group, name, data, dtype, chunks, *, fill=None, fill_attr=True, units=None, dims=()):
+def _fixed(group, name, data, dtype, chunks, *, fill=None, fill_attr=True, units=None, dims=(), rows=None):
     """A dataset of fixed size whose chunks are allocated when it is made (writing into it later never
-    changes the file's metadata), holding ``data``."""
+    changes the file's metadata), holding ``data``; with ``rows`` (1-d), ``rows`` long, ``data`` first
+    and the fill value after it (spare rows, written without a padded copy of ``data``)."""
     dtype = np.dtype(dtype)
     fill = _fill_of(dtype) if fill is None else dtype.type(fill)
-    shape = np.shape(data)
+    shape = np.shape(data) if rows is None else (rows,)
     if 0 in shape:
         d = group.create_dataset(name, shape=shape, dtype=dtype, fillvalue=fill)
     else:
@@ -277,7 +278,14 @@ def _fixed(group, name, data, dtype, chunks, *, fill=None, fill_attr=True, units
         # every element is written just below: HDF5 need not write the fill value first
         d = group.create_dataset(name, shape=shape, dtype=dtype, chunks=chunks, fillvalue=fill, fill_time="never",
                                  dcpl=dcpl)
-        d[...] = data
+        if rows is None:
+            d[...] = data
+        else:
+            n = len(data)
+            if n:
+                d[:n] = data
+            for start in range(n, rows, chunks[0]):  # the spare rows, a chunk at a time
+                d[start:min(start + chunks[0], rows)] = np.full(min(chunks[0], rows - start), fill, dtype=dtype)
     if fill_attr:
         d.attrs["_FillValue"] = fill
     if units is not None:
@@ -466,14 +474,17 @@ def _sweep_layout(r: SweepResult) -> _Layout:
         raise ValueError("stick phases of points that are not computed (status -1) cannot be archived")
     if point.size:
         starts = np.concatenate([[0], np.flatnonzero(point[1:] != point[:-1]) + 1])
-        if np.unique(point[starts]).size != starts.size:  # a point's rows are apart: group them, in order
+        in_order = bool((point[1:] >= point[:-1]).all())  # as a sweep computes them (cheap to check)
+        if not in_order and np.unique(point[starts]).size != starts.size:
+            # a point's rows are apart: group them, in order
             order = np.argsort(point, kind="stable")
             point = point[order]
             columns = [c[order] for c in columns]
             starts = np.concatenate([[0], np.flatnonzero(point[1:] != point[:-1]) + 1])
     else:
         starts = np.empty(0, dtype=np.int64)
-    count = np.where(computed, np.bincount(point, minlength=n), -1).astype(np.int64)
+    count = np.bincount(point, minlength=n).astype(np.int64, copy=False)
+    count[~computed] = -1
     first = np.full(n, -1, dtype=np.int64)
     first[point[starts]] = starts
     return _Layout(point, *columns, first, count)
@@ -523,17 +534,12 @@ def _write_sweep(f, r: SweepResult, created: str, layout: _Layout, spare_rows: i
     stick = _dimension(f, "stick", rows)
     row_chunks = (min(CHUNK_ROWS, max(rows, 1)),)
 
-    def padded(values, fill):
-        out = np.full(rows, fill, dtype=values.dtype)
-        out[:values.size] = values
-        return out
-
-    sp = _fixed(f, "stick_point", padded(layout.point, -1), np.int64, row_chunks, fill=-1, fill_attr=False,
-                units="1", dims=(stick,))
+    sp = _fixed(f, "stick_point", layout.point, np.int64, row_chunks, fill=-1, fill_attr=False, units="1",
+                dims=(stick,), rows=rows)
     sp.attrs["instance_dimension"] = "point"
     for name, values, units in (("stick_t", layout.t, "s"), ("stick_delta", layout.delta, "m"),
                                 ("stick_dwell", layout.dwell, "s")):
-        _fixed(f, name, padded(values, np.nan), float, row_chunks, units=units, dims=(stick,))
+        _fixed(f, name, values, float, row_chunks, units=units, dims=(stick,), rows=rows)
     if r.extras:
         _write_tree(f.create_group("extras"), r.extras)
 

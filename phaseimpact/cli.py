@@ -650,6 +650,7 @@ def _run_grid(args, setup: Setup, axes: list):
                     saved = ""
             print(f"phaseimpact: interrupted{saved}. Resume with:\n  {_resume_command(args.argv)}", file=sys.stderr)
             return None
+        del checkpoint  # its record of the file (per-point arrays) is not needed for the final write
         archive.save(result, out, force=args.force)
     return result
 
