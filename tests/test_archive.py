@@ -460,6 +460,31 @@ def test_checkpoint_cost_follows_the_new_points_not_the_file(tmp_path):
     assert big < len(big_after) / 10
 
 
+def test_spare_stick_rows_hold_fill_values_and_rows_out_of_point_order_keep_it(tmp_path):
+    """The first checkpoint keeps room for the stick phases to come (written a chunk at a time after
+    the data): every spare row reads as no point (-1) and NaN. Chunks stored out of point order (a
+    recomputed point, another backend's order) keep their order in the final archive: each point's
+    rows are together already."""
+    grid = big_grid(40)  # 4000 points
+    rng = np.random.default_rng(5)
+    result = SweepResult(grid, None, {"rtol": 1e-10, "engine": "synthetic", "version": "test"})
+    path = tmp_path / "spare.h5"
+    result.store(np.arange(2000, 2500), synthetic(500, rng))
+    archive.Checkpoint(path, fsync=False)(result)
+    rows = len(result.stick_point)
+    with h5py.File(path, "r") as f:
+        point = f["stick_point"][()]
+        assert point.size > rows + 4096  # spare rows for the 3500 points to come, over several chunks
+        assert same_bits(point[:rows], result.stick_point) and (point[rows:] == -1).all()
+        for name in ("stick_t", "stick_delta", "stick_dwell"):
+            assert np.isnan(f[name][rows:]).all() and not np.isnan(f[name][:rows]).any()
+    result.store(np.arange(0, 2000), synthetic(2000, rng))  # rows of lower points after higher ones
+    archive.save(result, path, force=True)
+    back = archive.load(path)
+    assert back.stick_point[0] == 2000 and back.stick_point[-1] == 1999
+    assert_same_result(back, result)
+
+
 def test_checkpoint_rewrites_the_file_when_its_stick_rows_run_out(tmp_path):
     grid = big_grid(20)
     rng = np.random.default_rng(3)
