@@ -514,7 +514,7 @@ def cmd_critical(args) -> int:
     _check_critical_law(law)
     _check_kappa_range(args)
     _note(f"locating kappa_c and kappa_2 of {law.label()} at v = {params.v:g} m/s"
-          + (" and measuring the exponents (about 15 s)" if args.exponents else ""))
+          + (" and measuring the exponents (about 1 s)" if args.exponents else ""))
     result = critical_damping(params, law, kappa_min=args.kappa_min, kappa_max=args.kappa_max,
                               rtol=args.kappa_rtol, integrator_rtol=args.rtol, with_kappa_2=True,
                               with_exponents=args.exponents)
@@ -1209,7 +1209,7 @@ def build_parser() -> argparse.ArgumentParser:
     kappa_range(p, False, " (default: 1e-8 K/v)")
     p.add_argument("--exponents", action="store_true",
                    help="also measure the adding-sliding exponents (slip speed ~ eps^1.5, stick offset ~ eps^2; "
-                        "about 15 s)")
+                        "about 1 s)")
     json_option(p)
     p.set_defaults(func=cmd_critical)
 
