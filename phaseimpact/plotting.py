@@ -225,9 +225,12 @@ def plot_atlas(result, *, contours: str | None = None, curves=()):
     """
     from matplotlib.colors import BoundaryNorm, ListedColormap
 
+    from .integrate import OUTCOMES
+
     ax0, ax1 = result.grid.axes
     names = list(OUTCOME_COLOURS)
-    codes = np.array([names.index(str(n)) for n in result.outcome_names()]).reshape(result.shape)
+    colour_of = np.array([names.index(n) for n in (*OUTCOMES, "not computed")])  # outcome code -> colour
+    codes = colour_of[np.where(result.outcome < 0, len(OUTCOMES), result.outcome)].reshape(result.shape)
     with style():
         fig, axes = figure(1, 1, width=6.6, height=4.4)
         ax = axes[0, 0]
@@ -242,7 +245,7 @@ def plot_atlas(result, *, contours: str | None = None, curves=()):
         ax.set_xlabel(axis_label(ax0.name))
         ax.set_ylabel(axis_label(ax1.name))
         ax.grid(False)
-        present = set(result.outcome_names())
+        present = {names[i] for i in np.unique(codes)}
         if contours:
             count = np.asarray(result.values[contours], dtype=float).reshape(result.shape)
             count[result.status.reshape(result.shape) != 0] = np.nan
