@@ -325,3 +325,40 @@ def test_engine_kernels_are_compiled_without_reference_counting():
                 if obj.targetoptions["_nrt"]:
                     counted.add(name)
     assert counted == {"run", "run_block", "_grow", "_push_event", "_push_sample", "_summarize", "workspace"}
+
+
+def test_no_kernel_returns_an_array():
+    """A kernel (compiled without reference counting) that returned an array to a counting caller
+    would have it freed under its owner (memory corruption): every compiled overload of every
+    kernel returns scalars or tuples of scalars. Read from numba's cache index after one call of
+    each entry (the overloads themselves stay in the callers' machine code)."""
+    from numba.core import types
+    from numba.core.registry import CPUDispatcher
+
+    from phaseimpact.integrate import _dop853_stages, dop853, driver, events, radau5
+    from phaseimpact.model import laws
+    from phaseimpact.model import rhs as rhs_module
+
+    p = SEED.replace(kappa=3e9)
+    simulate(p, "hunt-crossley", 2e-3, save="steps")
+    simulate(p, "paper", None, stop_on="slip")
+    simulate(p, "paper", 2e-4, integrator="rk4")
+    simulate_many([p, p.replace(kappa=1e12)], "paper", n_threads=2)
+
+    def holds_array(t):
+        return isinstance(t, types.Array) or (isinstance(t, types.BaseTuple) and any(map(holds_array, t.types)))
+
+    def return_types(dispatcher):  # numba internals: the cache index lists each overload's argument types
+        index = dispatcher._cache._cache_file._load_index()
+        return [dispatcher._cache.load_overload(key[0], dispatcher.targetctx).signature.return_type for key in index]
+
+    assert any(holds_array(t) for t in return_types(driver._grow))  # the check sees an array return
+    checked = 0
+    for module in (laws, rhs_module, events, _dop853_stages, dop853, radau5, driver):
+        for name, obj in vars(module).items():
+            if isinstance(obj, CPUDispatcher) and obj.py_func.__module__ == module.__name__ \
+                    and not obj.targetoptions["_nrt"]:
+                for returned in return_types(obj):
+                    assert not holds_array(returned), f"{module.__name__}.{name} returns {returned}"
+                    checked += 1
+    assert checked >= 50  # every kernel the runs above compiled
