@@ -225,12 +225,12 @@ def plot_atlas(result, *, contours: str | None = None, curves=()):
     """
     from matplotlib.colors import BoundaryNorm, ListedColormap
 
-    from .integrate import OUTCOMES
+    from .continuation.sweep import OUTCOME_LABELS
 
     ax0, ax1 = result.grid.axes
     names = list(OUTCOME_COLOURS)
-    colour_of = np.array([names.index(n) for n in (*OUTCOMES, "not computed")])  # outcome code -> colour
-    codes = colour_of[np.where(result.outcome < 0, len(OUTCOMES), result.outcome)].reshape(result.shape)
+    colour_of = np.array([names.index(n) for n in OUTCOME_LABELS])
+    codes = colour_of[result.outcome_indices()].reshape(result.shape)
     with style():
         fig, axes = figure(1, 1, width=6.6, height=4.4)
         ax = axes[0, 0]

@@ -33,6 +33,10 @@ ENGINE = "phaseimpact driver: DOP853 (scipy tableau) with located events, numba"
 CHUNK_THREADS, CHUNK_MIN, CHUNK_MAX = 4096, 256, 65536
 
 
+#: The outcome classes and, last, the label of points not computed yet.
+OUTCOME_LABELS = drv.OUTCOMES + ("not computed",)
+
+
 @dataclass
 class SweepResult(ColumnAccess):
     """Columns of a grid of runs (points in C order over ``grid.axes``).
@@ -114,9 +118,12 @@ class SweepResult(ColumnAccess):
         """Points whose horizon ended the run before the outcome settled (counts are lower bounds)."""
         return self.stop_reason == drv.HORIZON
 
+    def outcome_indices(self) -> np.ndarray:
+        """Each point's index into :data:`OUTCOME_LABELS` (the outcomes, then "not computed")."""
+        return np.where(self.outcome < 0, len(drv.OUTCOMES), self.outcome)
+
     def outcome_names(self) -> np.ndarray:
-        names = np.array(drv.OUTCOMES + ("not computed",), dtype=object)
-        return names[np.where(self.outcome < 0, len(drv.OUTCOMES), self.outcome)]
+        return np.array(OUTCOME_LABELS, dtype=object)[self.outcome_indices()]
 
     def status_names(self) -> np.ndarray:
         names = np.array(drv.STATUSES + ("not computed",), dtype=object)
@@ -146,11 +153,10 @@ class SweepResult(ColumnAccess):
 
     def summary(self) -> dict:
         """Counts of outcomes and failures, for people."""
-        names = drv.OUTCOMES + ("not computed",)
-        counts = np.bincount(np.where(self.outcome < 0, len(drv.OUTCOMES), self.outcome), minlength=len(names))
+        counts = np.bincount(self.outcome_indices(), minlength=len(OUTCOME_LABELS))
         return {"points": int(self.grid.size), "computed": int(np.count_nonzero(self.status >= 0)),
                 "failed": int(np.count_nonzero(self.failed)), "cut_by_horizon": int(np.count_nonzero(self.cut)),
-                "outcomes": {name: int(counts[i]) for i, name in sorted(enumerate(names), key=lambda x: x[1])
+                "outcomes": {name: int(counts[i]) for i, name in sorted(enumerate(OUTCOME_LABELS), key=lambda x: x[1])
                              if counts[i]}}
 
 

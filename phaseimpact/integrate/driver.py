@@ -91,9 +91,7 @@ def _copy(src, dst):
 def _grow(a, n):
     """``a`` in an array twice as long, its first ``n`` rows kept."""
     b = np.empty((max(2 * a.shape[0], 16),) + a.shape[1:], a.dtype)
-    flat_a, flat_b = a.ravel(), b.ravel()
-    for j in range(n * (a.size // max(a.shape[0], 1))):
-        flat_b[j] = flat_a[j]
+    _copy(a.ravel(), b.ravel()[:n * (a.size // max(a.shape[0], 1))])
     return b
 
 
