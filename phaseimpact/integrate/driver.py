@@ -22,8 +22,21 @@ import numpy as np
 
 from .._jit import allocating, kernel
 from ..model.laws import PLAIN, STUCK
-from ..model.rhs import V1, V2, WORK, X1, X2, contact_side, damping_rate, energy, rhs, rhs_integration, stick_margin
-from . import dop853, radau5
+from ..model.rhs import (
+    FLIGHT,
+    V1,
+    V2,
+    WORK,
+    X1,
+    X2,
+    contact_side,
+    damping_rate,
+    energy,
+    rhs,
+    rhs_integration,
+    stick_margin,
+)
+from . import dop853, flight, radau5
 from .dop853 import N_STATE
 from .events import (
     CONTACT,
@@ -145,6 +158,16 @@ def _integration_state(side, y, t, u):
     u[TIME] = t
 
 
+@kernel(inline="always")  # in the root finders' loops: a call costs more than it
+def _dense(c, side, F, u0, s0, h, s, out):
+    """The integration state at ``s`` inside the step ``[s0, s0 + h]`` from ``u0``: the flight's
+    closed form, or the interpolant ``F`` of the step (:func:`_interpolant`)."""
+    if side == FLIGHT:
+        flight.state_at(c, F, u0, s0, s, out)
+    else:
+        dop853.dense_eval(F, u0, s0, h, s, out)
+
+
 @kernel
 def _phase_tolerances(side, atol, out):
     """Absolute tolerances of the integration state: ``atol`` is (x1, x2, v1, v2, W, t, w).
@@ -172,7 +195,7 @@ def _event_at(code, c, mode, side, energy_limit, target, column, F, u0, s0, h, s
     """Event function ``column`` at ``s`` on the dense output of the step; the pseudo column
     ``TIME_COLUMN`` is the physical time minus ``target`` (horizon and output times of a
     regularised phase, where ``t`` is a component of the state)."""
-    dop853.dense_eval(F, u0, s0, h, s, us)
+    _dense(c, side, F, u0, s0, h, s, us)
     if column == TIME_COLUMN:
         return us[TIME] - target
     force = _physical(code, c, mode, side, us, ys, fs)
@@ -217,6 +240,50 @@ def _brent(code, c, mode, side, energy_limit, target, column, F, u0, s0, h, xa, 
 
 
 @kernel
+def _flight_rate(column, y, f):
+    """The time derivative of event ``column`` in a flight, where ``delta``, ``deltadot`` and the
+    reach test are the events that can fire (NaN for the others)."""
+    if column == DELTA:
+        return y[V1] - y[V2]
+    if column == DELTADOT:
+        return f[V1] - f[V2]
+    if column == REACH:
+        return -y[V1]  # -(x1 + A), the reach A constant in a flight
+    return math.nan
+
+
+@kernel
+def _flight_root(code, c, mode, side, energy_limit, column, F, u0, s0, h, a, b, fa, fb, us, ys, fs, gs):
+    """Zero of event ``column`` in ``[a, b]`` (signs of ``fa``, ``fb`` differ) of a flight: Newton's
+    method on the closed form with the event's exact rate, kept inside the bracket (bisection
+    where it would leave it). Three or four evaluations where Brent's method on the same bracket
+    takes ten or more, each an elliptic function."""
+    # converged when the Newton correction is below 1e-14 of the bracket: the next one would be
+    # below rounding (quadratic convergence); the event values' own rounding keeps the correction
+    # from shrinking to machine epsilon of s
+    tol = 1e-14 * (b - a) + 4.0 * _EPS * abs(b)
+    x = a - fa * (b - a) / (fb - fa)
+    for _ in range(100):
+        g = _event_at(code, c, mode, side, energy_limit, 0.0, column, F, u0, s0, h, x, us, ys, fs, gs)
+        if g == 0:
+            return x
+        left = (g < 0) == (fa < 0)
+        if left:
+            a, fa = x, g
+        else:
+            b, fb = x, g
+        rate = _flight_rate(column, ys, fs)
+        step = g / rate if rate != 0 else math.inf
+        inward = step < 0 if left else step > 0  # towards the bracket's other end, where the root is
+        if b - a <= tol or (inward and abs(step) <= tol):
+            return x
+        x -= step
+        if not (a < x < b):
+            x = 0.5 * (a + b)
+    return x
+
+
+@kernel
 def _locate(code, c, mode, side, energy_limit, column, F, u0, s0, h, s1, g_start, g_end, us, ys, fs, gs):
     """The first zero of event ``column`` in ``[s0, s1]`` on the dense output.
 
@@ -247,6 +314,8 @@ def _locate(code, c, mode, side, energy_limit, column, F, u0, s0, h, s1, g_start
             return -math.inf  # the excursion is below what the step resolves: the caller shrinks it
     if gb == 0 or ga * gb > 0:
         return b
+    if side == FLIGHT and not math.isnan(_flight_rate(column, ys, fs)):
+        return _flight_root(code, c, mode, side, energy_limit, column, F, u0, s0, h, a, b, ga, gb, us, ys, fs, gs)
     return _brent(code, c, mode, side, energy_limit, 0.0, column, F, u0, s0, h, a, b, ga, gb, us, ys, fs, gs)
 
 
@@ -321,12 +390,15 @@ def _dop853_attempt(code, c, mode, side, s, s_bound, u, fu, h_abs, rtol, atol, K
 
 
 @kernel
-def _advance(code, c, mode, side, s, t_end, u, fu, y, f, force, h_abs, rtol, atol, max_step, w_floor, energy_limit,
-             next_sample, steps_left, g_old, g_new, fired, K, u_new, fu_new, y_new, f_new, tmp, stats, stiff):
+def _advance(code, c, mode, side, s, t_end, u, fu, y, f, force, h_abs, rtol, atol, max_step, flight_step, w_floor,
+             energy_limit, next_sample, steps_left, g_old, g_new, fired, K, u_new, fu_new, y_new, f_new, tmp, stats,
+             stiff):
     """Take steps in ``s`` from ``(s, u)`` while nothing happens: no event crosses, no sample and
     (regularised phase) not the horizon falls inside. Accepted steps update ``u, fu, y, f, g_old``
     and the running extremes ``stats``. DOP853 until the phase turns stiff (:mod:`.radau5`), Radau
-    from then on.
+    from then on; a flight in closed form (:mod:`.flight`), in brackets of ``flight_step``, or to
+    ``t_end`` at once when no event can happen any more and ``flight_step`` is ``max_step`` (not
+    saving steps).
 
     Returns ``(result, s, h, h_abs, h_next, force, force_new, steps, evaluations)``: ``_ADV_STEP``
     leaves the last step (``h``, ``u_new``, ``fu_new``, ``y_new``, ``f_new``, ``g_new``, ``fired``)
@@ -342,16 +414,23 @@ def _advance(code, c, mode, side, s, t_end, u, fu, y, f, force, h_abs, rtol, ato
     while u[TIME] < t_end:
         if steps >= steps_left:
             return _ADV_LIMIT, s, h, h_abs, h_next, force, force_new, steps, evaluations
-        # a regularised phase advances the time by w ds: its cap on the time step is one on s
-        h_abs = min(h_abs, max_step if not _regularised(side) else max_step / max(abs(u[0]), w_floor))
-        if radau5.due(stiff):  # entered from an accepted state, so that every step has one method
-            evaluations += radau5.enter(code, c, mode, side, u, fu, rtol, atol, stiff)
-        if radau5.active(stiff):
-            ok, s_new, h_next, force_new, spent = radau5.attempt(code, c, mode, side, s, s_bound, u, fu, h_abs,
-                                                                 stiff, u_new, fu_new)
+        if side == FLIGHT:
+            h_abs = min(h_abs, flight_step)
+            s_new = s_bound if flight_step == max_step and flight.unreachable(c, u) else min(s + h_abs, s_bound)
+            flight.state_at(c, K, u, s, s_new, u_new)  # K: the flight's invariants (it has no stages)
+            force_new = rhs_integration(code, c, u_new, mode, side, fu_new)
+            ok, h_next, spent = True, flight_step, 0
         else:
-            ok, s_new, h_next, force_new, spent = _dop853_attempt(code, c, mode, side, s, s_bound, u, fu, h_abs,
-                                                                  rtol, atol, K, u_new, fu_new, tmp)
+            # a regularised phase advances the time by w ds: its cap on the time step is one on s
+            h_abs = min(h_abs, max_step if not _regularised(side) else max_step / max(abs(u[0]), w_floor))
+            if radau5.due(stiff):  # entered from an accepted state, so that every step has one method
+                evaluations += radau5.enter(code, c, mode, side, u, fu, rtol, atol, stiff)
+            if radau5.active(stiff):
+                ok, s_new, h_next, force_new, spent = radau5.attempt(code, c, mode, side, s, s_bound, u, fu, h_abs,
+                                                                     stiff, u_new, fu_new)
+            else:
+                ok, s_new, h_next, force_new, spent = _dop853_attempt(code, c, mode, side, s, s_bound, u, fu, h_abs,
+                                                                      rtol, atol, K, u_new, fu_new, tmp)
         evaluations += spent
         if not ok:
             return _ADV_COLLAPSE, s, h, h_next, h_next, force, force_new, steps, evaluations
@@ -365,7 +444,7 @@ def _advance(code, c, mode, side, s, t_end, u, fu, y, f, force, h_abs, rtol, ato
         else:
             force_new = _physical(code, c, mode, side, u_new, y_new, f_new)
             evaluations += 1
-        if not radau5.active(stiff):
+        if side != FLIGHT and not radau5.active(stiff):
             radau5.watch(stiff, h * damping_rate(code, c, u_new, mode, side))
         _events(code, c, mode, side, energy_limit, u_new, y_new, f_new, force_new, g_new)
         any_fired = False
@@ -391,6 +470,10 @@ def _advance(code, c, mode, side, s, t_end, u, fu, y, f, force, h_abs, rtol, ato
 def _fresh_step(code, c, mode, side, s, u, fu, h, K, u_new, fu_new, tmp, stiff):
     """A step of exactly ``h`` from ``(s, u)`` with the phase's current method (the state at a
     root, a stop or the horizon); returns the evaluations spent."""
+    if side == FLIGHT:
+        flight.state_at(c, K, u, s, s + h, u_new)  # K: the flight's invariants
+        rhs_integration(code, c, u_new, mode, side, fu_new)
+        return 0
     if radau5.active(stiff):
         return radau5.fixed_step(code, c, mode, side, s, u, fu, h, stiff, u_new, fu_new)
     dop853.step(code, c, mode, side, u, fu, h, K, u_new, fu_new, tmp)
@@ -442,7 +525,11 @@ def _polish_root(code, c, mode, side, energy_limit, column, s, u, fu, s_end, g_s
 
 @kernel
 def _interpolant(code, c, mode, side, u, fu, u_new, fu_new, h, K, F, tmp, stiff):
-    """The last step's interpolant into ``F``; returns the evaluations spent."""
+    """The last step's interpolant into ``F`` (a flight's invariants, see :func:`_dense`); returns the
+    evaluations spent."""
+    if side == FLIGHT:
+        _copy(K[0], F[0])  # the flight's invariants
+        return 0
     if radau5.active(stiff):
         radau5.dense_coefficients(stiff, F)
         return 0
@@ -456,6 +543,8 @@ def _phase_step(code, c, mode, side, u, fu, rtol, atol, t_end, max_step, w_floor
     interval = t_end - u[TIME]
     if interval <= 0:
         return 0.0  # the phase starts on the horizon (an event at t_end): no step follows
+    if side == FLIGHT:
+        return min(interval, max_step)  # closed form: the step only brackets events
     if _regularised(side):
         interval /= max(abs(u[0]), w_floor)
     return dop853.initial_step(code, c, mode, side, u, fu, rtol, atol, interval,
@@ -602,6 +691,8 @@ def run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count,
     K6 = np.empty((16, N_STATE))
     F6 = np.empty((7, N_STATE))
     w_floor = atol[6] / rtol  # the scale of w = sqrt(|delta|)
+    # a flight's steps only bracket events (an eighth of the target's period); a figure gets finer ones
+    flight_step = max_step if save_kind != SAVE_STEPS else max_step / 4
     side = contact_side(code, c, y, mode)
     _integration_state(side, y, 0.0, u)
     _phase_tolerances(side, atol, atol_u)
@@ -613,6 +704,8 @@ def run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count,
     _quiet_start(quiet, y, mode, g_old)
     h_abs = _phase_step(code, c, mode, side, u, fu, rtol, atol_u, t_end, max_step, w_floor, tmp6, fu_new)
     nfev += 1
+    if side == FLIGHT:
+        flight.coefficients(c, u, s, K6)  # kept in K6 for the whole flight (it has no stages)
 
     stats = np.empty(2)
     stiff = radau5.workspace(stiff_after)
@@ -626,8 +719,9 @@ def run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count,
             times[i_time] if save_kind == SAVE_TIMES and i_time < times.shape[0] else math.inf)
         stats[0], stats[1] = max_force, max_indentation
         result, s, h, h_abs, h_next, force, force_new, d_steps, d_fev = _advance(
-            code, c, mode, side, s, t_end, u, fu, y, f, force, h_abs, rtol, atol_u, max_step, w_floor, energy_limit,
-            next_sample, max_steps - nsteps, g_old, g_new, fired, K6, u_new, fu_new, y_new, f_new, tmp6, stats, stiff)
+            code, c, mode, side, s, t_end, u, fu, y, f, force, h_abs, rtol, atol_u, max_step, flight_step, w_floor,
+            energy_limit, next_sample, max_steps - nsteps, g_old, g_new, fired, K6, u_new, fu_new, y_new, f_new, tmp6,
+            stats, stiff)
         max_force, max_indentation = stats[0], stats[1]
         nsteps += d_steps
         nfev += d_fev
@@ -702,7 +796,7 @@ def run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count,
                 if radau5.active(stiff):  # the state from a step to the root: the polynomial is of order 3
                     nfev += _fresh_step(code, c, mode, side, s, u, fu, roots[best] - s, K6, us, fu_r, tmp6, stiff)
                 else:
-                    dop853.dense_eval(F6, u, s, h, roots[best], us)
+                    _dense(c, side, F6, u, s, h, roots[best], us)
                 f_ev = _physical(code, c, mode, side, us, ys, fs)
                 kind = FORCE_PEAK if best == FORCE_RATE else REVERSAL
                 if best == REACH:
@@ -730,7 +824,7 @@ def run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count,
             # samples up to where this step's motion stands: its end, the restart or the horizon
             t_seg = u_new[TIME]
             if restart_col >= 0:
-                dop853.dense_eval(F6, u, s, h, s_restart, us)
+                _dense(c, side, F6, u, s, h, s_restart, us)
                 t_seg = s_restart if not _regularised(side) else us[TIME]
             elif s_horizon < math.inf:
                 t_seg = t_end
@@ -738,8 +832,8 @@ def run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count,
                 if not have_dense:
                     nfev += _interpolant(code, c, mode, side, u, fu, u_new, fu_new, h, K6, F6, tmp6, stiff)
                     have_dense = True
-                dop853.dense_eval(F6, u, s, h, _s_at_time(code, c, mode, side, F6, u, s, h, times[i_time], us, ys,
-                                                          fs, gs), us)
+                _dense(c, side, F6, u, s, h, _s_at_time(code, c, mode, side, F6, u, s, h, times[i_time], us, ys, fs,
+                                                        gs), us)
                 f_i = _physical(code, c, mode, side, us, ys, fs)
                 s_t, s_y, s_mode, s_force, n_s = _push_sample(s_t, s_y, s_mode, s_force, n_s, times[i_time], ys,
                                                               mode, f_i)
@@ -781,6 +875,8 @@ def run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count,
                 nfev += 1
             else:
                 h_abs = max(h_next, h_r)
+            if side == FLIGHT:
+                flight.coefficients(c, u, s, K6)
             if kind == SILENT:  # a restart only (the pair at its centre): nothing to log
                 quiet = restart_col
                 _events(code, c, mode, side, energy_limit, u, y, f, force, g_old)

@@ -1,0 +1,173 @@
+r"""Free flight in closed form: the driver's stepper for phases without a contact force.
+
+Apart, the projectile moves uniformly and the target is a conservative oscillator of one degree
+of freedom (docs/physics.md §3)::
+
+    x1 = x1(0) + x1dot t,        M2 x2'' = -(Kb x2 + Km x2^3)
+
+The oscillator is Duffing's without damping, solved by Jacobi's elliptic cosine: with
+``a = Kb/M2``, ``b = Km/M2`` and the turning point ``A`` of its energy,
+``x2 = A cn(omega t + psi | m)``, ``x2dot = -A omega sn dn``, ``omega^2 = a + b A^2``,
+``m = b A^2 / (2 omega^2)`` (``0 <= m <= 1/2``); the harmonic case ``Km = 0`` is ``cos``/``sin``, a
+free target moves uniformly and a rigid one stays at 0. The state at any time of the phase is then
+exact to rounding, so a flight costs no right-hand sides, has no truncation error and needs no
+error control: steps are only the brackets in which events are looked for (an eighth of the
+target's period, as the DOP853 steps they replace), and once no event can happen any more the
+phase goes to its end in one step.
+
+``sn, cn, dn`` and the incomplete integral ``F(phi | m)`` are scipy's (``scipy.special.ellipj``,
+``ellipkinc``; Cephes), called from compiled code through their C entry points in
+``scipy.special.cython_special``, registered under a fixed symbol name so that numba's on-disk
+cache stays valid across processes.
+
+The orbit's invariants (kind, ``A``, ``omega``, ``m``, and ``psi`` at a reference ``s``) are
+computed once per flight, at its start (:func:`coefficients`, into the first row of an array of
+the driver's, ``F[1]`` being scratch for the elliptic functions' outputs): a step then costs one
+evaluation of ``sn, cn, dn``.
+"""
+
+from __future__ import annotations
+
+import math
+
+import llvmlite.binding as llvm
+import numba
+import scipy.special
+from numba import types
+from numba.extending import get_cython_function_address
+
+from .._jit import kernel
+from ..model.rhs import KB_, KM_, M2_, RIGID_, SPRINGS_, V1, V2, WORK, X1, X2
+
+__all__ = ["coefficients", "state_at", "unreachable"]
+
+if numba.config.DISABLE_JIT:  # the uncompiled engine (tests): scipy's Python functions
+    def _jacobi(u, m, out):
+        """``sn, cn, dn`` of ``(u | m)`` into ``out[:3]`` (``out[3]``: the amplitude ``phi``)."""
+        out[0], out[1], out[2], out[3] = scipy.special.ellipj(u, m)
+
+    def _first_kind(phi, m):
+        """``F(phi | m)``."""
+        return scipy.special.ellipkinc(phi, m)
+else:
+    llvm.add_symbol("phaseimpact_ellipj", get_cython_function_address("scipy.special.cython_special", "ellipj"))
+    llvm.add_symbol("phaseimpact_ellipkinc",
+                    get_cython_function_address("scipy.special.cython_special", "ellipkinc"))
+    _DOUBLE_P = types.CPointer(types.double)
+    _ellipj = types.ExternalFunction("phaseimpact_ellipj", types.void(types.double, types.double, _DOUBLE_P,
+                                                                       _DOUBLE_P, _DOUBLE_P, _DOUBLE_P))
+    _ellipkinc = types.ExternalFunction("phaseimpact_ellipkinc",
+                                        types.double(types.double, types.double, types.intc))
+
+    @kernel
+    def _jacobi(u, m, out):
+        """``sn, cn, dn`` of ``(u | m)`` into ``out[:3]`` (``out[3]``: the amplitude ``phi``)."""
+        _ellipj(u, m, out[0:].ctypes, out[1:].ctypes, out[2:].ctypes, out[3:].ctypes)
+
+    @kernel
+    def _first_kind(phi, m):
+        """``F(phi | m)``."""
+        return _ellipkinc(phi, m, 0)
+
+
+TIME = 5
+# Kinds of target motion.
+RIGID, FREE, HARMONIC, DUFFING = range(4)
+# Layout of F[0].
+_KIND, _AMPLITUDE, _OMEGA, _M, _PSI, _S_REF = range(6)
+
+
+@kernel
+def coefficients(c, u, s, F):
+    """The invariants of the flight through the integration state ``u`` at ``s`` into ``F[0]``."""
+    x2, v2 = u[X2], u[V2]
+    if c[RIGID_] > 0:
+        F[0, _KIND] = RIGID
+        return
+    if c[SPRINGS_] == 0 or (c[KB_] == 0 and c[KM_] == 0):
+        F[0, _KIND] = FREE
+        return
+    a = c[KB_] / c[M2_]
+    b = c[KM_] / c[M2_]
+    if b == 0:
+        F[0, _KIND] = HARMONIC
+        F[0, _OMEGA] = math.sqrt(a)
+        return
+    F[0, _KIND] = DUFFING
+    energy = 0.5 * v2 * v2 + (0.5 * a + 0.25 * b * x2 * x2) * x2 * x2  # per unit mass
+    if energy <= 0:
+        F[0, _AMPLITUDE] = 0.0
+        return
+    amplitude = math.sqrt(4.0 * energy / (a + math.sqrt(a * a + 4.0 * b * energy)))
+    omega = math.sqrt(a + b * amplitude * amplitude)
+    m = 0.5 * b * amplitude * amplitude / (omega * omega)
+    # the amplitude phi of psi: cos(phi) = cn = x2 / A; sin(phi) = sn from sn dn = -v2 / (A omega),
+    # the root of m s^4 - s^2 + q^2 = 0 below 1 (atan2 of both: accurate at the turning points and
+    # at the centre alike)
+    q = v2 / (amplitude * omega)
+    s2 = 2.0 * q * q / (1.0 + math.sqrt(max(0.0, 1.0 - 4.0 * m * q * q)))
+    phi = math.atan2(-math.copysign(math.sqrt(min(s2, 1.0)), v2), min(1.0, max(-1.0, x2 / amplitude)))
+    F[0, _AMPLITUDE] = amplitude
+    F[0, _OMEGA] = omega
+    F[0, _M] = m
+    F[0, _PSI] = _first_kind(phi, m)
+    F[0, _S_REF] = s
+
+
+@kernel
+def state_at(c, F, u0, s0, s, out):
+    """The integration state at ``s`` of the flight that was at ``u0`` at ``s0`` (its invariants in
+    ``F[0]``, from :func:`coefficients`); the time is ``s`` itself (a plain phase). At ``s0`` it
+    is ``u0`` exactly, as an interpolant is at its step's start: an event the run restarted on is
+    zero there, not a rounding residue that a root finder could take for a crossing."""
+    if s == s0:
+        for j in range(6):
+            out[j] = u0[j]
+        return
+    tau = s - s0
+    out[X1] = u0[X1] + u0[V1] * tau
+    out[V1] = u0[V1]
+    out[WORK] = u0[WORK]
+    out[TIME] = s
+    kind = F[0, _KIND]
+    if kind == RIGID:
+        out[X2] = u0[X2]
+        out[V2] = u0[V2]
+    elif kind == FREE:
+        out[X2] = u0[X2] + u0[V2] * tau
+        out[V2] = u0[V2]
+    elif kind == HARMONIC:
+        omega = F[0, _OMEGA]
+        cos_, sin_ = math.cos(omega * tau), math.sin(omega * tau)
+        out[X2] = u0[X2] * cos_ + u0[V2] / omega * sin_
+        out[V2] = u0[V2] * cos_ - u0[X2] * omega * sin_
+    elif F[0, _AMPLITUDE] == 0:
+        out[X2] = 0.0
+        out[V2] = 0.0
+    else:
+        amplitude, omega = F[0, _AMPLITUDE], F[0, _OMEGA]
+        scratch = F[1]
+        _jacobi(omega * (s - F[0, _S_REF]) + F[0, _PSI], F[0, _M], scratch)
+        out[X2] = amplitude * scratch[1]
+        out[V2] = -amplitude * omega * scratch[0] * scratch[2]
+
+
+@kernel
+def unreachable(c, u):
+    """Whether no event can happen any more in this flight: the projectile recedes beyond the
+    target's reach and faster than the target can move (so ``delta < 0`` and ``deltadot < 0``
+    from now on, and the energy is constant)."""
+    v1 = u[V1]
+    if c[RIGID_] > 0:
+        return v1 <= 0
+    if c[SPRINGS_] == 0:
+        return v1 - u[V2] <= 0
+    a = c[KB_] / c[M2_]
+    b = c[KM_] / c[M2_]
+    x2, v2 = u[X2], u[V2]
+    energy = 0.5 * v2 * v2 + (0.5 * a + 0.25 * b * x2 * x2) * x2 * x2
+    root = math.sqrt(a * a + 4.0 * b * energy)
+    amplitude = math.sqrt(4.0 * energy / (a + root)) if a + root > 0 else abs(x2)
+    # |x2dot| = A omega |sn dn| <= A omega; the margins cover the rounding of A and omega
+    speed = amplitude * math.sqrt(a + b * amplitude * amplitude)
+    return v1 <= 0 and u[X1] + (1.0 + 1e-12) * amplitude < 0 and -v1 > (1.0 + 1e-12) * speed
