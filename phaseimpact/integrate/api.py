@@ -221,15 +221,14 @@ def simulate(params: Parameters, law: ContactLaw | str = "paper", t_end: float |
     out = d.run(law.code, c, y0, horizon, rtol, default_atol if atol is None else _atol(params, rtol, atol),
                 s.max_step, settle, stop_kind, stop_count, save_kind, times, int(max_steps), MAX_EVENTS, rk4_step,
                 int(every), stiff_after)
-    summary, ev_t, ev_kind, ev_mode, ev_y, ev_force, s_t, s_y, s_mode, s_force, y_final = out
+    summary, event_log, samples, y_final = out
     status = d.STATUSES[int(summary[d.S_STATUS])]
     reason = d.STOP_REASONS[int(summary[d.S_REASON])]
     outcome = d.OUTCOMES[int(summary[d.S_OUTCOME])]
     method = "DOP853+Radau5" if stiff else "DOP853"
     name = f"rk4[step={rk4_step:.3g}]" if rk4_step else f"exact[{method}, rtol={rtol:g}]"
     return Trajectory(
-        t=s_t, y=s_y, force=s_force, mode=s_mode, event_t=ev_t, event_kind=ev_kind, event_mode=ev_mode,
-        event_y=ev_y, event_force=ev_force, params=params, law=law, initial_state=y0, final_state=y_final,
+        samples=samples, event_log=event_log, params=params, law=law, initial_state=y0, final_state=y_final,
         t_end=horizon, status=status, stop_reason=reason, outcome=outcome, summary=summary, integrator=name)
 
 
@@ -306,8 +305,7 @@ def run_batch(batch: Batch, *, rtol: float, settle: bool = True, stop_on=None, n
                     MAX_EVENTS, 0.0, 1, stiff_after)
         full = np.empty((3, k))
         s = out[0]
-        d.stick_points(len(out[1]), out[1], out[2], out[4], s[d.S_T_STOP], s[d.S_OUTCOME] == d.PERMANENT_STICK,
-                       full[0], full[1], full[2])
+        d.stick_points(out[1], s[d.S_T_STOP], s[d.S_OUTCOME] == d.PERMANENT_STICK, full[0], full[1], full[2])
         parts_t.append(full[0])
         parts_delta.append(full[1])
         parts_dwell.append(full[2])

@@ -24,6 +24,8 @@ from .._jit import allocating, kernel
 from ..model.laws import PLAIN, STUCK
 from ..model.rhs import (
     FLIGHT,
+    M2_,
+    RIGID_,
     V1,
     V2,
     WORK,
@@ -34,6 +36,7 @@ from ..model.rhs import (
     energy,
     rhs,
     rhs_integration,
+    spring_force,
     stick_margin,
 )
 from . import dop853, flight, radau5
@@ -58,6 +61,7 @@ from .events import (
     crossed,
     departure_sign,
     energy_limit_of,
+    event_value,
     event_values,
     initial_mode,
     restarts,
@@ -74,6 +78,12 @@ FAILED, PERMANENT_STICK, RATCHET_ESCAPE, REBOUND, RUNAWAY_OUTCOME, BOUNDED, UNSE
 OUTCOMES = ("failed", "permanent-stick", "ratchet-escape", "rebound", "runaway", "bounded", "unsettled")
 # Save kinds.
 SAVE_SUMMARY, SAVE_STEPS, SAVE_TIMES = range(3)
+# Columns of the event log and of the samples: one float array each, so that a run hands Python
+# four arrays (boxing each costs about 0.2 us; eleven were a tenth of a trajectory's time).
+EV_T, EV_KIND, EV_MODE, EV_Y, EV_FORCE = 0, 1, 2, 3, 8
+N_EV_COLUMNS = 9
+SMP_T, SMP_Y, SMP_FORCE, SMP_MODE = 0, 1, 6, 7
+N_SMP_COLUMNS = 8
 
 # Summary vector of one run (columns of many runs).
 (S_STATUS, S_REASON, S_OUTCOME, S_T_STOP, S_MAX_FORCE, S_MAX_INDENTATION, S_RESTITUTION,
@@ -109,29 +119,34 @@ def _grow(a, n):
 
 
 @allocating
-def _push_event(ev_t, ev_kind, ev_mode, ev_y, ev_force, n, t, kind, mode, y, force):
-    """Append an event to the log (grown by doubling); returns the arrays and the new length."""
-    if n == ev_t.shape[0]:
-        ev_t, ev_kind, ev_mode, ev_y, ev_force = (_grow(ev_t, n), _grow(ev_kind, n), _grow(ev_mode, n),
-                                                  _grow(ev_y, n), _grow(ev_force, n))
-    ev_t[n] = t
-    ev_kind[n] = kind
-    ev_mode[n] = mode
-    _copy(y, ev_y[n])
-    ev_force[n] = force
-    return ev_t, ev_kind, ev_mode, ev_y, ev_force, n + 1
+def _push_event(ev, n, t, kind, mode, y, force):
+    """Append an event to the log ``ev`` (columns ``EV_*``, grown by doubling); returns the log
+    and its new length."""
+    if n == ev.shape[0]:
+        ev = _grow(ev, n)
+    row = ev[n]
+    row[EV_T] = t
+    row[EV_KIND] = kind
+    row[EV_MODE] = mode
+    for j in range(5):
+        row[EV_Y + j] = y[j]
+    row[EV_FORCE] = force
+    return ev, n + 1
 
 
 @allocating
-def _push_sample(s_t, s_y, s_mode, s_force, n, t, y, mode, force):
-    """Append a sample (grown by doubling); returns the arrays and the new length."""
-    if n == s_t.shape[0]:
-        s_t, s_y, s_mode, s_force = _grow(s_t, n), _grow(s_y, n), _grow(s_mode, n), _grow(s_force, n)
-    s_t[n] = t
-    _copy(y, s_y[n])
-    s_mode[n] = mode
-    s_force[n] = force
-    return s_t, s_y, s_mode, s_force, n + 1
+def _push_sample(smp, n, t, y, mode, force):
+    """Append a sample to ``smp`` (columns ``SMP_*``, grown by doubling); returns the samples and
+    their new length."""
+    if n == smp.shape[0]:
+        smp = _grow(smp, n)
+    row = smp[n]
+    row[SMP_T] = t
+    for j in range(5):
+        row[SMP_Y + j] = y[j]
+    row[SMP_FORCE] = force
+    row[SMP_MODE] = mode
+    return smp, n + 1
 
 
 @kernel
@@ -141,11 +156,17 @@ def _regularised(side):
 
 
 @kernel
-def _physical(code, c, mode, side, u, y, f):
-    """Physical state ``y`` and ``dy/dt`` (``f``) at the integration state ``u``; returns the force."""
+def _physical_state(side, u, y):
+    """Physical state ``y`` at the integration state ``u``."""
     y[X1] = u[X1] if not _regularised(side) else u[X2] + side * u[0] * u[0]
     for j in range(1, 5):
         y[j] = u[j]
+
+
+@kernel
+def _physical(code, c, mode, side, u, y, f):
+    """Physical state ``y`` and ``dy/dt`` (``f``) at the integration state ``u``; returns the force."""
+    _physical_state(side, u, y)
     return rhs(code, c, y, mode, f)
 
 
@@ -194,13 +215,20 @@ def _events(code, c, mode, side, energy_limit, u, y, f, force, g):
 def _event_at(code, c, mode, side, energy_limit, target, column, F, u0, s0, h, s, us, ys, fs, gs):
     """Event function ``column`` at ``s`` on the dense output of the step; the pseudo column
     ``TIME_COLUMN`` is the physical time minus ``target`` (horizon and output times of a
-    regularised phase, where ``t`` is a component of the state)."""
+    regularised phase, where ``t`` is a component of the state). The physical state is left in
+    ``ys``; the right-hand side (``fs``) is evaluated only for the force's rate, the one event that
+    reads it."""
     _dense(c, side, F, u0, s0, h, s, us)
     if column == TIME_COLUMN:
         return us[TIME] - target
-    force = _physical(code, c, mode, side, us, ys, fs)
-    _events(code, c, mode, side, energy_limit, us, ys, fs, force, gs)
-    return gs[column]
+    if column == DELTA and _regularised(side):
+        return side * us[0]  # delta = side w^2 keeps its sign through its root; w changes sign there
+    if column == FORCE_RATE:
+        force = _physical(code, c, mode, side, us, ys, fs)
+    else:
+        _physical_state(side, us, ys)
+        force = math.nan
+    return event_value(code, c, ys, fs, force, mode, energy_limit, column)
 
 
 @kernel
@@ -240,13 +268,13 @@ def _brent(code, c, mode, side, energy_limit, target, column, F, u0, s0, h, xa, 
 
 
 @kernel
-def _flight_rate(column, y, f):
+def _flight_rate(c, column, y):
     """The time derivative of event ``column`` in a flight, where ``delta``, ``deltadot`` and the
     reach test are the events that can fire (NaN for the others)."""
     if column == DELTA:
         return y[V1] - y[V2]
     if column == DELTADOT:
-        return f[V1] - f[V2]
+        return 0.0 if c[RIGID_] > 0 else spring_force(c, y[X2]) / c[M2_]  # -x2'', the projectile uniform
     if column == REACH:
         return -y[V1]  # -(x1 + A), the reach A constant in a flight
     return math.nan
@@ -272,7 +300,7 @@ def _flight_root(code, c, mode, side, energy_limit, column, F, u0, s0, h, a, b, 
             a, fa = x, g
         else:
             b, fb = x, g
-        rate = _flight_rate(column, ys, fs)
+        rate = _flight_rate(c, column, ys)
         step = g / rate if rate != 0 else math.inf
         inward = step < 0 if left else step > 0  # towards the bracket's other end, where the root is
         if b - a <= tol or (inward and abs(step) <= tol):
@@ -314,7 +342,7 @@ def _locate(code, c, mode, side, energy_limit, column, F, u0, s0, h, s1, g_start
             return -math.inf  # the excursion is below what the step resolves: the caller shrinks it
     if gb == 0 or ga * gb > 0:
         return b
-    if side == FLIGHT and not math.isnan(_flight_rate(column, ys, fs)):
+    if side == FLIGHT and not math.isnan(_flight_rate(c, column, ys)):
         return _flight_root(code, c, mode, side, energy_limit, column, F, u0, s0, h, a, b, ga, gb, us, ys, fs, gs)
     return _brent(code, c, mode, side, energy_limit, 0.0, column, F, u0, s0, h, a, b, ga, gb, us, ys, fs, gs)
 
@@ -466,7 +494,7 @@ def _advance(code, c, mode, side, s, t_end, u, fu, y, f, force, h_abs, rtol, ato
     return _ADV_END, s, h, h_abs, h_next, force, force_new, steps, evaluations
 
 
-@kernel
+@kernel(inline="always")
 def _fresh_step(code, c, mode, side, s, u, fu, h, K, u_new, fu_new, tmp, stiff):
     """A step of exactly ``h`` from ``(s, u)`` with the phase's current method (the state at a
     root, a stop or the horizon); returns the evaluations spent."""
@@ -523,7 +551,7 @@ def _polish_root(code, c, mode, side, energy_limit, column, s, u, fu, s_end, g_s
     return best, evaluations
 
 
-@kernel
+@kernel(inline="always")
 def _interpolant(code, c, mode, side, u, fu, u_new, fu_new, h, K, F, tmp, stiff):
     """The last step's interpolant into ``F`` (a flight's invariants, see :func:`_dense`); returns the
     evaluations spent."""
@@ -537,7 +565,7 @@ def _interpolant(code, c, mode, side, u, fu, u_new, fu_new, h, K, F, tmp, stiff)
     return 3
 
 
-@kernel
+@kernel(inline="always")
 def _phase_step(code, c, mode, side, u, fu, rtol, atol, t_end, max_step, w_floor, tmp, f1):
     """Initial step of a phase (scipy's rule), in its own independent variable."""
     interval = t_end - u[TIME]
@@ -556,8 +584,8 @@ def run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count,
         max_steps, max_events, rk4_step, rk4_every, stiff_after):
     """Integrate one trajectory. See :func:`phaseimpact.integrate.simulate` for the meaning.
 
-    Returns ``(summary, ev_t, ev_kind, ev_mode, ev_y, ev_force, s_t, s_y, s_mode, s_force, y_final)``
-    with arrays trimmed to their lengths.
+    Returns ``(summary, events, samples, y_final)``: the event log (columns ``EV_*``) and the
+    samples (columns ``SMP_*``) trimmed to their lengths.
     """
     y = y0.copy()
     t = 0.0
@@ -568,16 +596,9 @@ def run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count,
     nsteps = 0
     energy_limit = energy_limit_of(code, c, y0)
 
-    ev_t = np.empty(64)
-    ev_kind = np.empty(64, np.int64)
-    ev_mode = np.empty(64, np.int64)
-    ev_y = np.empty((64, 5))
-    ev_force = np.empty(64)
+    ev = np.empty((64, N_EV_COLUMNS))
     n_ev = 0
-    s_t = np.empty(256 if save_kind != SAVE_SUMMARY else 1)
-    s_y = np.empty((s_t.shape[0], 5))
-    s_mode = np.empty(s_t.shape[0], np.int64)
-    s_force = np.empty(s_t.shape[0])
+    smp = np.empty((256 if save_kind != SAVE_SUMMARY else 1, N_SMP_COLUMNS))
     n_s = 0
     counts = np.zeros(9, np.int64)
     max_force = force
@@ -585,22 +606,13 @@ def run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count,
     i_time = 0  # next output time (save_kind == SAVE_TIMES)
 
     if y[X1] == y[X2] and y[V1] > y[V2]:
-        ev_t[0] = 0.0
-        ev_kind[0] = CONTACT
-        ev_mode[0] = mode
-        _copy(y, ev_y[0])
-        ev_force[0] = force
-        n_ev = 1
+        ev, n_ev = _push_event(ev, n_ev, 0.0, CONTACT, mode, y, force)
         counts[CONTACT] += 1
     if save_kind == SAVE_STEPS:
-        s_t[0] = 0.0
-        _copy(y, s_y[0])
-        s_mode[0] = mode
-        s_force[0] = force
-        n_s = 1
+        smp, n_s = _push_sample(smp, n_s, 0.0, y, mode, force)
     if save_kind == SAVE_TIMES:
         while i_time < times.shape[0] and times[i_time] <= 0.0:
-            s_t, s_y, s_mode, s_force, n_s = _push_sample(s_t, s_y, s_mode, s_force, n_s, times[i_time], y,
+            smp, n_s = _push_sample(smp, n_s, times[i_time], y,
                                                             mode, force)
             i_time += 1
 
@@ -655,8 +667,8 @@ def run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count,
             if (d_old <= 0 < d_new) or (d_old > 0 >= d_new):
                 kind = CONTACT if d_new > 0 else SEPARATION
                 t_cross = t + h * d_old / (d_old - d_new)  # linear: RK4 resolves no event
-                ev_t, ev_kind, ev_mode, ev_y, ev_force, n_ev = _push_event(
-                    ev_t, ev_kind, ev_mode, ev_y, ev_force, n_ev, t_cross, kind, mode, y_new, force_new)
+                ev, n_ev = _push_event(
+                    ev, n_ev, t_cross, kind, mode, y_new, force_new)
                 counts[kind] += 1
             t += h
             for j in range(5):
@@ -664,15 +676,14 @@ def run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count,
             max_force = max(max_force, force_new)
             max_indentation = max(max_indentation, d_new)
             if save_kind == SAVE_STEPS and (nsteps % rk4_every == 0 or t >= t_end):
-                s_t, s_y, s_mode, s_force, n_s = _push_sample(s_t, s_y, s_mode, s_force, n_s, t, y,
+                smp, n_s = _push_sample(smp, n_s, t, y,
                                                                 mode, force_new)
             if energy(code, c, y) > energy_limit:
                 reason = RUNAWAY_STOP
                 break
         summary = _summarize(code, c, y0, y, mode, status, reason, t, max_force, max_indentation, counts,
-                             n_ev, ev_t, ev_kind, ev_y, nsteps, nfev)
-        return (summary, ev_t[:n_ev], ev_kind[:n_ev], ev_mode[:n_ev], ev_y[:n_ev], ev_force[:n_ev],
-                s_t[:n_s], s_y[:n_s], s_mode[:n_s], s_force[:n_s], y)
+                             n_ev, ev, nsteps, nfev)
+        return summary, ev[:n_ev], smp[:n_s], y
 
     # ---- adaptive DOP853 with events ----
     # Plain phases integrate u = (x1, x2, v1, v2, W, t) in s = t; regularised contact phases
@@ -802,8 +813,8 @@ def run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count,
                 if best == REACH:
                     kind = SETTLED  # recorded only: the run goes on
                 t_ev = us[TIME] if _regularised(side) else roots[best]
-                ev_t, ev_kind, ev_mode, ev_y, ev_force, n_ev = _push_event(
-                    ev_t, ev_kind, ev_mode, ev_y, ev_force, n_ev, t_ev, kind, mode, ys, f_ev)
+                ev, n_ev = _push_event(
+                    ev, n_ev, t_ev, kind, mode, ys, f_ev)
                 counts[kind] += 1
                 max_force = max(max_force, f_ev)
                 max_indentation = max(max_indentation, ys[X1] - ys[X2])
@@ -835,7 +846,7 @@ def run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count,
                 _dense(c, side, F6, u, s, h, _s_at_time(code, c, mode, side, F6, u, s, h, times[i_time], us, ys, fs,
                                                         gs), us)
                 f_i = _physical(code, c, mode, side, us, ys, fs)
-                s_t, s_y, s_mode, s_force, n_s = _push_sample(s_t, s_y, s_mode, s_force, n_s, times[i_time], ys,
+                smp, n_s = _push_sample(smp, n_s, times[i_time], ys,
                                                               mode, f_i)
                 i_time += 1
         if restart_col < 0 and s_horizon < math.inf:
@@ -847,7 +858,7 @@ def run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count,
             max_force = max(max_force, force)
             max_indentation = max(max_indentation, y[X1] - y[X2])
             if save_kind == SAVE_STEPS:
-                s_t, s_y, s_mode, s_force, n_s = _push_sample(s_t, s_y, s_mode, s_force, n_s, t_end, y, mode, force)
+                smp, n_s = _push_sample(smp, n_s, t_end, y, mode, force)
             break
         if restart_col >= 0:
             # the state at the root from a fresh step that ends there (the stages beyond the root
@@ -882,13 +893,13 @@ def run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count,
                 _events(code, c, mode, side, energy_limit, u, y, f, force, g_old)
                 _quiet_start(quiet, y, mode, g_old)
                 continue
-            ev_t, ev_kind, ev_mode, ev_y, ev_force, n_ev = _push_event(
-                ev_t, ev_kind, ev_mode, ev_y, ev_force, n_ev, t, kind, mode, y, force)
+            ev, n_ev = _push_event(
+                ev, n_ev, t, kind, mode, y, force)
             counts[kind] += 1
             max_force = max(max_force, force)
             max_indentation = max(max_indentation, y[X1] - y[X2])
             if save_kind == SAVE_STEPS:
-                s_t, s_y, s_mode, s_force, n_s = _push_sample(s_t, s_y, s_mode, s_force, n_s, t, y,
+                smp, n_s = _push_sample(smp, n_s, t, y,
                                                                 mode, force)
             if action == STOP_SETTLED:
                 reason = SETTLED_STOP
@@ -915,7 +926,7 @@ def run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count,
         max_force = max(max_force, force)
         max_indentation = max(max_indentation, y[X1] - y[X2])
         if save_kind == SAVE_STEPS:
-            s_t, s_y, s_mode, s_force, n_s = _push_sample(s_t, s_y, s_mode, s_force, n_s, u[TIME], y,
+            smp, n_s = _push_sample(smp, n_s, u[TIME], y,
                                                             mode, force)
 
     if radau5.failed(stiff):  # a step to a root did not converge: what follows it is not the motion
@@ -923,14 +934,13 @@ def run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count,
     t = u[TIME]
 
     summary = _summarize(code, c, y0, y, mode, status, reason, t, max_force, max_indentation, counts,
-                         n_ev, ev_t, ev_kind, ev_y, nsteps, nfev)
-    return (summary, ev_t[:n_ev], ev_kind[:n_ev], ev_mode[:n_ev], ev_y[:n_ev], ev_force[:n_ev],
-            s_t[:n_s], s_y[:n_s], s_mode[:n_s], s_force[:n_s], y)
+                         n_ev, ev, nsteps, nfev)
+    return summary, ev[:n_ev], smp[:n_s], y
 
 
 @allocating
 def _summarize(code, c, y0, y, mode, status, reason, t_stop, max_force, max_indentation, counts,
-               n_ev, ev_t, ev_kind, ev_y, nsteps, nfev):
+               n_ev, ev, nsteps, nfev):
     """The summary vector of a run (indices ``S_*``); undefined entries are NaN."""
     s = np.full(N_SUMMARY, np.nan)
     s[S_STATUS] = status
@@ -948,21 +958,21 @@ def _summarize(code, c, y0, y, mode, status, reason, t_stop, max_force, max_inde
     first_contact = -1
     first_stick = -1
     for i in range(n_ev):
-        kind = ev_kind[i]
+        kind = int(ev[i, EV_KIND])
         if kind == CONTACT and first_contact < 0:
             first_contact = i
         elif kind == SEPARATION and first_contact >= 0 and math.isnan(s[S_CONTACT_DURATION]):
-            s[S_CONTACT_DURATION] = ev_t[i] - ev_t[first_contact]
-            dd0 = ev_y[first_contact, V1] - ev_y[first_contact, V2]
+            s[S_CONTACT_DURATION] = ev[i, EV_T] - ev[first_contact, EV_T]
+            dd0 = ev[first_contact, EV_Y + V1] - ev[first_contact, EV_Y + V2]
             if dd0 != 0:
-                s[S_RESTITUTION] = -(ev_y[i, V1] - ev_y[i, V2]) / dd0
+                s[S_RESTITUTION] = -(ev[i, EV_Y + V1] - ev[i, EV_Y + V2]) / dd0
         if kind == STICK and first_stick < 0:
             first_stick = i
-            s[S_FIRST_STICK_T] = ev_t[i]
-            s[S_FIRST_STICK_DELTA] = ev_y[i, X1] - ev_y[i, X2]
-            s[S_FIRST_STICK_MARGIN] = stick_margin(c, ev_y[i])
+            s[S_FIRST_STICK_T] = ev[i, EV_T]
+            s[S_FIRST_STICK_DELTA] = ev[i, EV_Y + X1] - ev[i, EV_Y + X2]
+            s[S_FIRST_STICK_MARGIN] = stick_margin(c, ev[i, EV_Y:EV_Y + 5])
         if kind == SEPARATION and first_stick >= 0 and math.isnan(s[S_T_RUN]):
-            s[S_T_RUN] = ev_t[i]
+            s[S_T_RUN] = ev[i, EV_T]
     if status != SUCCESS:
         outcome = FAILED
     elif reason == RUNAWAY_STOP:
@@ -981,23 +991,25 @@ def _summarize(code, c, y0, y, mode, status, reason, t_stop, max_force, max_inde
 
 
 @kernel
-def stick_points(n_ev, ev_t, ev_kind, ev_y, t_stop, permanent, out_t, out_delta, out_dwell):
-    """Stick phases of a log: time, ``delta*`` and dwell (to the next slip; to ``t_stop``, or
-    inf if the last stick is permanent). Writes up to ``len(out_t)``; returns their number."""
+def stick_points(ev, t_stop, permanent, out_t, out_delta, out_dwell):
+    """Stick phases of an event log (columns ``EV_*``): time, ``delta*`` and dwell (to the next
+    slip; to ``t_stop``, or inf if the last stick is permanent). Writes up to ``len(out_t)``;
+    returns their number."""
     n = 0
     cap = out_t.shape[0]
+    n_ev = ev.shape[0]
     for i in range(n_ev):
-        if ev_kind[i] != STICK:
+        if ev[i, EV_KIND] != STICK:
             continue
         end = math.inf if permanent else t_stop
         for j in range(i + 1, n_ev):
-            if ev_kind[j] == SLIP:
-                end = ev_t[j]
+            if ev[j, EV_KIND] == SLIP:
+                end = ev[j, EV_T]
                 break
         if n < cap:
-            out_t[n] = ev_t[i]
-            out_delta[n] = ev_y[i, X1] - ev_y[i, X2]
-            out_dwell[n] = end - ev_t[i]
+            out_t[n] = ev[i, EV_T]
+            out_delta[n] = ev[i, EV_Y + X1] - ev[i, EV_Y + X2]
+            out_dwell[n] = end - ev[i, EV_T]
         n += 1
     return n
 
@@ -1024,7 +1036,6 @@ def run_block(code, C, Y0, t_end, rtol, ATOL, max_step, settle, stop_kind, stop_
         s = out[0]
         _copy(s, summary[i])
         permanent = s[S_OUTCOME] == PERMANENT_STICK
-        st_count[i] = stick_points(out[1].shape[0], out[1], out[2], out[4], s[S_T_STOP], permanent,
-                                   st_t[i], st_delta[i], st_dwell[i])
+        st_count[i] = stick_points(out[1], s[S_T_STOP], permanent, st_t[i], st_delta[i], st_dwell[i])
 
 

@@ -1,7 +1,8 @@
 """The event table of the hybrid system, compiled (docs/physics.md §3, §5).
 
-Each event is a column of :func:`event_values`, with the direction that fires it and what the
-driver does then (:data:`ACTIONS`); :func:`transition` applies an event located at a state.
+Each event is a column of :func:`event_values` (one of them: :func:`event_value`), with the
+direction that fires it and what the driver does then (:data:`ACTIONS`); :func:`transition`
+applies an event located at a state.
 
 ==================  =========  =========  ===================================================
 column              direction  action     meaning
@@ -78,34 +79,42 @@ def is_unilateral(code):
 
 
 @kernel
-def event_values(code, c, y, f, force, mode, energy_limit, g):
-    """All event functions at ``y`` (``f`` its derivative, ``force`` its contact force) into ``g``.
+def event_value(code, c, y, f, force, mode, energy_limit, column):
+    """Event function ``column`` at ``y`` (``f`` its derivative and ``force`` its contact force,
+    read by ``FORCE_RATE`` only, so that a root finder on another event skips the right-hand
+    side). Inactive events are held at +-1 so that they never fire."""
+    stuck = mode == STUCK
+    if column == DELTA:
+        return y[X1] - y[X2]
+    if column == ENERGY:
+        return energy_limit - energy(code, c, y)
+    if column == PAIR_CENTRE:
+        # the stick-break function jumps where x2 crosses 0: the run restarts there, so that the
+        # jump never falls inside a step (a break right after it would be stepped over)
+        return y[X2] if stuck and c[SPRINGS_] > 0 else 1.0
+    if column == STICK_BREAK:
+        return stick_break_distance(c, y) if stuck else 1.0
+    if column == DELTADOT:
+        return 1.0 if stuck else y[V1] - y[V2]
+    if column == FORCE_RATE:
+        if stuck:  # the stuck force M1/M S(x2) peaks where x2 does
+            return (c[KB_] + 3.0 * c[KM_] * y[X2] * y[X2]) * y[V2] * c[M1_] / (c[M1_] + c[M2_])
+        if force == 0.0 and is_unilateral(code):
+            return -1.0
+        deltadot = y[V1] - y[V2]
+        p_delta, p_rate = force_partials(code, y[X1] - y[X2], deltadot, mode, c[K_], c[DAMP_], c[ALPHA_])
+        return p_delta * deltadot + p_rate * (f[V1] - f[V2])
+    # REACH
+    if not stuck and is_unilateral(code) and c[SPRINGS_] > 0 and y[X1] - y[X2] < 0 and y[V1] < 0:
+        return -(y[X1] + target_reach(c, y))
+    return -1.0
 
-    Inactive events are held at +-1 so that they never fire.
-    """
-    delta = y[X1] - y[X2]
-    deltadot = y[V1] - y[V2]
-    g[DELTA] = delta
-    g[ENERGY] = energy_limit - energy(code, c, y)
-    g[REACH] = -1.0
-    g[STICK_BREAK] = 1.0
-    g[PAIR_CENTRE] = 1.0
-    if mode == STUCK:
-        # the stick-break function below jumps where x2 crosses 0: the run restarts there, so that
-        # the jump never falls inside a step (a break right after it would be stepped over)
-        g[PAIR_CENTRE] = y[X2] if c[SPRINGS_] > 0 else 1.0
-        g[DELTADOT] = 1.0
-        # the stuck force M1/M S(x2) peaks where x2 does
-        g[FORCE_RATE] = (c[KB_] + 3.0 * c[KM_] * y[X2] * y[X2]) * y[V2] * c[M1_] / (c[M1_] + c[M2_])
-        g[STICK_BREAK] = stick_break_distance(c, y)
-        return
-    g[DELTADOT] = deltadot
-    p_delta, p_rate = force_partials(code, delta, deltadot, mode, c[K_], c[DAMP_], c[ALPHA_])
-    rate = p_delta * deltadot + p_rate * (f[V1] - f[V2])
-    touching = force != 0.0 or not is_unilateral(code)
-    g[FORCE_RATE] = rate if touching else -1.0
-    if is_unilateral(code) and c[SPRINGS_] > 0 and delta < 0 and y[V1] < 0:
-        g[REACH] = -(y[X1] + target_reach(c, y))
+
+@kernel
+def event_values(code, c, y, f, force, mode, energy_limit, g):
+    """All event functions at ``y`` into ``g`` (:func:`event_value`)."""
+    for column in range(N_EVENTS):
+        g[column] = event_value(code, c, y, f, force, mode, energy_limit, column)
 
 
 @kernel

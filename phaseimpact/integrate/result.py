@@ -87,6 +87,9 @@ class Trajectory:
         ``(x1, x2, x1dot, x2dot, W)`` with ``W`` the contact work (J), contact force (N), mode.
     event_t, event_kind, event_mode, event_y, event_force : ndarray
         The event log as arrays (``event_kind`` indexes :data:`EVENT_KINDS`).
+    samples, event_log : ndarray
+        Both as the driver returns them, one row per sample or event (columns ``SMP_*`` and
+        ``EV_*`` of :mod:`.driver`); the arrays above are views of them (kinds and modes as integers).
     params, law : Parameters, ContactLaw
         What was integrated.
     initial_state, final_state : ndarray, shape (5,)
@@ -105,15 +108,8 @@ class Trajectory:
     integrator : str
     """
 
-    t: np.ndarray
-    y: np.ndarray
-    force: np.ndarray
-    mode: np.ndarray
-    event_t: np.ndarray
-    event_kind: np.ndarray
-    event_mode: np.ndarray
-    event_y: np.ndarray
-    event_force: np.ndarray
+    samples: np.ndarray = field(repr=False)
+    event_log: np.ndarray = field(repr=False)
     params: Parameters
     law: ContactLaw
     initial_state: np.ndarray
@@ -124,6 +120,42 @@ class Trajectory:
     outcome: str
     summary: np.ndarray = field(repr=False)
     integrator: str = "exact"
+
+    @property
+    def t(self) -> np.ndarray:
+        return self.samples[:, d.SMP_T]
+
+    @property
+    def y(self) -> np.ndarray:
+        return self.samples[:, d.SMP_Y:d.SMP_Y + 5]
+
+    @property
+    def force(self) -> np.ndarray:
+        return self.samples[:, d.SMP_FORCE]
+
+    @cached_property
+    def mode(self) -> np.ndarray:
+        return self.samples[:, d.SMP_MODE].astype(np.int64)
+
+    @property
+    def event_t(self) -> np.ndarray:
+        return self.event_log[:, d.EV_T]
+
+    @cached_property
+    def event_kind(self) -> np.ndarray:
+        return self.event_log[:, d.EV_KIND].astype(np.int64)
+
+    @cached_property
+    def event_mode(self) -> np.ndarray:
+        return self.event_log[:, d.EV_MODE].astype(np.int64)
+
+    @property
+    def event_y(self) -> np.ndarray:
+        return self.event_log[:, d.EV_Y:d.EV_Y + 5]
+
+    @property
+    def event_force(self) -> np.ndarray:
+        return self.event_log[:, d.EV_FORCE]
 
     @property
     def message(self) -> str:
@@ -240,8 +272,7 @@ class Trajectory:
         """Stick phases: times (s), ``delta*`` (m) and dwell (s; inf for a permanent stick)."""
         n = int(np.count_nonzero(self.event_kind == EVENT_KINDS.index("stick")))
         out = np.empty((3, n))
-        d.stick_points(len(self.event_t), self.event_t, self.event_kind, self.event_y, self.t_stop,
-                       self.outcome == "permanent-stick", out[0], out[1], out[2])
+        d.stick_points(self.event_log, self.t_stop, self.outcome == "permanent-stick", out[0], out[1], out[2])
         return out[0], out[1], out[2]
 
 
