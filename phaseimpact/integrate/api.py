@@ -143,19 +143,27 @@ def _stop_on(stop_on) -> tuple[int, int]:
     return EVENT_KINDS.index(kind), int(n)
 
 
+_NO_TIMES = np.empty(0)  # the driver only reads it
+
+
 def _save(save):
     if isinstance(save, str):
         if save not in ("summary", "steps"):
             raise ValueError(f"save = {save!r} is out of range; allowed: 'summary', 'steps' or an array of times")
-        return (d.SAVE_SUMMARY if save == "summary" else d.SAVE_STEPS), np.empty(0)
+        return (d.SAVE_SUMMARY if save == "summary" else d.SAVE_STEPS), _NO_TIMES
     times = np.asarray(save, dtype=float)
     if times.ndim != 1 or not np.all(np.isfinite(times)) or np.any(np.diff(times) <= 0):
         raise ValueError("save: output times must be a finite, strictly increasing 1-d array")
     return d.SAVE_TIMES, times
 
 
+_STIFF_ON, _STIFF_OFF = np.int64(radau5.STIFF_STEPS), np.int64(0)
+
+
 def _stiff_after(stiff) -> np.int64:
     """The driver's switch: DOP853 steps at the stability limit before Radau takes over (0: never)."""
+    if stiff is True:  # the common case, without the isinstance of a union
+        return _STIFF_ON
     if not isinstance(stiff, bool | np.bool_):
         raise ValueError(f"stiff = {stiff!r} is out of range; allowed: True or False")
     return np.int64(radau5.STIFF_STEPS if stiff else 0)
@@ -225,11 +233,17 @@ def simulate(params: Parameters, law: ContactLaw | str = "paper", t_end: float |
     status = d.STATUSES[int(summary[d.S_STATUS])]
     reason = d.STOP_REASONS[int(summary[d.S_REASON])]
     outcome = d.OUTCOMES[int(summary[d.S_OUTCOME])]
-    method = "DOP853+Radau5" if stiff else "DOP853"
-    name = f"rk4[step={rk4_step:.3g}]" if rk4_step else f"exact[{method}, rtol={rtol:g}]"
     return Trajectory(
         samples=samples, event_log=event_log, params=params, law=law, initial_state=y0, final_state=y_final,
-        t_end=horizon, status=status, stop_reason=reason, outcome=outcome, summary=summary, integrator=name)
+        t_end=horizon, status=status, stop_reason=reason, outcome=outcome, summary=summary,
+        integrator=_integrator_name(rk4_step, rtol, stiff_after > 0))
+
+
+@functools.lru_cache(maxsize=64)
+def _integrator_name(rk4_step: float, rtol: float, stiff: bool) -> str:
+    if rk4_step:
+        return f"rk4[step={rk4_step:.3g}]"
+    return f"exact[{'DOP853+Radau5' if stiff else 'DOP853'}, rtol={rtol:g}]"
 
 
 @dataclass(frozen=True)
