@@ -113,10 +113,11 @@ def _atol(params: Parameters, rtol: float, atol) -> np.ndarray:
 
 
 @functools.lru_cache(maxsize=1024)
-def _packed(params: Parameters, law: ContactLaw, rtol: float) -> tuple[np.ndarray, np.ndarray]:
-    """The driver's coefficient array and default absolute tolerances (cached; the driver never
-    writes to them and they are not handed out)."""
-    return pack(params, law), _atol(params, rtol, None)
+def _packed(params: Parameters, law: ContactLaw, rtol: float) -> tuple:
+    """The driver's coefficient array and default absolute tolerances, seed eq. 6's initial state
+    and the case's scales (cached: one lookup per run; the driver never writes to the arrays and
+    only copies of the initial state are handed out)."""
+    return pack(params, law), _atol(params, rtol, None), initial_state(params.v), scales(params)
 
 
 def _initial(params: Parameters, initial) -> np.ndarray:
@@ -210,13 +211,13 @@ def simulate(params: Parameters, law: ContactLaw | str = "paper", t_end: float |
     if integrator not in INTEGRATORS:
         raise ValueError(f"integrator = {integrator!r} is out of range; allowed: one of {', '.join(INTEGRATORS)}")
     stiff_after = _stiff_after(stiff)
-    s = scales(params)
-    horizon = s.horizon if t_end is None else check_real("t_end", t_end, "a finite number > 0", lambda x: x > 0)
     rtol = check_rtol(rtol)
+    c, default_atol, seed_state, s = _packed(params, law, rtol)
+    horizon = s.horizon if t_end is None else check_real("t_end", t_end, "a finite number > 0", lambda x: x > 0)
     save_kind, times = _save(save)
     settle = (t_end is None or save_kind == d.SAVE_SUMMARY) if stop_when_settled is None else bool(stop_when_settled)
     stop_kind, stop_count = _stop_on(stop_on)
-    y0 = _initial(params, initial)
+    y0 = seed_state.copy() if initial is None else _initial(params, initial)
     rk4_step = 0.0
     if integrator == "rk4":
         rk4_step = s.contact_time / 1000 if step is None else check_real("step", step, "a number > 0", lambda x: x > 0)
@@ -225,7 +226,6 @@ def simulate(params: Parameters, law: ContactLaw | str = "paper", t_end: float |
         if horizon / rk4_step > max_steps:
             raise ValueError(f"step = {rk4_step!r} needs {horizon / rk4_step:.3g} steps; allowed: at most "
                              f"max_steps = {max_steps}")
-    c, default_atol = _packed(params, law, rtol)
     out = d.run(law.code, c, y0, horizon, rtol, default_atol if atol is None else _atol(params, rtol, atol),
                 s.max_step, settle, stop_kind, stop_count, save_kind, times, int(max_steps), MAX_EVENTS, rk4_step,
                 int(every), stiff_after)

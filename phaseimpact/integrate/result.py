@@ -76,7 +76,7 @@ def run_message(status: str, reason: str, t_stop: float, outcome: str) -> str:
     return f"the horizon t_end = {t_stop:.6g} s ended the run before the outcome settled"
 
 
-@dataclass(frozen=True)
+@dataclass(eq=False)  # not frozen: a frozen dataclass's __init__ costs a microsecond per run
 class Trajectory:
     """One trajectory of the impact model.
 
