@@ -114,3 +114,36 @@ def test_long_flight_is_one_step_once_nothing_can_happen():
     u_sep = np.append(far.event_y[far.event_kind == 1][-1], far.event_t[far.event_kind == 1][-1])
     expected = closed_form(SEED, u_sep, [2.0])[0]
     np.testing.assert_allclose(far.final_state[:4], expected[:4], rtol=1e-12, atol=1e-18)
+
+
+@pytest.mark.parametrize("name", ["duffing (seed plate)", "strong membrane", "harmonic", "membrane only"])
+def test_next_centre_is_the_targets_next_pass_through_zero(name):
+    """Flight steps end where the target passes its centre: x2 is zero there and keeps one sign
+    before it (so x2dot is monotone within a step)."""
+    params = TARGETS[name]
+    c = pack(params, as_law("hunt-crossley"))
+    u0 = integration_state(-1e-5, 4e-5, -0.3, 0.7, t=1e-4)
+    F = np.zeros((7, 6))
+    flight.coefficients(c, u0, u0[5], F)
+    s, out = u0[5], np.empty(6)
+    for _ in range(5):
+        centre = flight.next_centre(F, s)
+        flight.state_at(c, F, u0, u0[5], centre, out)
+        assert abs(out[1]) < 1e-12 * params.hertz_indentation
+        between = closed_form(params, u0, np.linspace(s, centre, 400)[1:-1])
+        assert np.all(between[:, 1] > 0) or np.all(between[:, 1] < 0)
+        s = centre
+
+
+def test_a_grazing_extremum_in_flight_is_not_stepped_over():
+    """Seed case at 8.45 m/s near a grazing (an extremum of delta in flight crossing zero): the
+    sixth extremum is a smooth function of kappa across its root. A flight step holding the
+    minimum of delta and the next contact, with deltadot crossing zero twice in it, skipped the
+    minimum and jumped from -1e-7 to +7e-6."""
+    from phaseimpact.continuation.transition import delta_extremum
+
+    root = 7.70688062e9
+    below, above = (delta_extremum(seed_parameters(v=8.45041368, kappa=root * f), "hunt-crossley", 6)
+                    for f in (0.999, 1.001))
+    assert below < 0 < above
+    assert 0.5 < -below / above < 2.0

@@ -323,7 +323,19 @@ def _locate(code, c, mode, side, energy_limit, column, F, u0, s0, h, s1, g_start
     expected = 1.0 if g_start > 0 else -1.0
     a, ga, b, gb = s0, g_start, s1, g_end
     g0 = _event_at(code, c, mode, side, energy_limit, 0.0, column, F, u0, s0, h, s0, us, ys, fs, gs)
-    if g0 * expected <= 0:
+    if g0 * expected <= 0 and side == FLIGHT and column == DELTA:
+        # a flight step holds at most one extremum of delta (flight.py): if delta left zero and
+        # came back, it was away at that extremum, the zero of deltadot
+        d0 = _event_at(code, c, mode, side, energy_limit, 0.0, np.int64(DELTADOT), F, u0, s0, h, s0, us, ys, fs, gs)
+        d1 = _event_at(code, c, mode, side, energy_limit, 0.0, np.int64(DELTADOT), F, u0, s0, h, s1, us, ys, fs, gs)
+        if not d0 * d1 < 0:
+            return -math.inf
+        a = _flight_root(code, c, mode, side, energy_limit, np.int64(DELTADOT), F, u0, s0, h, s0, s1, d0, d1, us, ys,
+                         fs, gs)
+        ga = _event_at(code, c, mode, side, energy_limit, 0.0, column, F, u0, s0, h, a, us, ys, fs, gs)
+        if ga * expected <= 0:
+            return -math.inf
+    elif g0 * expected <= 0:
         found_away = False
         prev = s0
         for i in range(1, 33):
@@ -424,9 +436,9 @@ def _advance(code, c, mode, side, s, t_end, u, fu, y, f, force, h_abs, rtol, ato
     """Take steps in ``s`` from ``(s, u)`` while nothing happens: no event crosses, no sample and
     (regularised phase) not the horizon falls inside. Accepted steps update ``u, fu, y, f, g_old``
     and the running extremes ``stats``. DOP853 until the phase turns stiff (:mod:`.radau5`), Radau
-    from then on; a flight in closed form (:mod:`.flight`), in brackets of ``flight_step``, or to
-    ``t_end`` at once when no event can happen any more and ``flight_step`` is ``max_step`` (not
-    saving steps).
+    from then on; a flight in closed form (:mod:`.flight`), in steps that end where the target
+    passes its centre or after ``flight_step``, or to ``t_end`` at once when no event can happen
+    any more and ``flight_step`` is inf (not saving steps).
 
     Returns ``(result, s, h, h_abs, h_next, force, force_new, steps, evaluations)``: ``_ADV_STEP``
     leaves the last step (``h``, ``u_new``, ``fu_new``, ``y_new``, ``f_new``, ``g_new``, ``fired``)
@@ -442,10 +454,12 @@ def _advance(code, c, mode, side, s, t_end, u, fu, y, f, force, h_abs, rtol, ato
     while u[TIME] < t_end:
         if steps >= steps_left:
             return _ADV_LIMIT, s, h, h_abs, h_next, force, force_new, steps, evaluations
-        if side == FLIGHT:
-            h_abs = min(h_abs, flight_step)
-            s_new = s_bound if flight_step == max_step and flight.unreachable(c, u) else min(s + h_abs, s_bound)
-            flight.state_at(c, K, u, s, s_new, u_new)  # K: the flight's invariants (it has no stages)
+        if side == FLIGHT:  # K: the flight's invariants (it has no stages)
+            if flight_step == math.inf and flight.unreachable(c, u):
+                s_new = s_bound
+            else:
+                s_new = min(s + min(h_abs, flight_step), s_bound, flight.next_centre(K, s))
+            flight.state_at(c, K, u, s, s_new, u_new)
             force_new = rhs_integration(code, c, u_new, mode, side, fu_new)
             ok, h_next, spent = True, flight_step, 0
         else:
@@ -572,7 +586,7 @@ def _phase_step(code, c, mode, side, u, fu, rtol, atol, t_end, max_step, w_floor
     if interval <= 0:
         return 0.0  # the phase starts on the horizon (an event at t_end): no step follows
     if side == FLIGHT:
-        return min(interval, max_step)  # closed form: the step only brackets events
+        return interval  # closed form: its steps only bracket events (see _advance)
     if _regularised(side):
         interval /= max(abs(u[0]), w_floor)
     return dop853.initial_step(code, c, mode, side, u, fu, rtol, atol, interval,
@@ -706,8 +720,9 @@ def run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count,
     K6 = rows6[9:25]  # DOP853's stages
     F6 = rows6[25:]  # the step's interpolant
     w_floor = atol[6] / rtol  # the scale of w = sqrt(|delta|)
-    # a flight's steps only bracket events (an eighth of the target's period); a figure gets finer ones
-    flight_step = max_step if save_kind != SAVE_STEPS else max_step / 4
+    # a flight's steps only bracket events, between the target's passes through its centre; a
+    # figure gets finer ones
+    flight_step = math.inf if save_kind != SAVE_STEPS else max_step / 4
     side = contact_side(code, c, y, mode)
     _integration_state(side, y, 0.0, u)
     _phase_tolerances(side, atol, atol_u)

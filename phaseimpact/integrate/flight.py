@@ -11,19 +11,21 @@ The oscillator is Duffing's without damping, solved by Jacobi's elliptic cosine:
 ``m = b A^2 / (2 omega^2)`` (``0 <= m <= 1/2``); the harmonic case ``Km = 0`` is ``cos``/``sin``, a
 free target moves uniformly and a rigid one stays at 0. The state at any time of the phase is then
 exact to rounding, so a flight costs no right-hand sides, has no truncation error and needs no
-error control: steps are only the brackets in which events are looked for (an eighth of the
-target's period, as the DOP853 steps they replace), and once no event can happen any more the
-phase goes to its end in one step.
+error control: steps are only the brackets in which events are looked for, and they end where
+the target passes its centre (:func:`next_centre`). Between two such passes ``x2dot`` is monotone
+(``x2dot' = -S(x2)/M2`` keeps its sign), so ``deltadot = x1dot - x2dot`` has at most one zero and
+``delta`` at most one extremum in a step: no pair of events can hide inside one. Once no event
+can happen any more the phase goes to its end in one step (:func:`unreachable`).
 
-``sn, cn, dn`` and the incomplete integral ``F(phi | m)`` are scipy's (``scipy.special.ellipj``,
-``ellipkinc``; Cephes), called from compiled code through their C entry points in
+``sn, cn, dn`` and the integrals ``F(phi | m)``, ``K(m)`` are scipy's (``scipy.special.ellipj``,
+``ellipkinc``, ``ellipk``; Cephes), called from compiled code through their C entry points in
 ``scipy.special.cython_special``, registered under a fixed symbol name so that numba's on-disk
 cache stays valid across processes.
 
-The orbit's invariants (kind, ``A``, ``omega``, ``m``, and ``psi`` at a reference ``s``) are
-computed once per flight, at its start (:func:`coefficients`, into the first row of an array of
-the driver's, ``F[1]`` being scratch for the elliptic functions' outputs): a step then costs one
-evaluation of ``sn, cn, dn``.
+The orbit's invariants (kind, ``A``, ``omega``, ``m``, ``psi`` at a reference ``s``, and the
+quarter period ``K(m)`` of the elliptic argument) are computed once per flight, at its start
+(:func:`coefficients`, into rows 0 and 2 of an array of the driver's, row 1 being scratch for the
+elliptic functions' outputs): a step then costs one evaluation of ``sn, cn, dn``.
 """
 
 from __future__ import annotations
@@ -39,7 +41,7 @@ from numba.extending import get_cython_function_address
 from .._jit import kernel
 from ..model.rhs import KB_, KM_, M2_, RIGID_, SPRINGS_, V1, V2, WORK, X1, X2
 
-__all__ = ["coefficients", "state_at", "unreachable"]
+__all__ = ["coefficients", "state_at", "next_centre", "unreachable"]
 
 if numba.config.DISABLE_JIT:  # the uncompiled engine (tests): scipy's Python functions
     def _jacobi(u, m, out):
@@ -49,15 +51,21 @@ if numba.config.DISABLE_JIT:  # the uncompiled engine (tests): scipy's Python fu
     def _first_kind(phi, m):
         """``F(phi | m)``."""
         return scipy.special.ellipkinc(phi, m)
+
+    def _complete(m):
+        """``K(m)``."""
+        return scipy.special.ellipk(m)
 else:
     llvm.add_symbol("phaseimpact_ellipj", get_cython_function_address("scipy.special.cython_special", "ellipj"))
     llvm.add_symbol("phaseimpact_ellipkinc",
                     get_cython_function_address("scipy.special.cython_special", "ellipkinc"))
+    llvm.add_symbol("phaseimpact_ellipk", get_cython_function_address("scipy.special.cython_special", "ellipk"))
     _DOUBLE_P = types.CPointer(types.double)
     _ellipj = types.ExternalFunction("phaseimpact_ellipj", types.void(types.double, types.double, _DOUBLE_P,
                                                                        _DOUBLE_P, _DOUBLE_P, _DOUBLE_P))
     _ellipkinc = types.ExternalFunction("phaseimpact_ellipkinc",
                                         types.double(types.double, types.double, types.intc))
+    _ellipk = types.ExternalFunction("phaseimpact_ellipk", types.double(types.double, types.intc))
 
     @kernel
     def _jacobi(u, m, out):
@@ -69,18 +77,26 @@ else:
         """``F(phi | m)``."""
         return _ellipkinc(phi, m, 0)
 
+    @kernel
+    def _complete(m):
+        """``K(m)``."""
+        return _ellipk(m, 0)
+
 
 TIME = 5
 # Kinds of target motion.
 RIGID, FREE, HARMONIC, DUFFING = range(4)
-# Layout of F[0].
+# Layout of F[0] and F[2].
 _KIND, _AMPLITUDE, _OMEGA, _M, _PSI, _S_REF = range(6)
+_QUARTER = 0  # in F[2]
 
 
 @kernel
 def coefficients(c, u, s, F):
-    """The invariants of the flight through the integration state ``u`` at ``s`` into ``F[0]``."""
+    """The invariants of the flight through the integration state ``u`` at ``s`` into ``F[0]``
+    (and the quarter period into ``F[2]``)."""
     x2, v2 = u[X2], u[V2]
+    F[0, _S_REF] = s
     if c[RIGID_] > 0:
         F[0, _KIND] = RIGID
         return
@@ -89,14 +105,14 @@ def coefficients(c, u, s, F):
         return
     a = c[KB_] / c[M2_]
     b = c[KM_] / c[M2_]
-    if b == 0:
-        F[0, _KIND] = HARMONIC
-        F[0, _OMEGA] = math.sqrt(a)
-        return
-    F[0, _KIND] = DUFFING
     energy = 0.5 * v2 * v2 + (0.5 * a + 0.25 * b * x2 * x2) * x2 * x2  # per unit mass
-    if energy <= 0:
+    F[0, _KIND] = HARMONIC if b == 0 else DUFFING
+    if energy <= 0:  # at rest in the centre
         F[0, _AMPLITUDE] = 0.0
+        F[0, _OMEGA] = math.sqrt(a)
+        F[0, _M] = 0.0
+        F[0, _PSI] = 0.0
+        F[2, _QUARTER] = 0.5 * math.pi
         return
     amplitude = math.sqrt(4.0 * energy / (a + math.sqrt(a * a + 4.0 * b * energy)))
     omega = math.sqrt(a + b * amplitude * amplitude)
@@ -110,8 +126,24 @@ def coefficients(c, u, s, F):
     F[0, _AMPLITUDE] = amplitude
     F[0, _OMEGA] = omega
     F[0, _M] = m
-    F[0, _PSI] = _first_kind(phi, m)
-    F[0, _S_REF] = s
+    F[0, _PSI] = phi if m == 0 else _first_kind(phi, m)
+    F[2, _QUARTER] = 0.5 * math.pi if m == 0 else _complete(m)
+
+
+@kernel
+def next_centre(F, s):
+    """Where after ``s`` the target next passes its centre ``x2 = 0`` (``cn = 0``, the elliptic
+    argument an odd multiple of ``K``); inf for a free or rigid target, which has none."""
+    kind = F[0, _KIND]
+    if kind == RIGID or kind == FREE or F[0, _AMPLITUDE] == 0:
+        return math.inf
+    omega, quarter = F[0, _OMEGA], F[2, _QUARTER]
+    argument = omega * (s - F[0, _S_REF]) + F[0, _PSI]
+    n = math.floor((argument - quarter) / (2.0 * quarter)) + 1.0
+    centre = F[0, _S_REF] + ((2.0 * n + 1.0) * quarter - F[0, _PSI]) / omega
+    if centre - s <= 1e-12 * quarter / omega:  # on a centre (to rounding): the next one
+        centre += 2.0 * quarter / omega
+    return centre
 
 
 @kernel
