@@ -721,8 +721,8 @@ def run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count,
     F6 = rows6[25:]  # the step's interpolant
     w_floor = atol[6] / rtol  # the scale of w = sqrt(|delta|)
     # a flight's steps only bracket events, between the target's passes through its centre; a
-    # figure gets finer ones
-    flight_step = math.inf if save_kind != SAVE_STEPS else max_step / 4
+    # figure gets a sample every sixteenth of the target's period
+    flight_step = math.inf if save_kind != SAVE_STEPS else max_step / 2
     side = contact_side(code, c, y, mode)
     _integration_state(side, y, 0.0, u)
     _phase_tolerances(side, atol, atol_u)
