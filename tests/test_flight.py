@@ -85,6 +85,12 @@ def test_unreachable_means_no_event_can_follow(name):
     ``delta < 0`` and ``deltadot < 0`` throughout; just short of its bounds it says no."""
     params = TARGETS[name]
     c = pack(params, as_law("hunt-crossley"))
+
+    def unreachable(u):
+        F = np.zeros((7, 6))
+        flight.coefficients(c, u, u[5], F)
+        return flight.unreachable(F, u)
+
     x2, v2 = (0.0, 0.0) if params.target == "rigid" else (6e-5, -0.4)
     period = params.target_period if np.isfinite(params.target_period) else 1e-3
     # receding beyond the reach and faster than the target can move
@@ -92,16 +98,16 @@ def test_unreachable_means_no_event_can_follow(name):
         u0 = integration_state(-2e-3, x2, v1, v2)
         if params.target == "free":
             u0[3] = v1 + 0.1
-        if flight.unreachable(c, u0):
+        if unreachable(u0):
             states = closed_form(params, u0, np.linspace(0.0, 4.0 * period, 4001))
             assert np.all(states[:, 0] - states[:, 1] < 0)
             assert np.all(states[:, 2] - states[:, 3] < 0)
     # approaching, or within reach: never claimed
-    assert not flight.unreachable(c, integration_state(-2e-3, x2, 0.1, v2))
+    assert not unreachable(integration_state(-2e-3, x2, 0.1, v2))
     if params.target == "plate":
-        assert not flight.unreachable(c, integration_state(-1e-6, x2, -9.0, v2))
+        assert not unreachable(integration_state(-1e-6, x2, -9.0, v2))
         slow = integration_state(-2e-3, x2, -1e-3, v2)
-        assert not flight.unreachable(c, slow)
+        assert not unreachable(slow)
 
 
 def test_long_flight_is_one_step_once_nothing_can_happen():

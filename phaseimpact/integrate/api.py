@@ -315,7 +315,7 @@ def run_batch(batch: Batch, *, rtol: float, settle: bool = True, stop_on=None, n
             continue
         # more stick phases than the buffer holds (near kappa_c): rerun this one for all of them
         out = d.run(batch.law.code, batch.C[i], batch.Y0[i], batch.t_end[i], rtol, batch.atol[i],
-                    batch.max_step[i], settle, stop_kind, stop_count, d.SAVE_SUMMARY, np.empty(0), MAX_STEPS,
+                    batch.max_step[i], settle, stop_kind, stop_count, d.SAVE_SUMMARY, _NO_TIMES, MAX_STEPS,
                     MAX_EVENTS, 0.0, 1, stiff_after)
         full = np.empty((3, k))
         s = out[0]

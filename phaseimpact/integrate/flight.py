@@ -39,7 +39,7 @@ from numba import types
 from numba.extending import get_cython_function_address
 
 from .._jit import kernel
-from ..model.rhs import KB_, KM_, M2_, RIGID_, SPRINGS_, V1, V2, WORK, X1, X2
+from ..model.rhs import KB_, KM_, M2_, RIGID_, SPRINGS_, V1, V2, WORK, X1, X2, target_reach
 
 __all__ = ["coefficients", "state_at", "next_centre", "unreachable"]
 
@@ -105,17 +105,16 @@ def coefficients(c, u, s, F):
         return
     a = c[KB_] / c[M2_]
     b = c[KM_] / c[M2_]
-    energy = 0.5 * v2 * v2 + (0.5 * a + 0.25 * b * x2 * x2) * x2 * x2  # per unit mass
     F[0, _KIND] = HARMONIC if b == 0 else DUFFING
-    if energy <= 0:  # at rest in the centre
+    amplitude = target_reach(c, u)  # the turning point of the target's energy
+    omega = math.sqrt(a + b * amplitude * amplitude)
+    if amplitude == 0:  # at rest in the centre
         F[0, _AMPLITUDE] = 0.0
-        F[0, _OMEGA] = math.sqrt(a)
+        F[0, _OMEGA] = omega
         F[0, _M] = 0.0
         F[0, _PSI] = 0.0
         F[2, _QUARTER] = 0.5 * math.pi
         return
-    amplitude = math.sqrt(4.0 * energy / (a + math.sqrt(a * a + 4.0 * b * energy)))
-    omega = math.sqrt(a + b * amplitude * amplitude)
     m = 0.5 * b * amplitude * amplitude / (omega * omega)
     # the amplitude phi of psi: cos(phi) = cn = x2 / A; sin(phi) = sn from sn dn = -v2 / (A omega),
     # the root of m s^4 - s^2 + q^2 = 0 below 1 (atan2 of both: accurate at the turning points and
@@ -185,21 +184,17 @@ def state_at(c, F, u0, s0, s, out):
 
 
 @kernel
-def unreachable(c, u):
-    """Whether no event can happen any more in this flight: the projectile recedes beyond the
-    target's reach and faster than the target can move (so ``delta < 0`` and ``deltadot < 0``
-    from now on, and the energy is constant)."""
+def unreachable(F, u):
+    """Whether no event can happen any more in the flight whose invariants are in ``F``: the
+    projectile recedes beyond the target's reach and faster than the target can move (so
+    ``delta < 0`` and ``deltadot < 0`` from now on, and the energy is constant)."""
     v1 = u[V1]
-    if c[RIGID_] > 0:
+    kind = F[0, _KIND]
+    if kind == RIGID:
         return v1 <= 0
-    if c[SPRINGS_] == 0:
+    if kind == FREE:
         return v1 - u[V2] <= 0
-    a = c[KB_] / c[M2_]
-    b = c[KM_] / c[M2_]
-    x2, v2 = u[X2], u[V2]
-    energy = 0.5 * v2 * v2 + (0.5 * a + 0.25 * b * x2 * x2) * x2 * x2
-    root = math.sqrt(a * a + 4.0 * b * energy)
-    amplitude = math.sqrt(4.0 * energy / (a + root)) if a + root > 0 else abs(x2)
+    amplitude = F[0, _AMPLITUDE]
     # |x2dot| = A omega |sn dn| <= A omega; the margins cover the rounding of A and omega
-    speed = amplitude * math.sqrt(a + b * amplitude * amplitude)
-    return v1 <= 0 and u[X1] + (1.0 + 1e-12) * amplitude < 0 and -v1 > (1.0 + 1e-12) * speed
+    return (v1 <= 0 and u[X1] + (1.0 + 1e-12) * amplitude < 0
+            and -v1 > (1.0 + 1e-12) * amplitude * F[0, _OMEGA])
