@@ -16,7 +16,10 @@ from ..model.laws import ContactLaw, as_law
 from ..model.rhs import initial_state, pack
 from ..parameters import Parameters
 from . import driver as d
-from . import radau5
+from . import (
+    precompile,  # noqa: F401  (registers the two-process first compile)
+    radau5,
+)
 from .events import EVENT_KINDS
 from .result import Columns, Trajectory
 

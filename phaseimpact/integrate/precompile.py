@@ -1,0 +1,173 @@
+"""The first-ever compile of the engine, on two cores.
+
+Numba compiles one function at a time under a global lock, so the first call of
+:func:`.driver.run` or :func:`.driver.run_block` on an empty cache compiles the whole call tree in
+one thread (about 24 s on this machine kind) while the other core idles. The Radau IIA kernels
+(:mod:`.radau5`, about 7 s with the law kernels they call) do not depend on the explicit stepper,
+the flight's closed form or the event root finders (about 8 s), and the driver's loop needs both.
+
+So when numba is about to compile one of the two entries from scratch (its ``numba:compile`` event
+fires only on a cache miss), a helper process compiles the Radau kernels (:data:`HELPER_PART`)
+while this one compiles the rest (:data:`LOCAL_PART`); both write to numba's disk cache. Once the
+helper is done, the entry's own compile here loads the Radau kernels from that cache. A cached
+kernel keeps its LLVM bitcode for inlining into its callers, so the machine code, and every
+result, is the same however the cache was filled. On a warm cache nothing here runs.
+
+The argument types below are the ones the driver calls the kernels with:
+``tests/test_precompile.py`` compiles from an empty cache and checks that no kernel is compiled
+twice and that this process compiles none of the helper's. ``PHASEIMPACT_COMPILE_PROCESSES=1``
+(the default on a single core) turns the helper off.
+"""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+import tempfile
+import warnings
+
+from numba import typeof, types
+from numba.core import event
+
+from . import dop853, driver, flight, radau5
+
+__all__ = ["HELPER_PART", "LOCAL_PART", "compile_part", "processes"]
+
+#: Environment variable: the number of processes of a first-ever compile (1 or 2).
+PROCESSES_VARIABLE = "PHASEIMPACT_COMPILE_PROCESSES"
+#: A helper that has not finished by then is abandoned (this process compiles what it needs itself).
+HELPER_TIMEOUT = 600.0
+
+_ARG_TYPES = {
+    "I": types.int64,
+    "F": types.float64,
+    "B": types.boolean,
+    "V": types.float64[::1],
+    "M": types.float64[:, ::1],
+    "IV": types.int64[::1],
+}
+
+# (function, argument types): the roots of each part; numba compiles their callees with them.
+HELPER_PART = (
+    (radau5.attempt, "I V I I F F V V F STIFF V V"),
+    (radau5.fixed_step, "I V I I F V V F STIFF V V"),
+    (radau5.dense_coefficients, "STIFF M"),
+    (radau5.enter, "I V I I V V F V STIFF"),
+    (radau5.watch, "STIFF F"),
+    (radau5.due, "STIFF"),
+    (radau5.active, "STIFF"),
+    (radau5.failed, "STIFF"),
+    (radau5.reset, "STIFF"),
+    (radau5.workspace, "I"),
+)
+LOCAL_PART = (
+    (dop853.step, "I V I I V V F M V V V"),
+    (dop853.error_norm, "M F V V F V"),
+    (dop853.dense_coefficients, "I V I I V V V V F M M V"),
+    (dop853.initial_step, "I V I I V V F V F F V V"),
+    (flight.coefficients, "V V F M"),
+    (flight.next_centre, "M F"),
+    (flight.unreachable, "M V"),
+    (driver._locate, "I V I I F I M V F F F F F V V V V"),
+    (driver._s_at_time, "I V I I M V F F F V V V V"),
+    (driver._summarize, "I V V V I I I F F F IV I M I I"),
+    (driver._events, "I V I I F V V V F V"),
+    (driver._quiet_start, "I V I V"),
+    (driver._integration_state, "I V F V"),
+    (driver._phase_tolerances, "I V V"),
+    (driver._push_event, "M I F I I V F"),
+    (driver._push_sample, "M I F V I F"),
+    (driver.stick_points, "M F B V V V"),
+    (driver.contact_side, "I V V I"),
+    (driver.initial_mode, "I V V"),
+    (driver.energy_limit_of, "I V V"),
+    (driver.restarts, "I I I B"),
+    (driver.transition, "I V I V I B"),
+)
+
+
+_HELPER = f"import {__name__} as part; part.compile_part(part.HELPER_PART)"
+
+
+def processes() -> int:
+    """How many processes a first-ever compile uses: ``PHASEIMPACT_COMPILE_PROCESSES`` (1 or 2),
+    by default 2 when this process may run on two cores."""
+    value = os.environ.get(PROCESSES_VARIABLE, "")
+    if value:
+        if value not in ("1", "2"):
+            raise ValueError(f"{PROCESSES_VARIABLE} = {value!r} is out of range; allowed: 1 or 2")
+        return int(value)
+    cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1
+    return 2 if cores >= 2 else 1
+
+
+def compile_part(part) -> None:
+    """Compile (or load from the disk cache) every root of ``part`` and its callees."""
+    for function, spec in part:
+        function.compile(tuple(_arg_type(code) for code in spec.split()))
+
+
+def _arg_type(code: str):
+    if code == "STIFF":  # the Radau state tuple, typed from the pure-Python workspace (no compile)
+        return typeof(radau5.workspace.py_func(0))
+    return _ARG_TYPES[code]
+
+
+def _start_helper():
+    """The helper process and the file its error output goes to (None if it cannot start)."""
+    env = {**os.environ, PROCESSES_VARIABLE: "1"}
+    errors = tempfile.TemporaryFile("w+")  # a file, not a pipe: nothing reads it while this process compiles
+    try:
+        helper = subprocess.Popen([sys.executable, "-c", _HELPER], env=env, stdin=subprocess.DEVNULL,
+                                  stdout=subprocess.DEVNULL, stderr=errors, text=True)
+    except OSError as exc:
+        errors.close()
+        warnings.warn(f"phaseimpact: the compile helper did not start ({exc}); compiling in one process",
+                      RuntimeWarning, stacklevel=3)
+        return None
+    return helper, errors
+
+
+def _join(helper: subprocess.Popen, errors) -> None:
+    """Wait for the helper; if it failed, say so (this process then compiles its part itself)."""
+    with errors:
+        try:
+            helper.wait(timeout=HELPER_TIMEOUT)
+        except subprocess.TimeoutExpired:
+            helper.kill()
+            helper.wait()
+            warnings.warn(f"phaseimpact: the compile helper did not finish in {HELPER_TIMEOUT:.0f} s; "
+                          "compiling its part in this process", RuntimeWarning, stacklevel=3)
+            return
+        if helper.returncode != 0:
+            errors.seek(0)
+            tail = "\n".join(errors.read().strip().splitlines()[-5:])
+            warnings.warn(f"phaseimpact: the compile helper failed (exit {helper.returncode}); compiling "
+                          f"its part in this process:\n{tail}", RuntimeWarning, stacklevel=3)
+
+
+class _FirstCompile(event.Listener):
+    """Splits the first compile of an entry over two processes (once per process)."""
+
+    def __init__(self):
+        self.done = False
+
+    def on_start(self, ev):
+        if self.done or ev.data["dispatcher"] not in (driver.run, driver.run_block):
+            return
+        self.done = True
+        if processes() < 2:
+            return
+        helper = _start_helper()
+        compile_part(LOCAL_PART)
+        if helper is not None:
+            _join(*helper)
+
+    def on_end(self, ev):
+        pass
+
+
+event.register("numba:compile", _FirstCompile())
+
+

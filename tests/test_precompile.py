@@ -1,0 +1,91 @@
+"""The two-process first compile (phaseimpact/integrate/precompile.py): from an empty numba cache,
+every kernel is compiled once, this process compiles none of the helper's, and the compiled engine
+gives bit for bit the results of the project's cache."""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from phaseimpact import seed_parameters, simulate, simulate_many
+from phaseimpact.integrate import precompile
+
+# Runs one cold session: records every phaseimpact function numba compiles in this process, then
+# the numbers of three runs and a batch.
+COLD_SESSION = r"""
+import json
+from numba.core import event
+compiled = []
+class Recorder(event.Listener):
+    def on_start(self, ev):
+        f = ev.data["dispatcher"].py_func
+        if f.__module__.startswith("phaseimpact"):
+            compiled.append(f.__module__ + "." + f.__name__)
+    def on_end(self, ev):
+        pass
+event.register("numba:compile", Recorder())
+from phaseimpact import seed_parameters, simulate, simulate_many
+p = seed_parameters(v=1.0, kappa=3e9)
+runs = [simulate(p, "hunt-crossley", 2e-3), simulate(p.replace(kappa=2e12), "paper", None, stop_on="slip"),
+        simulate(p.replace(kappa=1e14, v=5.0), "paper", 2e-3)]
+cols = simulate_many([p, p.replace(kappa=1e12), p.replace(kappa=1e14, v=5.0)], "paper", n_threads=2)
+print(json.dumps({"compiled": compiled,
+                  "runs": [[float(x) for x in r.summary] + [float(x) for x in r.final_state] for r in runs],
+                  "max_force": [float(x) for x in cols.max_force], "t_run": [float(x) for x in cols.t_run]}))
+"""
+
+# Functions compiled with a second signature on purpose (numba types a literal 0 separately).
+SEVERAL_SIGNATURES = {"phaseimpact.integrate.driver._grow", "phaseimpact.integrate.driver._push_event",
+                      "phaseimpact.integrate.driver._push_sample"}
+
+
+@pytest.fixture(scope="module")
+def cold_session(tmp_path_factory):
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path_factory.mktemp("numba-cache")),
+               PHASEIMPACT_COMPILE_PROCESSES="2")
+    env.pop("NUMBA_DISABLE_JIT", None)
+    out = subprocess.run([sys.executable, "-c", COLD_SESSION], env=env, capture_output=True, text=True,
+                         check=True, timeout=900)
+    return json.loads(out.stdout.strip().splitlines()[-1])
+
+
+def test_cold_compile_compiles_every_kernel_once_and_none_of_the_helpers(cold_session):
+    compiled = cold_session["compiled"]
+    repeated = {name for name in compiled if compiled.count(name) > 1} - SEVERAL_SIGNATURES
+    assert not repeated, f"compiled twice (a signature in precompile.py differs from the driver's): {repeated}"
+    helper_modules = {f.__module__ for f, _ in precompile.HELPER_PART}
+    here = [name for name in compiled if name.rsplit(".", 1)[0] in helper_modules]
+    assert not here, f"compiled here although the helper compiles them: {here}"
+    # the entries and this process's part were compiled here (the cache was empty)
+    for function, _ in precompile.LOCAL_PART:
+        assert f"{function.__module__}.{function.__name__}" in compiled
+    assert "phaseimpact.integrate.driver.run" in compiled
+
+
+def test_cold_compiled_engine_gives_the_same_numbers(cold_session):
+    p = seed_parameters(v=1.0, kappa=3e9)
+    runs = [simulate(p, "hunt-crossley", 2e-3), simulate(p.replace(kappa=2e12), "paper", None, stop_on="slip"),
+            simulate(p.replace(kappa=1e14, v=5.0), "paper", 2e-3)]
+    cols = simulate_many([p, p.replace(kappa=1e12), p.replace(kappa=1e14, v=5.0)], "paper", n_threads=2)
+    for cold, run in zip(cold_session["runs"], runs, strict=True):
+        np.testing.assert_array_equal(cold, np.concatenate([run.summary, run.final_state]))
+    np.testing.assert_array_equal(cold_session["max_force"], cols.max_force)
+    np.testing.assert_array_equal(cold_session["t_run"], cols.t_run)
+
+
+@pytest.mark.parametrize(("value", "expected"), [("1", 1), ("2", 2)])
+def test_processes_reads_the_environment(monkeypatch, value, expected):
+    monkeypatch.setenv(precompile.PROCESSES_VARIABLE, value)
+    assert precompile.processes() == expected
+
+
+@pytest.mark.parametrize("value", ["0", "3", "two"])
+def test_processes_refuses_other_values(monkeypatch, value):
+    monkeypatch.setenv(precompile.PROCESSES_VARIABLE, value)
+    with pytest.raises(ValueError, match=f"{precompile.PROCESSES_VARIABLE} = '{value}' is out of range"):
+        precompile.processes()
