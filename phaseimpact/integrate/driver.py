@@ -393,7 +393,7 @@ def _quiet_start(quiet, y, mode, g):
 
 
 @kernel(inline="always")  # the hot loop's own code: a call costs more than it
-def _dop853_attempt(code, c, mode, side, s, s_bound, u, fu, h_abs, rtol, atol, K, u_new, fu_new, tmp):
+def _dop853_attempt(code, c, mode, side, s, s_bound, u, fu, h_abs, rtol, atol, K, u_new, fu_new):
     """One accepted DOP853 step from ``(s, u)`` (at most to ``s_bound``), first try ``h_abs``.
 
     Returns ``(ok, s_new, h_next, force_new, evaluations)``; ``ok`` False when the step size
@@ -407,7 +407,7 @@ def _dop853_attempt(code, c, mode, side, s, s_bound, u, fu, h_abs, rtol, atol, K
             return False, s, h_abs, 0.0, evaluations
         s_new = min(s + h_abs, s_bound)
         h = s_new - s
-        force_new = dop853.step(code, c, mode, side, u, fu, h, K, u_new, fu_new, tmp)
+        force_new = dop853.step(code, c, mode, side, u, fu, h, K, u_new, fu_new)
         evaluations += 12
         err = dop853.error_norm(K, h, u, u_new, rtol, atol)
         if err < 1.0:
@@ -431,8 +431,7 @@ def _dop853_attempt(code, c, mode, side, s, s_bound, u, fu, h_abs, rtol, atol, K
 
 @kernel
 def _advance(code, c, mode, side, s, t_end, u, fu, y, f, force, h_abs, rtol, atol, max_step, flight_step, w_floor,
-             energy_limit, next_sample, steps_left, g_old, g_new, fired, K, u_new, fu_new, y_new, f_new, tmp, stats,
-             stiff):
+             energy_limit, next_sample, steps_left, g_old, g_new, fired, K, u_new, fu_new, y_new, f_new, stats, stiff):
     """Take steps in ``s`` from ``(s, u)`` while nothing happens: no event crosses, no sample and
     (regularised phase) not the horizon falls inside. Accepted steps update ``u, fu, y, f, g_old``
     and the running extremes ``stats``. DOP853 until the phase turns stiff (:mod:`.radau5`), Radau
@@ -472,7 +471,7 @@ def _advance(code, c, mode, side, s, t_end, u, fu, y, f, force, h_abs, rtol, ato
                                                                      stiff, u_new, fu_new)
             else:
                 ok, s_new, h_next, force_new, spent = _dop853_attempt(code, c, mode, side, s, s_bound, u, fu, h_abs,
-                                                                      rtol, atol, K, u_new, fu_new, tmp)
+                                                                      rtol, atol, K, u_new, fu_new)
         evaluations += spent
         if not ok:
             return _ADV_COLLAPSE, s, h, h_next, h_next, force, force_new, steps, evaluations
@@ -511,7 +510,7 @@ def _advance(code, c, mode, side, s, t_end, u, fu, y, f, force, h_abs, rtol, ato
 # inlined at numba level, like the two below: with their flight branch LLVM stopped inlining
 # these small dispatchers into the run, which cost runs without a flight 5-9 %
 @kernel(inline="always")
-def _fresh_step(code, c, mode, side, s, u, fu, h, K, u_new, fu_new, tmp, stiff):
+def _fresh_step(code, c, mode, side, s, u, fu, h, K, u_new, fu_new, stiff):
     """A step of exactly ``h`` from ``(s, u)`` with the phase's current method (the state at a
     root, a stop or the horizon); returns the evaluations spent."""
     if side == FLIGHT:
@@ -520,13 +519,13 @@ def _fresh_step(code, c, mode, side, s, u, fu, h, K, u_new, fu_new, tmp, stiff):
         return 0
     if radau5.active(stiff):
         return radau5.fixed_step(code, c, mode, side, s, u, fu, h, stiff, u_new, fu_new)
-    dop853.step(code, c, mode, side, u, fu, h, K, u_new, fu_new, tmp)
+    dop853.step(code, c, mode, side, u, fu, h, K, u_new, fu_new)
     return 12
 
 
 @kernel
-def _polish_root(code, c, mode, side, energy_limit, column, s, u, fu, s_end, g_start, g_end, x, K, u_r, fu_r, tmp,
-                 stiff, ys, fs, gs):
+def _polish_root(code, c, mode, side, energy_limit, column, s, u, fu, s_end, g_start, g_end, x, K, u_r, fu_r, stiff,
+                 ys, fs, gs):
     """Refine the root ``x`` of event ``column`` (found on the step's interpolant) on steps from
     ``s`` that end at the trial points (Illinois' regula falsi in ``[s, s_end]``).
 
@@ -541,7 +540,7 @@ def _polish_root(code, c, mode, side, energy_limit, column, s, u, fu, s_end, g_s
     best, f_best = x, math.inf
     kept = 0
     for _ in range(40):
-        evaluations += _fresh_step(code, c, mode, side, s, u, fu, x - s, K, u_r, fu_r, tmp, stiff)
+        evaluations += _fresh_step(code, c, mode, side, s, u, fu, x - s, K, u_r, fu_r, stiff)
         force = _physical(code, c, mode, side, u_r, ys, fs)
         _events(code, c, mode, side, energy_limit, u_r, ys, fs, force, gs)
         fx = gs[column]
@@ -752,8 +751,8 @@ def run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count,
         stats[0], stats[1] = max_force, max_indentation
         result, s, h, h_abs, h_next, force, force_new, d_steps, d_fev = _advance(
             code, c, mode, side, s, t_end, u, fu, y, f, force, h_abs, rtol, atol_u, max_step, flight_step, w_floor,
-            energy_limit, next_sample, max_steps - nsteps, g_old, g_new, fired, K6, u_new, fu_new, y_new, f_new, tmp6,
-            stats, stiff)
+            energy_limit, next_sample, max_steps - nsteps, g_old, g_new, fired, K6, u_new, fu_new, y_new, f_new, stats,
+            stiff)
         max_force, max_indentation = stats[0], stats[1]
         nsteps += d_steps
         nfev += d_fev
@@ -813,7 +812,7 @@ def run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count,
             if restart_col >= 0 and radau5.active(stiff):
                 s_restart, spent = _polish_root(code, c, mode, side, energy_limit, restart_col, s, u, fu, s_new,
                                                 g_old[restart_col], g_new[restart_col], s_restart, K6, u_r, fu_r,
-                                                tmp6, stiff, ys, fs, gs)
+                                                stiff, ys, fs, gs)
                 nfev += spent
             # recorded events before the restart, in time order
             while True:
@@ -826,7 +825,7 @@ def run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count,
                     break
                 fired[best] = False
                 if radau5.active(stiff):  # the state from a step to the root: the polynomial is of order 3
-                    nfev += _fresh_step(code, c, mode, side, s, u, fu, roots[best] - s, K6, us, fu_r, tmp6, stiff)
+                    nfev += _fresh_step(code, c, mode, side, s, u, fu, roots[best] - s, K6, us, fu_r, stiff)
                 else:
                     _dense(c, side, F6, u, s, h, roots[best], us)
                 f_ev = _physical(code, c, mode, side, us, ys, fs)
@@ -845,7 +844,7 @@ def run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count,
         if stop_record >= 0:
             # stopped at a recorded event: the state there from a fresh step that ends at it
             if stop_record > s:
-                nfev += _fresh_step(code, c, mode, side, s, u, fu, stop_record - s, K6, u_r, fu_r, tmp6, stiff)
+                nfev += _fresh_step(code, c, mode, side, s, u, fu, stop_record - s, K6, u_r, fu_r, stiff)
                 _copy(u_r, u)
                 if not _regularised(side):
                     u[TIME] = stop_record
@@ -872,7 +871,7 @@ def run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count,
                 i_time += 1
         if restart_col < 0 and s_horizon < math.inf:
             # a regularised phase reaches the horizon inside the step: the state there from a fresh step
-            nfev += _fresh_step(code, c, mode, side, s, u, fu, s_horizon - s, K6, u_r, fu_r, tmp6, stiff)
+            nfev += _fresh_step(code, c, mode, side, s, u, fu, s_horizon - s, K6, u_r, fu_r, stiff)
             _copy(u_r, u)
             u[TIME] = t_end  # without the root finder's residue
             force = _physical(code, c, mode, side, u, y, f)
@@ -886,7 +885,7 @@ def run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count,
             # belong to the continuation, not to the motion)
             h_r = s_restart - s
             if h_r > 0:
-                nfev += _fresh_step(code, c, mode, side, s, u, fu, h_r, K6, u_r, fu_r, tmp6, stiff)
+                nfev += _fresh_step(code, c, mode, side, s, u, fu, h_r, K6, u_r, fu_r, stiff)
             else:
                 _copy(u, u_r)
             t = s_restart if not _regularised(side) else u_r[TIME]

@@ -62,7 +62,7 @@ HELPER_PART = (
     (radau5.workspace, "I"),
 )
 LOCAL_PART = (
-    (dop853.step, "I V I I V V F M V V V"),
+    (dop853.step, "I V I I V V F M V V"),
     (dop853.error_norm, "M F V V F V"),
     (dop853.dense_coefficients, "I V I I V V V V F M M V"),
     (dop853.initial_step, "I V I I V V F V F F V V"),

@@ -25,8 +25,8 @@ from .laws import PLAIN, STUCK, ContactLaw, as_law, contact_force, contact_poten
 
 __all__ = [
     "X1", "X2", "V1", "V2", "WORK", "pack", "N_COEF",
-    "rhs", "rhs_integration", "contact_side", "damping_rate", "PLAIN_PHASE", "FLIGHT", "energy", "stick_force",
-    "stick_orbit", "stick_margin", "stick_break_distance",
+    "rhs", "rhs_integration", "rhs_values", "contact_side", "damping_rate", "PLAIN_PHASE", "FLIGHT", "energy",
+    "stick_force", "stick_orbit", "stick_margin", "stick_break_distance",
     "jacobian", "contact_force_of_states", "energy_of_states", "initial_state",
 ]
 
@@ -51,31 +51,14 @@ def spring_force(c, x2):
 
 
 @kernel
-def stick_force(c, y):
-    """Force that keeps the projectile with the target while stuck, ``F_req``, N."""
-    return c[M1_] / (c[M1_] + c[M2_]) * spring_force(c, y[X2])
+def _stick_force_at(c, x2):
+    return c[M1_] / (c[M1_] + c[M2_]) * spring_force(c, x2)
 
 
 @kernel
-def rhs(code, c, y, mode, out):
-    """Write ``dy/dt`` into ``out`` (shape (5,)); return the contact force ``P``, N."""
-    x2, v1, v2 = y[X2], y[V1], y[V2]
-    out[X1] = v1
-    out[X2] = v2
-    if mode == STUCK:
-        if c[RIGID_] > 0:
-            out[V1] = out[V2] = out[WORK] = 0.0
-            return 0.0
-        accel = -spring_force(c, x2) / (c[M1_] + c[M2_])
-        out[V1] = out[V2] = accel
-        force = stick_force(c, y)
-        out[WORK] = force * (v1 - v2)
-        return force
-    force = contact_force(code, y[X1] - x2, v1 - v2, mode, c[K_], c[DAMP_], c[ALPHA_])
-    out[V1] = -force / c[M1_]
-    out[V2] = 0.0 if c[RIGID_] > 0 else (force - spring_force(c, x2)) / c[M2_]
-    out[WORK] = force * (v1 - v2)
-    return force
+def stick_force(c, y):
+    """Force that keeps the projectile with the target while stuck, ``F_req``, N."""
+    return _stick_force_at(c, y[X2])
 
 
 #: Phase kinds of the integration (:func:`contact_side`): plain, free flight, or a regularised
@@ -109,39 +92,54 @@ def contact_side(code, c, y, mode):
 
 
 @kernel
-def rhs_integration(code, c, u, mode, side, out):
-    """Write ``du/ds`` into ``out`` (shape (6,)) for a phase of kind ``side`` (:func:`contact_side`);
-    return the contact force, N.
+def rhs_values(code, c, u0, x2, v1, v2, mode, side):
+    """The rates of a phase of kind ``side`` (:func:`contact_side`) and the contact force:
+    ``(du0, dx2, dv1, dv2, dW, dt, P)`` per unit of the phase's independent variable ``s``.
 
-    Plain and flight phases: ``u = (x1, x2, v1, v2, W, t)`` and ``s = t`` (flight: without a
-    contact force, also past ``delta = 0``). Regularised contact: ``u[0] = w`` with
-    ``delta = side w^2`` and ``dt = w ds``; past ``w = 0`` (where the phase ends on an event) the
-    force continues as an odd function of ``w``, so the equations stay smooth across the root.
+    The integration state is ``u = (u0, x2, x1dot, x2dot, W, t)``; its last two components are
+    quadratures, which the rates do not read. Plain and flight phases: ``u0 = x1`` and ``s = t``
+    (flight: without a contact force, also past ``delta = 0``). Regularised contact: ``u0 = w``
+    with ``delta = side w^2`` and ``dt = w ds``; past ``w = 0`` (where the phase ends on an event)
+    the force continues as an odd function of ``w``, so the equations stay smooth across the root.
+    Scalars in and out: a stepper keeps its stages in registers (:mod:`..integrate.dop853`).
     """
     if side == PLAIN_PHASE:
-        force = rhs(code, c, u, mode, out)
-        out[5] = 1.0
-        return force
-    x2, v1, v2 = u[X2], u[V1], u[V2]
+        deltadot = v1 - v2
+        if mode == STUCK:
+            if c[RIGID_] > 0:
+                return v1, v2, 0.0, 0.0, 0.0, 1.0, 0.0
+            accel = -spring_force(c, x2) / (c[M1_] + c[M2_])
+            force = _stick_force_at(c, x2)
+            return v1, v2, accel, accel, force * deltadot, 1.0, force
+        force = contact_force(code, u0 - x2, deltadot, mode, c[K_], c[DAMP_], c[ALPHA_])
+        target = 0.0 if c[RIGID_] > 0 else (force - spring_force(c, x2)) / c[M2_]
+        return v1, v2, -force / c[M1_], target, force * deltadot, 1.0, force
     if side == FLIGHT:
-        out[X1] = v1
-        out[X2] = v2
-        out[V1] = 0.0
-        out[V2] = 0.0 if c[RIGID_] > 0 else -spring_force(c, x2) / c[M2_]
-        out[WORK] = 0.0
-        out[5] = 1.0
-        return 0.0
-    w = u[0]
+        return v1, v2, 0.0, 0.0 if c[RIGID_] > 0 else -spring_force(c, x2) / c[M2_], 0.0, 1.0, 0.0
+    w = u0
     deltadot = v1 - v2
     force = contact_force(code, side * w * w, deltadot, mode, c[K_], c[DAMP_], c[ALPHA_])
     if w < 0:
         force = -force
-    out[0] = 0.5 * side * deltadot
-    out[X2] = w * v2
-    out[V1] = -w * force / c[M1_]
-    out[V2] = 0.0 if c[RIGID_] > 0 else w * (force - spring_force(c, x2)) / c[M2_]
-    out[WORK] = w * force * deltadot
-    out[5] = w
+    target = 0.0 if c[RIGID_] > 0 else w * (force - spring_force(c, x2)) / c[M2_]
+    return 0.5 * side * deltadot, w * v2, -w * force / c[M1_], target, w * force * deltadot, w, force
+
+
+@kernel
+def rhs_integration(code, c, u, mode, side, out):
+    """Write ``du/ds`` into ``out`` (shape (6,)) for a phase of kind ``side``; return the contact
+    force, N (:func:`rhs_values`)."""
+    out[0], out[X2], out[V1], out[V2], out[WORK], out[5], force = rhs_values(code, c, u[0], u[X2], u[V1], u[V2],
+                                                                             mode, side)
+    return force
+
+
+@kernel
+def rhs(code, c, y, mode, out):
+    """Write ``dy/dt`` into ``out`` (shape (5,)); return the contact force ``P``, N."""
+    # np.int64: a bare constant would be typed as a literal and compile rhs_values a second time
+    out[X1], out[X2], out[V1], out[V2], out[WORK], _, force = rhs_values(code, c, y[X1], y[X2], y[V1], y[V2],
+                                                                         mode, np.int64(PLAIN_PHASE))
     return force
 
 
