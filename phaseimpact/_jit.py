@@ -15,17 +15,35 @@ took and free the array under its owner. Kernels return scalars and tuples of sc
 ``allocating`` is for the few functions that create arrays (the run loops and their growing
 buffers, the Radau workspace): reference counted, as numba does by default. Both cache the
 machine code on disk (``cache=True``): the first-ever call compiles, later processes load.
+
+Both compile a function for calls from compiled code only, unless it says ``python=True``: numba
+otherwise wraps every compiled function for calls from Python too (unboxing each argument, boxing
+the result), and generating and optimising a wrapper for each of the engine's ~80 compiled
+functions took about 1.5 s of the first-ever compile (one process: 26.6 -> 25.2 s, medians of 3
+cold runs; numba's C-callable wrappers, never used here, are off for all). A function without the wrapper must never be called from Python:
+numba does not check, the call crashes. So every function Python code calls (the entries
+``run`` and ``run_block``, what a module lists in ``__all__``, what the oracle and the tests call)
+says ``python=True``, and ``tests/test_integrate.py`` finds every call from Python in the
+package, tests, benchmarks and studies and checks that its target has the wrapper.
 """
 
 from __future__ import annotations
-
-import functools
 
 import numba
 
 __all__ = ["kernel", "allocating"]
 
-#: ``@kernel`` or ``@kernel(inline="always")``: a compiled helper that allocates nothing.
-kernel = functools.partial(numba.njit, cache=True, _nrt=False)
-#: ``@allocating`` or ``@allocating(nogil=True)``: a compiled function that creates arrays.
-allocating = functools.partial(numba.njit, cache=True, _nrt=True)
+
+def _compiler(reference_counted: bool):
+    def decorate(function=None, *, python: bool = False, inline: str = "never", nogil: bool = False):
+        compile_ = numba.njit(cache=True, _nrt=reference_counted, inline=inline, nogil=nogil,
+                              no_cpython_wrapper=not python, no_cfunc_wrapper=True)
+        return compile_ if function is None else compile_(function)
+    return decorate
+
+
+#: ``@kernel``, ``@kernel(inline="always")``, ``@kernel(python=True)``: a compiled helper that
+#: allocates nothing.
+kernel = _compiler(reference_counted=False)
+#: ``@allocating``, ``@allocating(python=True, nogil=True)``: a compiled function that creates arrays.
+allocating = _compiler(reference_counted=True)

@@ -327,6 +327,85 @@ def test_engine_kernels_are_compiled_without_reference_counting():
     assert counted == {"run", "run_block", "_grow", "_push_event", "_push_sample", "_summarize", "workspace"}
 
 
+def _python_calls_of_compiled_functions():
+    """Every call of a compiled function from Python code (not from a compiled function) in the
+    package, tests, benchmarks and studies: ``(where, dispatcher)``, names resolved through each
+    file's imports."""
+    import ast
+    import importlib
+    from pathlib import Path
+
+    from numba.core.registry import CPUDispatcher
+
+    root = Path(__file__).resolve().parents[1]
+    modules = {}
+    for path in (root / "phaseimpact").rglob("*.py"):
+        name = ".".join(path.relative_to(root).with_suffix("").parts).removesuffix(".__init__")
+        modules[name] = importlib.import_module(name)
+
+    def compiled(module_name, attr):
+        obj = getattr(modules.get(module_name), attr, None)
+        return obj if isinstance(obj, CPUDispatcher) else None
+
+    def is_compiled_function(node):
+        return any(ast.unparse(d).startswith(("kernel", "allocating")) for d in node.decorator_list)
+
+    calls = []
+    for folder in ("phaseimpact", "tests", "benchmarks", "studies"):
+        for path in (root / folder).rglob("*.py"):
+            package = ".".join(path.relative_to(root).parts[:-1])
+            tree = ast.parse(path.read_text())
+            aliases = {}  # local name -> a module's name, or (module name, attribute)
+            for node in ast.walk(tree):
+                if isinstance(node, ast.Import):
+                    for a in node.names:
+                        aliases[a.asname or a.name] = a.name
+                elif isinstance(node, ast.ImportFrom):
+                    base = node.module or ""
+                    if node.level:  # relative: the package's first parts, then the module
+                        parts = package.split(".")
+                        base = ".".join(parts[:len(parts) - node.level + 1] + ([base] if base else []))
+                    for a in node.names:
+                        full = f"{base}.{a.name}"
+                        aliases[a.asname or a.name] = full if full in modules else (base, a.name)
+
+            def visit(node, in_compiled, path=path, aliases=aliases):
+                if isinstance(node, ast.FunctionDef):
+                    in_compiled = is_compiled_function(node)
+                if isinstance(node, ast.Call) and not in_compiled:
+                    target, f = None, node.func
+                    if isinstance(f, ast.Name) and isinstance(aliases.get(f.id), tuple):
+                        target = compiled(*aliases[f.id])
+                    elif isinstance(f, ast.Attribute) and isinstance(f.value, ast.Name) \
+                            and isinstance(aliases.get(f.value.id), str):
+                        target = compiled(aliases[f.value.id], f.attr)
+                    if target is not None:
+                        calls.append((f"{path.relative_to(root)}:{node.lineno}", target))
+                for child in ast.iter_child_nodes(node):
+                    visit(child, in_compiled)
+
+            visit(tree, False)
+    return calls, modules
+
+
+def test_compiled_functions_called_from_python_have_a_python_entry():
+    """A compiled function without numba's CPython wrapper (``phaseimpact._jit``: all but
+    ``python=True``) crashes the interpreter when Python calls it: every call from Python code,
+    and every compiled function a module exports, must reach one with the wrapper."""
+    from numba.core.registry import CPUDispatcher
+
+    calls, modules = _python_calls_of_compiled_functions()
+    assert len(calls) > 40  # the scan sees the calls (the oracle, the tests, the api)
+    missing = sorted({where + " " + target.py_func.__qualname__ for where, target in calls
+                      if target.targetoptions.get("no_cpython_wrapper")})
+    assert not missing, missing
+    for name, module in modules.items():
+        for exported in getattr(module, "__all__", ()):
+            obj = getattr(module, exported)
+            if isinstance(obj, CPUDispatcher):
+                assert not obj.targetoptions.get("no_cpython_wrapper"), f"{name}.{exported}"
+
+
 def test_no_kernel_returns_an_array():
     """A kernel (compiled without reference counting) that returned an array to a counting caller
     would have it freed under its owner (memory corruption): every compiled overload of every

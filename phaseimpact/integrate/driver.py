@@ -594,7 +594,7 @@ def _phase_step(code, c, mode, side, u, fu, rtol, atol, t_end, max_step, w_floor
                                max_step if not _regularised(side) else max_step / max(abs(u[0]), w_floor), tmp, f1)
 
 
-@allocating
+@allocating(python=True)
 def run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count, save_kind, times,
         max_steps, max_events, rk4_step, rk4_every, stiff_after):
     """Integrate one trajectory. See :func:`phaseimpact.integrate.simulate` for the meaning.
@@ -1010,7 +1010,7 @@ def _summarize(code, c, y0, y, mode, status, reason, t_stop, max_force, max_inde
     return s
 
 
-@kernel
+@kernel(python=True)
 def stick_points(ev, t_stop, permanent, out_t, out_delta, out_dwell):
     """Stick phases of an event log (columns ``EV_*``): time, ``delta*`` and dwell (to the next
     slip; to ``t_stop``, or inf if the last stick is permanent). Writes up to ``len(out_t)``;
@@ -1034,7 +1034,7 @@ def stick_points(ev, t_stop, permanent, out_t, out_delta, out_dwell):
     return n
 
 
-@allocating(nogil=True)
+@allocating(python=True, nogil=True)
 def run_block(code, C, Y0, t_end, rtol, ATOL, max_step, settle, stop_kind, stop_count, max_steps, max_events,
               rk4_step, stiff_after, start, stop, summary, st_t, st_delta, st_dwell, st_count):
     """Runs ``start..stop-1`` of a batch, without the GIL (callers run blocks in threads; each run's

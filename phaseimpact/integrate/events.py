@@ -110,7 +110,7 @@ def event_value(code, c, y, f, force, mode, energy_limit, column):
     return -1.0
 
 
-@kernel
+@kernel(python=True)
 def event_values(code, c, y, f, force, mode, energy_limit, g):
     """All event functions at ``y`` into ``g`` (:func:`event_value`)."""
     for column in range(N_EVENTS):
@@ -138,7 +138,7 @@ def crossed(column, g_old, g_new):
     return d <= 0 and g_old[column] > 0 and g_new[column] <= 0
 
 
-@kernel
+@kernel(python=True)
 def departure_sign(column, y, mode):
     """Sign event ``column`` takes just after a run restarts on its zero at ``y``."""
     if column == DELTA:
@@ -151,7 +151,7 @@ def departure_sign(column, y, mode):
     return 1.0
 
 
-@kernel
+@kernel(python=True)
 def restarts(code, column, mode, settle):
     """Whether an event of ``column`` changes the phase (restart) rather than being recorded."""
     if column == FORCE_RATE:
@@ -171,7 +171,7 @@ def _stick_bound(code, c, y):
     return c[K_] * hertz_power(abs(delta), c[ALPHA_])
 
 
-@kernel
+@kernel(python=True)
 def initial_mode(code, c, y):
     """Mode of a run starting at ``y``: the sign of ``deltadot``, or stuck (``paper``) when the
     relative velocity is zero and the stick bound holds (seed eq. 6 gives +1)."""
@@ -188,7 +188,7 @@ def initial_mode(code, c, y):
     return -1 if required < 0 else 1
 
 
-@kernel
+@kernel(python=True)
 def transition(code, c, column, y, mode, settle):
     """Apply event ``column`` located at ``y`` (corrected in place).
 
@@ -235,7 +235,7 @@ def transition(code, c, column, y, mode, settle):
     return SETTLED, mode, (STOP_SETTLED if settle else GO_ON)
 
 
-@kernel
+@kernel(python=True)
 def energy_limit_of(code, c, y0):
     """Energy at which a run counts as a runaway (a multiple of its own initial energy)."""
     e0 = energy(code, c, y0)

@@ -91,7 +91,7 @@ _KIND, _AMPLITUDE, _OMEGA, _M, _PSI, _S_REF = range(6)
 _QUARTER = 0  # in F[2]
 
 
-@kernel
+@kernel(python=True)
 def coefficients(c, u, s, F):
     """The invariants of the flight through the integration state ``u`` at ``s`` into ``F[0]``
     (and the quarter period into ``F[2]``)."""
@@ -129,7 +129,7 @@ def coefficients(c, u, s, F):
     F[2, _QUARTER] = 0.5 * math.pi if m == 0 else _complete(m)
 
 
-@kernel
+@kernel(python=True)
 def next_centre(F, s):
     """Where after ``s`` the target next passes its centre ``x2 = 0`` (``cn = 0``, the elliptic
     argument an odd multiple of ``K``); inf for a free or rigid target, which has none."""
@@ -145,7 +145,7 @@ def next_centre(F, s):
     return centre
 
 
-@kernel
+@kernel(python=True)
 def state_at(c, F, u0, s0, s, out):
     """The integration state at ``s`` of the flight that was at ``u0`` at ``s0`` (its invariants in
     ``F[0]``, from :func:`coefficients`); the time is ``s`` itself (a plain phase). At ``s0`` it
@@ -183,7 +183,7 @@ def state_at(c, F, u0, s0, s, out):
         out[V2] = -amplitude * omega * scratch[0] * scratch[2]
 
 
-@kernel
+@kernel(python=True)
 def unreachable(F, u):
     """Whether no event can happen any more in the flight whose invariants are in ``F``: the
     projectile recedes beyond the target's reach and faster than the target can move (so

@@ -75,7 +75,7 @@ WS_ROWS = 24
 N_CTL = 13
 
 
-@allocating
+@allocating(python=True)
 def workspace(switch_after):
     """A fresh ``stiff`` tuple for one run: ``(ws, real LU, complex LU, complex vector, pivots, ctl,
     state, derivative, start, start derivative)``; the last four are scratch states for the
@@ -101,7 +101,7 @@ def active(stiff):
     return stiff[5][ON] != 0.0
 
 
-@kernel
+@kernel(python=True)
 def failed(stiff):
     """True once a step to a root could not be taken (the run must end with a failure status)."""
     return stiff[5][FAILED] != 0.0
@@ -121,7 +121,7 @@ def due(stiff):
     return ctl[ON] == 0.0 and ctl[SWITCH_AFTER] > 0.0 and ctl[COUNT] >= ctl[SWITCH_AFTER]
 
 
-@kernel
+@kernel(python=True)
 def enter(code, c, mode, side, u, fu, rtol, atol, stiff):
     """Switch the phase to Radau at ``(u, fu)``; returns the evaluations spent (the Jacobian)."""
     ws, ctl = stiff[0], stiff[5]
@@ -426,7 +426,7 @@ def attempt(code, c, mode, side, s, s_bound, u, fu, h_abs, stiff, u_new, fu_new)
     return True, s_new, h * factor, force_new, evaluations
 
 
-@kernel
+@kernel(python=True)
 def fixed_step(code, c, mode, side, s, u, fu, h, stiff, u_new, fu_new):
     """A step of exactly ``h`` (to an event's root) without error control, split into equal
     sub-steps until Newton converges. Returns the evaluations spent."""

@@ -52,7 +52,7 @@ STUCK, PLAIN = 0, 2
 CONTACT_READINGS = ("printed", "unilateral")
 
 
-@kernel(inline="always")
+@kernel(python=True, inline="always")
 def hertz_power(ad, alpha):
     """``ad**alpha`` for ``ad >= 0``; Hertz's 3/2 as the cheaper ``ad*sqrt(ad)``."""
     if alpha == 1.5:
@@ -65,7 +65,7 @@ def _sign(x):
     return 1.0 if x > 0 else (-1.0 if x < 0 else 0.0)
 
 
-@kernel
+@kernel(python=True)
 def contact_force(code, delta, deltadot, mode, K, damping, alpha):
     """Contact force ``P`` (N, positive pushing the bodies apart) while slipping or free.
 
@@ -88,7 +88,7 @@ def contact_force(code, delta, deltadot, mode, K, damping, alpha):
     return (K + damping * deltadot) * hertz_power(abs(delta), alpha) * sign
 
 
-@kernel
+@kernel(python=True)
 def force_partials(code, delta, deltadot, mode, K, damping, alpha):
     """``(dP/ddelta, dP/ddeltadot)`` of :func:`contact_force` (exact; zero where ``P`` is 0).
 
@@ -113,7 +113,7 @@ def force_partials(code, delta, deltadot, mode, K, damping, alpha):
     return sign * (K + damping * deltadot) * stiffness * _sign(delta), sign * damping * hertz_power(ad, alpha)
 
 
-@kernel
+@kernel(python=True)
 def contact_potential(code, delta, K, alpha):
     """Potential of the elastic term, ``K |delta|^(alpha+1)/(alpha+1)`` (J), for the laws whose
     elastic term is conservative; 0 for ``paper``, whose elastic term acts like friction."""

@@ -55,7 +55,7 @@ def _stick_force_at(c, x2):
     return c[M1_] / (c[M1_] + c[M2_]) * spring_force(c, x2)
 
 
-@kernel
+@kernel(python=True)
 def stick_force(c, y):
     """Force that keeps the projectile with the target while stuck, ``F_req``, N."""
     return _stick_force_at(c, y[X2])
@@ -66,7 +66,7 @@ def stick_force(c, y):
 PLAIN_PHASE, FLIGHT = 0, 2
 
 
-@kernel
+@kernel(python=True)
 def contact_side(code, c, y, mode):
     """How the driver integrates the phase that starts at ``y`` in ``mode``.
 
@@ -91,7 +91,7 @@ def contact_side(code, c, y, mode):
     return side
 
 
-@kernel
+@kernel(python=True)
 def rhs_values(code, c, u0, x2, v1, v2, mode, side):
     """The rates of a phase of kind ``side`` (:func:`contact_side`) and the contact force:
     ``(du0, dx2, dv1, dv2, dW, dt, P)`` per unit of the phase's independent variable ``s``.
@@ -125,7 +125,7 @@ def rhs_values(code, c, u0, x2, v1, v2, mode, side):
     return 0.5 * side * deltadot, w * v2, -w * force / c[M1_], target, w * force * deltadot, w, force
 
 
-@kernel
+@kernel(python=True)
 def rhs_integration(code, c, u, mode, side, out):
     """Write ``du/ds`` into ``out`` (shape (6,)) for a phase of kind ``side``; return the contact
     force, N (:func:`rhs_values`)."""
@@ -134,7 +134,7 @@ def rhs_integration(code, c, u, mode, side, out):
     return force
 
 
-@kernel
+@kernel(python=True)
 def rhs(code, c, y, mode, out):
     """Write ``dy/dt`` into ``out`` (shape (5,)); return the contact force ``P``, N."""
     # np.int64: a bare constant would be typed as a literal and compile rhs_values a second time
@@ -143,7 +143,7 @@ def rhs(code, c, y, mode, out):
     return force
 
 
-@kernel(inline="always")
+@kernel(python=True, inline="always")
 def damping_rate(code, c, u, mode, side):
     """How fast the contact damps the relative motion at the integration state ``u`` of a phase
     of kind ``side``: ``dP/d(deltadot) (1/M1 + 1/M2)`` per unit of the phase's independent
@@ -158,7 +158,7 @@ def damping_rate(code, c, u, mode, side):
     return rate * abs(u[0]) if regularised else rate
 
 
-@kernel
+@kernel(python=True)
 def energy(code, c, y):
     """Mechanical energy (docs/physics.md §4), J: kinetic + target springs + the contact potential
     of laws whose elastic term is conservative."""
@@ -185,7 +185,7 @@ def target_reach(c, y):
     return _orbit_amplitude(c, y[X2], y[V2], c[M2_])
 
 
-@kernel
+@kernel(python=True)
 def stick_orbit(c, y):
     """Amplitude ``A`` of the stuck pair's orbit and the ``|x2|`` at which the stick breaks.
 
@@ -207,7 +207,7 @@ def stick_orbit(c, y):
     return amplitude, x_break
 
 
-@kernel
+@kernel(python=True)
 def stick_margin(c, y):
     """Relative margin of a stick entered at ``y``: ``1 - M1/M S(A) / (K |delta*|^alpha)``.
 
@@ -224,7 +224,7 @@ def stick_margin(c, y):
     return 1.0 - required / bound
 
 
-@kernel
+@kernel(python=True)
 def stick_break_distance(c, y):
     """Stick-break event function, monotone along each half-swing of the stuck pair, m.
 
@@ -272,14 +272,14 @@ def jacobian(y, params: Parameters, law, mode: int = 1) -> np.ndarray:
     return J
 
 
-@kernel
+@kernel(python=True)
 def _force_of_states(code, c, ys, modes, out):
     work = np.empty(5)
     for i in range(ys.shape[0]):
         out[i] = rhs(code, c, ys[i], modes[i], work)
 
 
-@kernel
+@kernel(python=True)
 def _energy_of_states(code, c, ys, out):
     for i in range(ys.shape[0]):
         out[i] = energy(code, c, ys[i])
