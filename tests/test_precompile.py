@@ -39,11 +39,6 @@ print(json.dumps({"compiled": compiled,
                   "max_force": [float(x) for x in cols.max_force], "t_run": [float(x) for x in cols.t_run]}))
 """
 
-# Functions compiled with a second signature on purpose (numba types a literal 0 separately).
-SEVERAL_SIGNATURES = {"phaseimpact.integrate.driver._grow", "phaseimpact.integrate.driver._push_event",
-                      "phaseimpact.integrate.driver._push_sample"}
-
-
 @pytest.fixture(scope="module")
 def cold_session(tmp_path_factory):
     env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path_factory.mktemp("numba-cache")),
@@ -56,7 +51,7 @@ def cold_session(tmp_path_factory):
 
 def test_cold_compile_compiles_every_kernel_once_and_none_of_the_helpers(cold_session):
     compiled = cold_session["compiled"]
-    repeated = {name for name in compiled if compiled.count(name) > 1} - SEVERAL_SIGNATURES
+    repeated = {name for name in compiled if compiled.count(name) > 1}
     assert not repeated, f"compiled twice (a signature in precompile.py differs from the driver's): {repeated}"
     helper_modules = {f.__module__ for f, _ in precompile.HELPER_PART}
     here = [name for name in compiled if name.rsplit(".", 1)[0] in helper_modules]

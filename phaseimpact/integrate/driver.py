@@ -614,17 +614,18 @@ def run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count,
     nsteps = 0
     energy_limit = energy_limit_of(code, c, y0)
 
+    # np.int64: numba would type a bare 0 as a literal and compile the buffers' helpers twice
     ev = np.empty((64, N_EV_COLUMNS))
-    n_ev = 0
+    n_ev = np.int64(0)
     smp = np.empty((256 if save_kind != SAVE_SUMMARY else 1, N_SMP_COLUMNS))
-    n_s = 0
+    n_s = np.int64(0)
     counts = np.zeros(9, np.int64)
     max_force = force
     max_indentation = y[X1] - y[X2]
     i_time = 0  # next output time (save_kind == SAVE_TIMES)
 
     if y[X1] == y[X2] and y[V1] > y[V2]:
-        ev, n_ev = _push_event(ev, n_ev, 0.0, CONTACT, mode, y, force)
+        ev, n_ev = _push_event(ev, n_ev, 0.0, np.int64(CONTACT), mode, y, force)
         counts[CONTACT] += 1
     if save_kind == SAVE_STEPS:
         smp, n_s = _push_sample(smp, n_s, 0.0, y, mode, force)
