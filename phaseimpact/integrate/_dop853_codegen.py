@@ -8,8 +8,8 @@ keeps its stages in local variables and calls the scalar right-hand side
 compiler to reload what it had read, as it cannot tell the arrays apart (229 ns against 202 ns a
 step, and 11 % of a Hunt-Crossley run). The coefficients are taken from scipy, never retyped,
 and the sums keep the loop's order of operations, so the results are bit-for-bit those of the
-loops. Regenerate after a scipy upgrade
-changes the tableau (``tests/test_integrate.py`` checks the committed file against this)::
+loops. Regenerate after a scipy upgrade changes the tableau (``tests/test_integrate.py`` checks
+the committed file against this)::
 
     python -m phaseimpact.integrate._dop853_codegen
 """
