@@ -26,6 +26,7 @@ import subprocess
 import sys
 import tempfile
 import warnings
+from pathlib import Path
 
 from numba import typeof, types
 from numba.core import event
@@ -116,7 +117,10 @@ def _arg_type(code: str):
 
 def _start_helper():
     """The helper process and the file its error output goes to (None if it cannot start)."""
-    env = {**os.environ, PROCESSES_VARIABLE: "1"}
+    # the helper imports this very package, wherever this process found it
+    root = str(Path(__file__).resolve().parents[2])
+    env = {**os.environ, PROCESSES_VARIABLE: "1",
+           "PYTHONPATH": os.pathsep.join(filter(None, (root, os.environ.get("PYTHONPATH"))))}
     errors = tempfile.TemporaryFile("w+")  # a file, not a pipe: nothing reads it while this process compiles
     try:
         helper = subprocess.Popen([sys.executable, "-c", _HELPER], env=env, stdin=subprocess.DEVNULL,
