@@ -147,7 +147,7 @@ def main(argv=None) -> int:
     args = ap.parse_args(argv)
     name = "work_precision" + args.quick * "_quick"
     if args.plot_only:
-        plot(json.loads((RESULTS / f"{name}_points.json").read_text())["points"])
+        plot(json.loads((RESULTS / f"{name}_points.json").read_text())["points"], args.quick)
         return 0
     rtols = RTOLS[::2] + [RTOLS[-1]] if args.quick else RTOLS
     repeats, budget = (3, 2.0) if args.quick else (5, 10.0)
@@ -208,7 +208,7 @@ def main(argv=None) -> int:
                        "`python benchmarks/work_precision.py`\n\n" + text)
     (RESULTS / f"{name}_points.json").write_text(json.dumps({"load": end_load, "points": points}, indent=0) + "\n")
     save_targets(name, targets)
-    plot(points)
+    plot(points, args.quick)
     return 0
 
 
@@ -241,7 +241,8 @@ def equal_accuracy(points):
     return rows, targets
 
 
-def plot(points) -> None:
+def plot(points, quick: bool = False) -> None:
+    """The figure: ``figures/work_precision.png``, or a preview in ``figures/preview/`` (quick)."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -285,10 +286,11 @@ def plot(points) -> None:
     fig.suptitle(f"Work-precision, seed case kappa = {KAPPA:g}, v = 1 m/s, t_end = {T_END:g} s "
                  "(lower left is better; errors below 1e-16 drawn at 1e-16)", fontsize=11)
     fig.tight_layout(rect=(0, 0.08, 1, 0.97))
-    FIGURES.mkdir(exist_ok=True)
-    fig.savefig(FIGURES / "work_precision.png", dpi=110)
+    path = (FIGURES / "preview" if quick else FIGURES) / "work_precision.png"
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(path, dpi=110)
     plt.close(fig)
-    emit(f"\nwrote {FIGURES / 'work_precision.png'}")
+    emit(f"\nwrote {path}")
 
 
 if __name__ == "__main__":
