@@ -614,7 +614,8 @@ def run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count,
     nsteps = 0
     energy_limit = energy_limit_of(code, c, y0)
 
-    # np.int64: numba would type a bare 0 as a literal and compile the buffers' helpers twice
+    # Integer constants passed to compiled callees go as np.int64: a literal argument would compile
+    # a second copy of the callee (and of everything it calls) specialised on that value.
     ev = np.empty((64, N_EV_COLUMNS))
     n_ev = np.int64(0)
     smp = np.empty((256 if save_kind != SAVE_SUMMARY else 1, N_SMP_COLUMNS))
@@ -631,8 +632,7 @@ def run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count,
         smp, n_s = _push_sample(smp, n_s, 0.0, y, mode, force)
     if save_kind == SAVE_TIMES:
         while i_time < times.shape[0] and times[i_time] <= 0.0:
-            smp, n_s = _push_sample(smp, n_s, times[i_time], y,
-                                                            mode, force)
+            smp, n_s = _push_sample(smp, n_s, times[i_time], y, mode, force)
             i_time += 1
 
     status = SUCCESS
@@ -686,8 +686,7 @@ def run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count,
             if (d_old <= 0 < d_new) or (d_old > 0 >= d_new):
                 kind = CONTACT if d_new > 0 else SEPARATION
                 t_cross = t + h * d_old / (d_old - d_new)  # linear: RK4 resolves no event
-                ev, n_ev = _push_event(
-                    ev, n_ev, t_cross, kind, mode, y_new, force_new)
+                ev, n_ev = _push_event(ev, n_ev, t_cross, kind, mode, y_new, force_new)
                 counts[kind] += 1
             t += h
             for j in range(5):
@@ -695,8 +694,7 @@ def run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count,
             max_force = max(max_force, force_new)
             max_indentation = max(max_indentation, d_new)
             if save_kind == SAVE_STEPS and (nsteps % rk4_every == 0 or t >= t_end):
-                smp, n_s = _push_sample(smp, n_s, t, y,
-                                                                mode, force_new)
+                smp, n_s = _push_sample(smp, n_s, t, y, mode, force_new)
             if energy(code, c, y) > energy_limit:
                 reason = RUNAWAY_STOP
                 break
@@ -707,8 +705,6 @@ def run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count,
     # ---- adaptive DOP853 with events ----
     # Plain phases integrate u = (x1, x2, v1, v2, W, t) in s = t; regularised contact phases
     # (side = +-1) integrate u = (w, x2, v1, v2, W, t) in s with dt = w ds (model.rhs.rhs_integration).
-    # Integer constants passed to compiled callees go as np.int64: a literal argument would compile
-    # a second copy of the callee (and of everything it calls) specialised on that value.
     rows6 = np.empty((9 + 16 + 7, N_STATE))
     u = rows6[0]
     fu = rows6[1]
@@ -834,8 +830,7 @@ def run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count,
                 if best == REACH:
                     kind = SETTLED  # recorded only: the run goes on
                 t_ev = us[TIME] if _regularised(side) else roots[best]
-                ev, n_ev = _push_event(
-                    ev, n_ev, t_ev, kind, mode, ys, f_ev)
+                ev, n_ev = _push_event(ev, n_ev, t_ev, kind, mode, ys, f_ev)
                 counts[kind] += 1
                 max_force = max(max_force, f_ev)
                 max_indentation = max(max_indentation, ys[X1] - ys[X2])
@@ -867,8 +862,7 @@ def run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count,
                 _dense(c, side, F6, u, s, h, _s_at_time(code, c, mode, side, F6, u, s, h, times[i_time], us, ys, fs,
                                                         gs), us)
                 f_i = _physical(code, c, mode, side, us, ys, fs)
-                smp, n_s = _push_sample(smp, n_s, times[i_time], ys,
-                                                              mode, f_i)
+                smp, n_s = _push_sample(smp, n_s, times[i_time], ys, mode, f_i)
                 i_time += 1
         if restart_col < 0 and s_horizon < math.inf:
             # a regularised phase reaches the horizon inside the step: the state there from a fresh step
@@ -914,14 +908,12 @@ def run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count,
                 _events(code, c, mode, side, energy_limit, u, y, f, force, g_old)
                 _quiet_start(quiet, y, mode, g_old)
                 continue
-            ev, n_ev = _push_event(
-                ev, n_ev, t, kind, mode, y, force)
+            ev, n_ev = _push_event(ev, n_ev, t, kind, mode, y, force)
             counts[kind] += 1
             max_force = max(max_force, force)
             max_indentation = max(max_indentation, y[X1] - y[X2])
             if save_kind == SAVE_STEPS:
-                smp, n_s = _push_sample(smp, n_s, t, y,
-                                                                mode, force)
+                smp, n_s = _push_sample(smp, n_s, t, y, mode, force)
             if action == STOP_SETTLED:
                 reason = SETTLED_STOP
                 break
@@ -947,8 +939,7 @@ def run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count,
         max_force = max(max_force, force)
         max_indentation = max(max_indentation, y[X1] - y[X2])
         if save_kind == SAVE_STEPS:
-            smp, n_s = _push_sample(smp, n_s, u[TIME], y,
-                                                            mode, force)
+            smp, n_s = _push_sample(smp, n_s, u[TIME], y, mode, force)
 
     if radau5.failed(stiff):  # a step to a root did not converge: what follows it is not the motion
         status, reason = STEP_SIZE_COLLAPSE, FAILED_STOP

@@ -21,6 +21,7 @@ twice and that this process compiles none of the helper's. ``PHASEIMPACT_COMPILE
 
 from __future__ import annotations
 
+import functools
 import os
 import subprocess
 import sys
@@ -109,6 +110,7 @@ def compile_part(part) -> None:
         function.compile(tuple(_arg_type(code) for code in spec.split()))
 
 
+@functools.cache
 def _arg_type(code: str):
     if code == "STIFF":  # the Radau state tuple, typed from the pure-Python workspace (no compile)
         return typeof(radau5.workspace.py_func(0))
