@@ -1,14 +1,49 @@
 """phaseimpact: Abrate's two-degree-of-freedom impact model and the seed paper's damped variant,
 analysed as a dynamical system."""
 
-from .integrate import Columns, Event, Trajectory, scales, simulate, simulate_many
-from .model import LAWS, ContactLaw, kappa_for_restitution
-from .parameters import Geometry, Material, Parameters, derive_parameters, seed_parameters
-
+# First: phaseimpact._jit names its cache directory with it.
 __version__ = "0.2.0"
+
+import importlib
+
+from . import _environment
+
+# NumPy's f2py reads SOURCE_DATE_EPOCH once, when it is first imported (SciPy and numba import it),
+# and crashes on a bad value; so a bad value is hidden while f2py imports here, then put back for
+# phaseimpact's own check to refuse with a message. (Only then: f2py costs 0.1 s of start-up.)
+_hidden = _environment.hide_bad_source_date_epoch()
+if _hidden is not None:
+    try:
+        import numpy.f2py  # noqa: F401
+    finally:
+        _environment.restore_source_date_epoch(_hidden)
+del _hidden
+
+# The public names, imported on first use: the engine (numba, SciPy) costs about 0.3 s, which
+# the commands that integrate nothing (phaseimpact cases, params, --version) do not pay.
+_EXPORTS = {
+    "Columns": "integrate", "Event": "integrate", "Trajectory": "integrate", "scales": "integrate",
+    "simulate": "integrate", "simulate_many": "integrate",
+    "LAWS": "model", "ContactLaw": "model", "kappa_for_restitution": "model",
+    "Geometry": "parameters", "Material": "parameters", "Parameters": "parameters",
+    "derive_parameters": "parameters", "seed_parameters": "parameters",
+}
 
 __all__ = [
     "Columns", "ContactLaw", "Event", "Geometry", "LAWS", "Material", "Parameters", "Trajectory",
     "derive_parameters", "kappa_for_restitution", "scales", "seed_parameters", "simulate", "simulate_many",
     "__version__",
 ]
+
+
+def __getattr__(name):
+    module = _EXPORTS.get(name)
+    if module is None:
+        raise AttributeError(f"module 'phaseimpact' has no attribute {name!r}")
+    value = getattr(importlib.import_module(f".{module}", __name__), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__():
+    return sorted(set(globals()) | set(_EXPORTS))

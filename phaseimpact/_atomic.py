@@ -14,14 +14,17 @@ Two pieces, used together by :func:`atomic_path`:
 from __future__ import annotations
 
 import contextlib
+import ctypes
 import errno
 import fcntl
 import glob
 import os
 import re
+import stat
 import tempfile
 
-__all__ = ["PathLockedError", "atomic_path", "exclusive", "check_target", "fsync_file", "fsync_folder"]
+__all__ = ["PathLockedError", "atomic_path", "exclusive", "check_target", "fsync_file", "fsync_folder", "reserve",
+           "release_reserve"]
 
 
 class PathLockedError(ValueError):
@@ -49,14 +52,22 @@ def _holder(lock_file: str) -> str:
 def check_target(path, name: str = "out") -> str:
     """Check, without writing anything, that ``path`` can become a file; return it as ``str``.
 
-    Raises ``ValueError`` naming ``name`` for an empty path, an existing folder, a path below a
-    regular file, or a folder this process may not write in.
+    Raises ``ValueError`` naming ``name`` for an empty path, an existing folder, an existing file that
+    is not a regular file (a FIFO or device: opening it would wait or write elsewhere), a path below
+    a regular file, or a folder this process may not write in.
     """
     path = os.fspath(path)
     if not isinstance(path, str) or not path.strip():
         raise ValueError(f"{name} = {path!r} is out of range; allowed: a file path such as results.h5")
     if os.path.isdir(path):
         raise ValueError(f"{name} = {path!r} is a folder; allowed: a file path (e.g. {os.path.join(path, 'sweep.h5')})")
+    try:
+        mode = os.stat(path).st_mode
+    except OSError:
+        mode = None  # nothing there yet (or nothing readable: the checks below say what)
+    if mode is not None and not stat.S_ISREG(mode):
+        raise ValueError(f"{name} = {path!r} is not a regular file (a FIFO, device or socket); allowed: a path "
+                         "to a new or a regular file")
     folder = os.path.dirname(os.path.abspath(path))
     existing = folder
     while not os.path.exists(existing):
@@ -113,8 +124,14 @@ def exclusive(path, name: str = "out"):
         if same:
             break
         os.close(fd)
-    os.ftruncate(fd, 0)
-    os.write(fd, f"{os.getpid()}\n".encode("ascii"))
+    try:
+        os.ftruncate(fd, 0)
+        os.write(fd, f"{os.getpid()}\n".encode("ascii"))
+    except OSError as error:  # a full disk: nothing can be written, not even the lock's pid
+        with contextlib.suppress(OSError):
+            os.remove(lock_file)
+        os.close(fd)
+        raise OSError(error.errno, error.strerror, path) from None
     _HELD[key] = [fd, 1]
     try:
         yield path
@@ -174,9 +191,12 @@ def atomic_path(path, name: str = "path"):
                 os.fsync(handle.fileno())
             os.replace(tmp, path)
             fsync_folder(folder)  # the rename itself survives a power cut
-        except BaseException:
+        except BaseException as error:
             if os.path.exists(tmp):
                 os.remove(tmp)
+            if isinstance(error, OSError) and error.errno is not None and error.filename in (None, tmp):
+                # a full disk or a failing write: name the file the user asked for, not our temporary one
+                raise OSError(error.errno, error.strerror or str(error), path) from None
             raise
 
 
@@ -201,3 +221,32 @@ def fsync_file(h5file) -> None:
 
     fid = h5file.id if isinstance(h5file, h5py.File) else h5file
     os.fsync(fid.get_vfd_handle())
+
+
+_FALLOC_FL_KEEP_SIZE = 1
+_fallocate = getattr(ctypes.CDLL(None, use_errno=True), "fallocate", None)
+if _fallocate is not None:
+    _fallocate.argtypes = (ctypes.c_int, ctypes.c_int, ctypes.c_int64, ctypes.c_int64)
+
+
+def reserve(fd: int, end: int) -> None:
+    """Allocate the disk blocks of bytes ``0 .. end`` of the open file ``fd`` without changing its
+    size (``fallocate(FALLOC_FL_KEEP_SIZE)``), so that a full disk shows here, as an ``OSError``
+    (ENOSPC), and not in the middle of a library's later writes into that range. A no-op where the
+    system or the file system has no such call."""
+    if _fallocate is None or end <= 0:
+        return
+    if _fallocate(fd, _FALLOC_FL_KEEP_SIZE, 0, end) != 0:
+        code = ctypes.get_errno()
+        if code in (errno.EOPNOTSUPP, errno.ENOSYS, errno.EINVAL, errno.ENODEV, errno.ESPIPE):
+            return
+        raise OSError(code, os.strerror(code))
+
+
+def release_reserve(path: str) -> None:
+    """Give back the blocks :func:`reserve` allocated beyond the end of the closed file ``path``
+    (a shrinking truncate frees every block past the new end; the bytes stay the same)."""
+    size = os.path.getsize(path)
+    with contextlib.suppress(OSError):
+        os.truncate(path, size + 1)
+        os.truncate(path, size)

@@ -1,4 +1,5 @@
-"""How the engine is compiled (numba): the two decorators every compiled function uses.
+"""How the engine is compiled (numba): the two decorators every compiled function uses, and where
+the compiled machine code is kept.
 
 ``kernel`` is for the helpers that never allocate: the law, the right-hand sides, the steppers,
 the event functions, the driver's inner loop. They only read and write arrays their caller owns,
@@ -13,8 +14,7 @@ took and free the array under its owner. Kernels return scalars and tuples of sc
 (``tests/test_integrate.py`` checks every compiled overload).
 
 ``allocating`` is for the few functions that create arrays (the run loops and their growing
-buffers, the Radau workspace): reference counted, as numba does by default. Both cache the
-machine code on disk (``cache=True``): the first-ever call compiles, later processes load.
+buffers, the Radau workspace): reference counted, as numba does by default.
 
 Both compile a function for calls from compiled code only, unless it says ``python=True``: numba
 otherwise wraps every compiled function for calls from Python too (unboxing each argument, boxing
@@ -26,19 +26,306 @@ function Python code calls (the entries ``run`` and ``run_block``, what a module
 ``__all__``, what the oracle and the tests call) says ``python=True``, and
 ``tests/test_integrate.py`` finds every call from Python in the package, tests, benchmarks and
 studies and checks that its target has the wrapper.
+
+Numba is imported only when something is compiled. Until then (``phaseimpact cases``, ``params``,
+building a case: they import the laws but integrate nothing) a decorated function is a
+:class:`_Deferred` placeholder; the first use of one, or the first decoration once numba is
+imported (the integrator modules import it), hands every placeholder to numba and puts the
+compiled function in its place in every module that imported it.
+
+The cache
+---------
+Compiled machine code is kept on disk (numba's ``cache=True`` files) in one directory per
+version of the engine's sources, ``phaseimpact-<version>-<digest>`` (:func:`cache_info`), where
+the digest is the SHA-256 of every file whose code is compiled (:data:`ENGINE_SOURCES`). numba
+itself checks only the cached function's own file, while a cached function holds the machine
+code of every function it calls: after an edit of ``model/rhs.py`` the driver ran the old
+right-hand side. A new digest is a new, empty directory, so any edit recompiles everything.
+The directory lies in the first of these roots that can hold it:
+
+1. ``$NUMBA_CACHE_DIR`` when set;
+2. ``__pycache__/`` of the installed package (written by whoever can write the install, e.g.
+   ``phaseimpact warmup`` run by the owner of a shared install; read by everyone once it is
+   complete, even where they cannot write it);
+3. ``$XDG_CACHE_HOME/phaseimpact`` (default ``~/.cache/phaseimpact``), per user;
+4. none: every process compiles for itself, and says so on stderr when it does.
+
+Of the directories this module created in a root, the :data:`KEEP` most recently used stay (a few
+checkouts or versions side by side); older ones are removed when a new one is made.
 """
 
 from __future__ import annotations
 
-import numba
+import functools
+import hashlib
+import os
+import shutil
+import sys
+import tempfile
+import time
+from dataclasses import dataclass
+from pathlib import Path
 
-__all__ = ["kernel", "allocating"]
+__all__ = ["kernel", "allocating", "cache_info", "CacheInfo", "ENGINE_SOURCES", "processes", "PROCESSES_VARIABLE"]
+
+#: The package's root directory.
+PACKAGE = Path(__file__).resolve().parent
+#: The files whose code numba compiles, relative to :data:`PACKAGE` (folders: every ``.py`` in them).
+ENGINE_SOURCES = ("model", "integrate", "_jit.py", "_signals.py")
+#: Directories of older engine sources kept in a cache root besides the one in use.
+KEEP = 4
+#: Marks a cache directory this module made (only those are ever removed).
+_MARKER = "phaseimpact-cache"
+#: Written by ``phaseimpact warmup`` once every entry is compiled: a cache others may read only.
+COMPLETE = "complete"
+
+#: Environment variable: the number of processes of a first-ever compile (1 or 2).
+PROCESSES_VARIABLE = "PHASEIMPACT_COMPILE_PROCESSES"
+
+
+def processes() -> int:
+    """How many processes a first-ever compile uses: ``PHASEIMPACT_COMPILE_PROCESSES`` (1 or 2),
+    by default 2 when this process may run on two cores."""
+    value = os.environ.get(PROCESSES_VARIABLE, "")
+    if value:
+        if value not in ("1", "2"):
+            raise ValueError(f"{PROCESSES_VARIABLE} = {value!r} is out of range; allowed: 1 or 2")
+        return int(value)
+    cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1
+    return 2 if cores >= 2 else 1
+
+
+# ------------------------------------------------------------------------------------------------
+# Where the cache lives
+# ------------------------------------------------------------------------------------------------
+
+def _version() -> str:
+    from . import __version__  # defined before anything else in phaseimpact/__init__.py
+
+    return __version__
+
+
+def engine_digest(package: Path = PACKAGE) -> str:
+    """SHA-256 (hex, 16 digits) of the engine's sources under ``package``: names and contents."""
+    digest = hashlib.sha256()
+    files = []
+    for entry in ENGINE_SOURCES:
+        path = package / entry
+        files.extend(sorted(path.rglob("*.py")) if path.is_dir() else [path])
+    for path in files:
+        digest.update(path.relative_to(package).as_posix().encode() + b"\0")
+        digest.update(path.read_bytes() + b"\0")
+    return digest.hexdigest()[:16]
+
+
+@dataclass(frozen=True)
+class CacheInfo:
+    """Where this process keeps the compiled engine.
+
+    ``path`` is None when nothing is cached (``reason`` says why); ``writable`` is False for a
+    complete cache this user may only read; ``tried`` lists the roots tried, in order."""
+
+    path: Path | None
+    writable: bool
+    source: str
+    reason: str
+    tried: tuple[str, ...]
+
+    def describe(self) -> str:
+        if self.path is None:
+            return f"no cache ({self.reason})"
+        return f"{self.path} ({self.source}{'' if self.writable else ', read-only'})"
+
+
+def _user_root() -> Path | None:
+    base = os.environ.get("XDG_CACHE_HOME") or (os.path.join(os.path.expanduser("~"), ".cache"))
+    if not os.path.isabs(base):  # no usable HOME ("~" left as is)
+        return None
+    return Path(base) / "phaseimpact"
+
+
+def _roots() -> list[tuple[Path, str]]:
+    roots = []
+    if os.environ.get("NUMBA_CACHE_DIR"):
+        roots.append((Path(os.environ["NUMBA_CACHE_DIR"]), "NUMBA_CACHE_DIR"))
+    roots.append((PACKAGE / "__pycache__", "the install's"))
+    user = _user_root()
+    if user is not None:
+        roots.append((user, "per user"))
+    return roots
+
+
+def _writable(path: Path) -> bool:
+    try:
+        path.mkdir(parents=True, exist_ok=True)
+        tempfile.TemporaryFile(dir=path).close()
+    except OSError:
+        return False
+    return True
+
+
+def _prune(root: Path, keep: Path) -> None:
+    """Remove all but the :data:`KEEP` most recently used cache directories this module made."""
+    try:
+        ours = [d for d in root.iterdir() if d != keep and (d / _MARKER).is_file()]
+        ours.sort(key=lambda d: (d / _MARKER).stat().st_mtime, reverse=True)
+    except OSError:
+        return
+    for old in ours[KEEP:]:
+        shutil.rmtree(old, ignore_errors=True)
+
+
+def _choose() -> CacheInfo:
+    name = f"phaseimpact-{_version()}-{engine_digest()}"
+    tried = []
+    for root, source in _roots():
+        path = root / name
+        tried.append(str(path))
+        fresh = not path.exists()
+        if _writable(path):
+            marker = path / _MARKER
+            try:
+                marker.touch()  # its time is this directory's last use (pruning keeps the recent ones)
+            except OSError:
+                pass
+            if fresh:
+                _prune(root, path)
+            return CacheInfo(path, True, source, "", tuple(tried))
+        if (path / COMPLETE).is_file():  # filled by someone else (a shared install's owner): read it
+            return CacheInfo(path, False, source, "", tuple(tried))
+    return CacheInfo(None, False, "", "none of " + ", ".join(tried) + " is writable", tuple(tried))
+
+
+@functools.cache
+def cache_info() -> CacheInfo:
+    """Where this process keeps the compiled engine (chosen once, on first need)."""
+    if os.environ.get("NUMBA_DISABLE_JIT", "0") not in ("", "0"):
+        return CacheInfo(None, False, "", "NUMBA_DISABLE_JIT is set", ())
+    return _choose()
+
+
+def _cache_subdir(py_file: str) -> Path:
+    info = cache_info()
+    source = Path(py_file).resolve()
+    try:
+        return info.path / source.parent.relative_to(PACKAGE)
+    except ValueError:  # a function from outside the package: numba's own stamp guards its file
+        parent = source.parent
+        return info.path / "external" / f"{parent.name}_{hashlib.sha1(str(parent).encode()).hexdigest()[:12]}"
+
+
+@functools.cache
+def _cache_class():
+    """numba's function cache, located in :func:`cache_info`'s directory; a save that cannot be
+    written (a read-only cache) leaves the compiled function to this process alone."""
+    from numba.core import caching
+
+    class Locator(caching._SourceFileBackedLocatorMixin, caching._CacheLocator):
+        def __init__(self, py_func, py_file):
+            self._py_file = py_file
+            self._lineno = py_func.__code__.co_firstlineno
+            self._cache_path = str(_cache_subdir(py_file))
+
+        def get_cache_path(self):
+            return self._cache_path
+
+        def ensure_cache_path(self):
+            if cache_info().writable:
+                super().ensure_cache_path()
+
+        @classmethod
+        def from_function(cls, py_func, py_file):
+            return cls(py_func, py_file)
+
+    class Impl(caching.CompileResultCacheImpl):
+        _locator_classes = [Locator]
+
+    class Cache(caching.FunctionCache):
+        _impl_class = Impl
+
+        def save_overload(self, sig, data):
+            try:
+                super().save_overload(sig, data)
+            except OSError:
+                pass
+
+    return Cache
+
+
+# ------------------------------------------------------------------------------------------------
+# The decorators
+# ------------------------------------------------------------------------------------------------
+
+_pending: list[_Deferred] = []
+
+
+def _compile(function, options):
+    import numba
+
+    cache = cache_info().path is not None
+    dispatcher = numba.njit(cache=False, **options)(function)
+    if cache:
+        dispatcher._cache = _cache_class()(function)  # what numba's cache=True does, with our locator
+    return dispatcher
+
+
+class _Deferred:
+    """A function for numba, held as Python until anything needs numba (see the module's docstring).
+    Calls and attributes go to the compiled function."""
+
+    def __init__(self, function, options):
+        functools.update_wrapper(self, function)
+        self.py_func = function
+        self._options = options
+        self._dispatcher = None
+
+    def __call__(self, *args, **kwargs):
+        return _resolve(self)(*args, **kwargs)
+
+    def __getattr__(self, name):
+        if name.startswith("__") or name in ("_options", "_dispatcher"):
+            raise AttributeError(name)
+        return getattr(_resolve(self), name)
+
+    def __repr__(self):
+        return f"<phaseimpact._jit._Deferred {self.__qualname__}>"
+
+
+def _resolve(deferred: _Deferred):
+    _compile_pending()
+    return deferred._dispatcher
+
+
+def _compile_pending() -> None:
+    """Hand every placeholder to numba and replace it wherever a module holds it."""
+    if not _pending:
+        return
+    done = {}
+    while _pending:
+        item = _pending.pop(0)
+        item._dispatcher = _compile(item.py_func, item._options)
+        done[id(item)] = item
+    for module in list(sys.modules.values()):
+        namespace = getattr(module, "__dict__", None)
+        if not isinstance(namespace, dict):
+            continue
+        for key, value in list(namespace.items()):
+            if type(value) is _Deferred and id(value) in done:
+                namespace[key] = value._dispatcher
 
 
 def _compiler(reference_counted: bool):
     def decorate(function=None, *, python: bool = False, inline: str = "never", nogil: bool = False):
-        compile_ = numba.njit(cache=True, _nrt=reference_counted, inline=inline, nogil=nogil,
-                              no_cpython_wrapper=not python, no_cfunc_wrapper=True)
+        options = dict(_nrt=reference_counted, inline=inline, nogil=nogil, no_cpython_wrapper=not python,
+                       no_cfunc_wrapper=True)
+
+        def compile_(f):
+            if "numba" in sys.modules:  # numba's import is paid: compile-ready functions, placeholders too
+                _compile_pending()
+                return _compile(f, options)
+            deferred = _Deferred(f, options)
+            _pending.append(deferred)
+            return deferred
         return compile_ if function is None else compile_(function)
     return decorate
 
@@ -48,3 +335,10 @@ def _compiler(reference_counted: bool):
 kernel = _compiler(reference_counted=False)
 #: ``@allocating``, ``@allocating(python=True, nogil=True)``: a compiled function that creates arrays.
 allocating = _compiler(reference_counted=True)
+
+
+def mark_complete() -> None:
+    """Say that the cache holds every entry (``phaseimpact warmup``): other users may read it."""
+    info = cache_info()
+    if info.path is not None and info.writable:
+        (info.path / COMPLETE).write_text(time.strftime("%Y-%m-%dT%H:%M:%S%z\n"))

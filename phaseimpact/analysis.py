@@ -11,6 +11,10 @@ negligible. Two ways to find them:
   planes): runs of samples that stay within ``tol`` (relative to the plane's extent) for at
   least ``min_dwell`` become candidates; candidates closer than ``tol`` merge. The tolerance
   biases a critical value near a split; it is reported with the points.
+
+The *equilibria* of the model (:func:`fixed_points`) come from its equations, not from a
+trajectory: for the unilateral laws and ``paper`` they are sets, not isolated points
+(docs/physics.md §5, "Equilibria").
 """
 
 from __future__ import annotations
@@ -21,15 +25,14 @@ from dataclasses import dataclass
 import numpy as np
 
 from .integrate import Trajectory, scales
-from .model import V1, V2, X1, X2, ContactLaw, as_law, jacobian, pack
-from .model.rhs import KB_, KM_, rhs
+from .model import STUCK, V1, V2, X1, X2, ContactLaw, as_law, jacobian
 from .parameters import Parameters
 
 __all__ = [
     "PLANES",
     "AsymptoticPoints",
-    "FixedPoint",
-    "EquilibriumSet",
+    "STABILITY_LABELS",
+    "Equilibrium",
     "find_asymptotic_points",
     "fixed_points",
     "plane_coordinates",
@@ -164,107 +167,218 @@ def _rest_runs(trajectory: Trajectory, plane, tol: float):
     return points, np.array(merged_dwell, dtype=float)
 
 
-@dataclass(frozen=True)
-class FixedPoint:
-    """An isolated equilibrium ``(x1, x2, x1dot, x2dot)`` with its Jacobian's eigenvalues."""
-
-    state: np.ndarray
-    eigenvalues: np.ndarray
-    stability: str  # "stable", "unstable", "neutral" (no eigenvalue with positive real part)
+#: Stability labels of an equilibrium's linearisation (:func:`_stability`), plus "non-smooth" where the
+#: contact force has no derivative there (``alpha < 1`` at ``delta = 0``).
+STABILITY_LABELS = ("stable", "unstable", "centre", "non-hyperbolic", "non-smooth")
 
 
 @dataclass(frozen=True)
-class EquilibriumSet:
-    """A continuum of equilibria, reported as a set (not one arbitrary member).
+class Equilibrium:
+    """An equilibrium of eq. 1 under a contact law: an isolated point or a set (docs/physics.md §5).
 
-    ``description`` states the set; ``members`` samples it; ``eigenvalues`` of the dynamics
-    transverse to the set (at a sample member) and ``stability`` as for :class:`FixedPoint`.
+    Attributes
+    ----------
+    kind : {"point", "set"}
+        A set is reported as a set (its conditions and samples), never as one arbitrary member.
+    name : {"rest", "separated", "stuck"}
+        ``rest``: the bodies at rest in contact at ``delta = 0`` (a bilateral law); ``separated``:
+        at rest with ``delta <= 0``, no force (a unilateral law); ``stuck``: ``paper``'s pair at
+        rest with ``delta*`` frozen (the sliding set of the Filippov system).
+    description : str
+        The set in words.
+    conditions : dict
+        ``{coordinate: condition}``: ``"= 0"``, ``"<= 0"``, ``"> 0"`` or ``"any"`` for ``x1dot``,
+        ``x2dot``, ``x2`` and ``delta = x1 - x2``.
+    dimension : int
+        0 for a point; the number of free coordinates of a set.
+    state : ndarray, shape (4,)
+        ``(x1, x2, x1dot, x2dot)`` of the member where the linearisation is taken.
+    members : ndarray, shape (k, 4)
+        Samples of the set (the point itself for a point).
+    coordinates : tuple of str
+        The coordinates of the linearisation: ``(x1, x2, x1dot, x2dot)``; ``(x1, x1dot)`` on a rigid
+        target (``x2`` is held at 0); on ``paper``'s stuck set those of the sliding flow,
+        ``(x1, x2, v)`` with ``v = x1dot = x2dot`` (``(x1,)`` on a rigid target).
+    eigenvalues : ndarray of complex
+        Of the exact Jacobian (:func:`phaseimpact.model.jacobian`) at ``state`` in these
+        coordinates, 1/s; those below :data:`ZERO_RTOL` of the largest are 0 (rounding of a zero
+        Jordan block); empty where ``stability`` is ``non-smooth``.
+    stability : str
+        One of :data:`STABILITY_LABELS`, from the eigenvalues alone (:func:`_stability`).
+    note : str
+        What the linearisation does not say (the nonlinear stability of the set or point).
     """
 
+    kind: str
+    name: str
     description: str
+    conditions: dict
+    dimension: int
+    state: np.ndarray
     members: np.ndarray
+    coordinates: tuple
     eigenvalues: np.ndarray
     stability: str
+    note: str
+
+    def as_dict(self) -> dict:
+        """Plain types for JSON; eigenvalues as ``{"re", "im"}`` pairs."""
+        return {"kind": self.kind, "name": self.name, "description": self.description,
+                "conditions": dict(self.conditions), "dimension": self.dimension,
+                "state": self.state.tolist(), "members": self.members.tolist(),
+                "coordinates": list(self.coordinates),
+                "eigenvalues": [{"re": float(z.real), "im": float(z.imag)} for z in self.eigenvalues],
+                "stability": self.stability, "note": self.note}
 
 
-def _stability(eigenvalues, rtol=1e-9) -> str:
-    scale = max(np.max(np.abs(eigenvalues)), 1e-300)
+#: Eigenvalues (real parts in :func:`_stability`) below this fraction of the largest modulus are zero.
+ZERO_RTOL = 1e-6
+
+
+def _stability(eigenvalues, rtol=ZERO_RTOL) -> str:
+    """Label of a linearisation: ``unstable`` (an eigenvalue with positive real part), ``stable``
+    (all negative: hyperbolic sink), ``centre`` (all on the imaginary axis, none zero), else
+    ``non-hyperbolic`` (a zero eigenvalue, or zero real parts beside negative ones).
+
+    Real parts count as zero up to ``rtol`` times the largest modulus: a zero Jordan block splits
+    by about ``sqrt(eps)`` of the matrix's scale in floating point.
+    """
+    eigenvalues = np.asarray(eigenvalues, dtype=complex)
+    scale = float(np.max(np.abs(eigenvalues), initial=0.0))
+    if scale == 0.0:
+        return "non-hyperbolic"
     real = eigenvalues.real / scale
     if np.any(real > rtol):
         return "unstable"
     if np.all(real < -rtol):
         return "stable"
-    return "neutral"
+    if np.all(np.abs(real) <= rtol) and np.all(np.abs(eigenvalues) / scale > rtol):
+        return "centre"
+    return "non-hyperbolic"
 
 
-def fixed_points(params: Parameters, law: ContactLaw | str = "paper", *,
-                 guesses=None, tol: float = 1e-12) -> list:
-    """Equilibria of the model: isolated fixed points by Newton, and the sets of equilibria.
+def fixed_points(params: Parameters, law: ContactLaw | str = "paper") -> list[Equilibrium]:
+    """The equilibria of eq. 1 under ``law`` on ``params``' target, each a point or a set.
 
-    Newton's method runs on the right-hand side with its exact Jacobian from
-    each guess of ``(x1, x2)`` (velocities zero); sets are reported as sets: the separated
-    states of a unilateral law (``x2`` at a spring equilibrium, ``delta <= 0``), the stick set
-    of ``paper`` (``delta`` arbitrary, frozen), and the translations of a free target.
+    At rest the accelerations vanish: ``M1 x1'' + M2 x2'' = -S(x2) = 0`` gives ``x2 = 0`` (the
+    only real root of ``S(x2) = Kb x2 + Km x2^3`` with ``Kb, Km >= 0``, not both 0; any ``x2`` for
+    a free target), and then ``P = 0`` at ``deltadot = 0``. Which ``delta`` has ``P(delta, 0) = 0``
+    is the law's: ``delta <= 0`` for a unilateral law (the separated set), ``delta = 0`` for a
+    bilateral one (an isolated point on a plate), every ``delta`` for ``paper``, whose stuck pair
+    at rest needs no force, ``M1/(M1+M2) S(0) = 0 <= K |delta*|^alpha`` (the stuck set; with the
+    unilateral reading only for ``delta > 0``, the rest being separated). docs/physics.md §5.
+
+    Returns the equilibria with their linearisation (:class:`Equilibrium`); ``kappa`` and ``v``
+    move none of them (the damping acts through ``deltadot``, zero at rest), ``v`` sets only the
+    spacing of the samples (the Hertz indentation).
     """
     law = as_law(law)
-    c = pack(params, law)
-    scale = params.hertz_indentation
-    mode = 0 if law.is_filippov else 1
-    found: list = []
-    if params.target == "plate":
-        # Isolated in x2: roots of S(x2) = 0 refined by Newton on the right-hand side.
-        roots = []
-        starts = guesses if guesses is not None else [(0.0, 0.0), (scale, scale), (-scale, -scale)]
-        for x1, x2 in starts:
-            y = np.array([x1, x2, 0.0, 0.0, 0.0])
-            for _ in range(100):
-                f = _rhs(y, c, law, mode)
-                J = jacobian(y, params, law, mode)
-                try:
-                    dy = np.linalg.lstsq(J, -f, rcond=None)[0]
-                except np.linalg.LinAlgError:
-                    break
-                y[:4] += dy
-                if np.max(np.abs(dy[:2])) <= tol * scale:
-                    break
-            if np.all(np.abs(_rhs(y, c, law, mode)) <= 1e-6 * (1 + abs((c[KB_] + c[KM_] * scale**2) * scale))):
-                if not any(abs(y[X2] - r) <= 1e-9 * scale for r in roots):
-                    roots.append(float(y[X2]))
-        for x2 in roots:
-            found.extend(_equilibria_at(x2, params, c, law, scale))
-    else:
-        found.extend(_equilibria_at(0.0, params, c, law, scale))
+    s = params.hertz_indentation  # spacing of the samples along a set
+    rigid = params.target == "rigid"
+    # a plate without springs (Kb = Km = 0, API only) holds its centre nowhere: a free target
+    x2_free = params.target == "free" or (params.target == "plate" and params.Kb == 0 and params.Km == 0)
+    x2_samples = (0.0, s) if x2_free else (0.0,)
+    x2_text = "any" if x2_free else "= 0"
+    where = ("the target held at x2 = 0 (rigid)" if rigid else
+             "the target anywhere, at rest (free)" if x2_free else "the plate at its static equilibrium x2 = 0")
+    found = []
+
+    def members(deltas):
+        return np.array([[x2 + d, x2, 0.0, 0.0] for x2 in x2_samples for d in deltas])
+
+    def conditions(delta):
+        return {"x1dot": "= 0", "x2dot": "= 0", "x2": x2_text, "delta": delta}
+
+    if law.is_unilateral:
+        state = np.array([-s, 0.0, 0.0, 0.0])
+        eig, coords = _eigenvalues(state, params, law, 1)
+        if law.is_filippov:
+            bound = "paper's outward slips can feed energy (docs/physics.md §3): no energy bound holds"
+        elif not law.is_conservative:
+            bound = "the law's elastic term has no potential: no energy bound holds"
+        else:  # a potential and a damping kappa >= 0 that only dissipates
+            bound = ("the energy (docs/physics.md §4) does not grow and bounds the velocities"
+                     + ("" if x2_free or rigid else " and the plate's swing")
+                     + ", so motions that start near the set stay near it: the set is stable")
+        found.append(Equilibrium(
+            "set", "separated",
+            f"separated at rest: delta = x1 - x2 <= 0, both at rest, no contact force; {where}",
+            conditions("<= 0"), 2 if x2_free else 1, state, members((-2 * s, -s, 0.0)), coords, eig,
+            _stability(eig),
+            "no member is stable: a velocity perturbation makes the projectile drift (a zero eigenvalue pair, "
+            f"a Jordan block) along the set; {bound}"))
+    if law.is_filippov:
+        unilateral = law.is_unilateral
+        deltas = (s, 2 * s) if unilateral else (-2 * s, -s, 0.0, s, 2 * s)
+        state = np.array([s, 0.0, 0.0, 0.0])
+        eig, coords = _eigenvalues(state, params, law, STUCK)
+        holds = ("no springs pull the pair apart: the stick never breaks" if rigid or x2_free else
+                 "a small swing A of the pair at sqrt(Kb/(M1+M2)) keeps the stick while M1/(M1+M2) S(A) <= "
+                 "K |delta*|^alpha (not at delta* = 0, whose bound is 0)")
+        found.append(Equilibrium(
+            "set", "stuck",
+            f"paper's stuck pair at rest: delta* = x1 - x2 {'> 0' if unilateral else 'any'} frozen, both at rest, "
+            f"stick force M1/(M1+M2) S(x2) = 0 within the bound K |delta*|^alpha; {where}",
+            conditions("> 0" if unilateral else "any"), 2 if x2_free else 1, state, members(deltas), coords, eig,
+            _stability(eig),
+            f"eigenvalues of the sliding flow on deltadot = 0; {holds}; a small slip stops in finite time (no "
+            "eigenvalue across the set) at a nearby delta*: the set is stable, no member asymptotically stable"))
+    if not (law.is_unilateral or law.is_filippov):  # bilateral: P(delta, 0) = 0 only at delta = 0
+        state = np.zeros(4)
+        if params.alpha < 1:
+            eig, coords, label = np.empty(0, dtype=complex), _coordinates(rigid, stuck=False), "non-smooth"
+        else:
+            eig, coords = _eigenvalues(state, params, law, 1)
+            label = _stability(eig)
+        energy = ("K |delta|^(alpha+1)/(alpha+1) + M1 x1dot^2/2" if rigid else
+                  "the energy of docs/physics.md §4 (contact potential included)")
+        degenerate = ("" if params.alpha == 1 else
+                      "; for alpha < 1 the contact stiffness is infinite at delta = 0: no linearisation"
+                      if params.alpha < 1 else
+                      "; the contact stiffness alpha K |delta|^(alpha-1) vanishes at delta = 0 (alpha > 1): the "
+                      "linearisation is degenerate")
+        found.append(Equilibrium(
+            "set" if x2_free else "point", "rest",
+            f"at rest in contact at delta = x1 - x2 = 0; {where}", conditions("= 0"), 1 if x2_free else 0,
+            state, members((0.0,)), coords, eig, label,
+            f"Lyapunov stable{' as a set' if x2_free else ''}: {energy} has a strict minimum "
+            f"{'across the set' if x2_free else 'here'} (Lagrange-Dirichlet), not asymptotically (no damping at "
+            f"rest){degenerate}"))
     return found
 
 
-def _rhs(y, c, law, mode):
-    out = np.empty(5)
-    rhs(law.code, c, y, mode, out)
-    return out[:4]
+def _coordinates(rigid: bool, stuck: bool) -> tuple:
+    if stuck:
+        return ("x1",) if rigid else ("x1", "x2", "v")
+    return ("x1", "x1dot") if rigid else ("x1", "x2", "x1dot", "x2dot")
 
 
-def _equilibria_at(x2, params, c, law, scale):
-    """The equilibria with the target at ``x2``: a point or a set, with eigenvalues."""
-    deltas = np.linspace(-2 * scale, 2 * scale, 5)
-    members = np.array([[x2 + d, x2, 0.0, 0.0] for d in deltas])
-    where = f"at x2 = {x2:g} m" if params.target != "free" else "with any x2 (free target)"
-    if law.is_filippov:
-        y = np.array([x2 + scale, x2, 0.0, 0.0, 0.0])
-        J = jacobian(y, params, law, 0)
-        eig = np.linalg.eigvals(J)
-        return [EquilibriumSet(f"stick set: any frozen delta, both at rest, target {where}", members,
-                               eig, _stability(eig))]
-    if law.is_unilateral:
-        y = np.array([x2 - scale, x2, 0.0, 0.0, 0.0])
-        J = jacobian(y, params, law, 1)
-        eig = np.linalg.eigvals(J)
-        separated = members[deltas <= 0]
-        return [EquilibriumSet(f"separated states: delta <= 0, both at rest, target {where}", separated,
-                               eig, _stability(eig))]
-    y = np.array([x2, x2, 0.0, 0.0, 0.0])
-    J = jacobian(y, params, law, 1)
-    eig = np.linalg.eigvals(J)
-    return [FixedPoint(y[:4].copy(), eig, _stability(eig))]
+def _eigenvalues(state, params, law, mode):
+    """Eigenvalues of the exact Jacobian at ``state`` in ``mode``, in the coordinates that move.
+
+    A rigid target's ``(x2, x2dot)`` are held, not dynamics. Stuck, the motion is the sliding flow
+    on ``x1dot = x2dot = v`` (an invariant plane of the stuck field): the Jacobian restricted to it.
+    """
+    rigid = params.target == "rigid"
+    stuck = mode == STUCK
+    y = state
+    if not stuck and not law.is_unilateral and params.alpha == 1:
+        # force_partials gives 0 at delta = 0 exactly; for alpha = 1 the stiffness is K at every delta
+        y = state + np.array([params.hertz_indentation, 0.0, 0.0, 0.0])
+    J = jacobian(y, params, law, mode)
+    if stuck:
+        embed = np.array([[1.0, 0, 0], [0, 1, 0], [0, 0, 1], [0, 0, 1]])  # (x1, x2, v) -> state
+        J = np.linalg.pinv(embed) @ J @ embed
+        keep = [0] if rigid else [0, 1, 2]
+    else:
+        keep = [X1, V1] if rigid else [X1, X2, V1, V2]
+    eig = np.linalg.eigvals(J[np.ix_(keep, keep)])
+    # rounding noise to exact zeros: a zero Jordan block (the drift along a set) splits by about
+    # sqrt(eps) of the matrix's scale, and real parts of a centre by about eps
+    scale = float(np.max(np.abs(eig), initial=0.0))
+    eig[np.abs(eig) <= ZERO_RTOL * scale] = 0.0
+    eig.real[np.abs(eig.real) <= 1e-12 * scale] = 0.0
+    return eig, _coordinates(rigid, stuck)
 
 
 def phase_portrait(params: Parameters, law: ContactLaw | str, kappas=None, *, speeds=None, states=None,

@@ -66,23 +66,36 @@ computed); rows not referenced by a committed point's ``stick_first``/``stick_co
 out (or the file is not an archive of the same grid) a checkpoint rewrites the file atomically as
 :func:`save` does, with room for the stick phases still to come. Archives of schema 1
 (phaseimpact 0.1) and 2 (groups ``/sweep``, ``/curve``) still load.
+
+Integrity. Every chunk of every variable carries a Fletcher-32 checksum (HDF5's filter, which
+netCDF-4, h5netcdf and h5py verify on every read); the file format is HDF5 1.8's, whose superblock
+and object headers (attributes included) are checksummed; root attribute ``text_sha256`` is the
+SHA-256 of the text attributes (HDF5 keeps them in its global heap, without a checksum); the chunk
+index (a v1 B-tree, without one) is checked on load. :func:`load` and :func:`describe` also check the
+content (codes within their tables, finite axes, scalar attributes) and refuse a damaged file with a
+:class:`DamagedArchiveError` (a ``ValueError``) that names it and the damage; what a checkpoint
+in progress leaves at points not yet committed and in unused stick rows is not damage.
 """
 
 from __future__ import annotations
 
+import contextlib
 import datetime
 import hashlib
+import itertools
 import json
 import math
 import os
 import re
+import stat
+import time
 from dataclasses import dataclass
 
 import h5py
 import numpy as np
 
 from . import __version__
-from ._atomic import atomic_path, exclusive, fsync_file
+from ._atomic import atomic_path, exclusive, fsync_file, release_reserve, reserve
 from .continuation import CriticalCurve, SweepResult
 from .continuation.grid import Axis, Grid
 from .integrate import OUTCOMES, STATUSES
@@ -92,7 +105,7 @@ from .model import ContactLaw
 from .parameters import Parameters
 
 __all__ = ["SCHEMA_VERSION", "KINDS", "CHUNK_POINTS", "Checkpoint", "save", "load", "describe", "same_work",
-           "check_overwrite", "kind_of", "created_timestamp"]
+           "check_overwrite", "kind_of", "created_timestamp", "DamagedArchiveError"]
 
 SCHEMA_VERSION = 3
 KINDS = ("sweep", "atlas", "critical-curve")
@@ -123,6 +136,19 @@ _LONG_NAMES = {
 _RESERVED = ("status", "outcome", "stop_reason", "stick_first", "stick_count", "stick_point", "stick_t",
              "stick_delta", "stick_dwell", "point", "stick", "extras")
 _NOT_A_VARIABLE = "This is a netCDF dimension but not a netCDF variable."
+#: Every dataset that holds data carries a Fletcher-32 checksum per chunk (HDF5's own filter, which
+#: netCDF-4, h5netcdf and h5py all read): damaged bytes fail the read instead of loading as numbers.
+_CHECKED = {"fletcher32": True}
+#: The HDF5 file format of HDF5 1.8 (read by netCDF-C >= 4.1 and h5py): its superblock and object
+#: headers (attributes included) carry checksums, so most damaged metadata is refused too. Pinned,
+#: so that a newer HDF5 writes the same bytes. Not 1.10's format: its superblock marks the file open
+#: while a checkpoint writes in place, which refuses readers then and every open after a kill -9.
+#: What its metadata checksums leave out is checked on load: the chunk index (a v1 B-tree, see
+#: :func:`_check_storage`) and the global heap of variable-length strings (:data:`_TEXT_DIGEST`).
+_LIBVER = ("v108", "v108")
+#: Root attribute: SHA-256 of the file's text attributes, which HDF5 keeps in its global heap (no
+#: checksum there: a changed digit of the case JSON would load silently).
+_TEXT_DIGEST = "text_sha256"
 
 
 # ------------------------------------------------------------------------------------------------
@@ -273,11 +299,12 @@ def _fixed(group, name, data, dtype, chunks, *, fill=None, fill_attr=True, units
     if 0 in shape:
         d = group.create_dataset(name, shape=shape, dtype=dtype, fillvalue=fill)
     else:
+        _reserve(group.file, _storage_bytes(shape, chunks, dtype.itemsize))
         dcpl = h5py.h5p.create(h5py.h5p.DATASET_CREATE)
         dcpl.set_alloc_time(h5py.h5d.ALLOC_TIME_EARLY)
         # every element is written just below: HDF5 need not write the fill value first
         d = group.create_dataset(name, shape=shape, dtype=dtype, chunks=chunks, fillvalue=fill, fill_time="never",
-                                 dcpl=dcpl)
+                                 dcpl=dcpl, **_CHECKED)
         if rows is None:
             d[...] = data
         else:
@@ -411,6 +438,38 @@ def save(result: SweepResult | CriticalCurve, path, *, force: bool = False) -> s
     return os.fspath(path)
 
 
+#: Disk space reserved beyond a dataset's data while an archive is written (object headers,
+#: attributes, the metadata HDF5 writes when the file closes), bytes.
+_RESERVE_MARGIN = 1 << 18
+
+
+def _storage_bytes(shape, chunks, itemsize: int) -> int:
+    """Bytes a dataset's allocated chunks (or its contiguous data) take on disk, checksums included."""
+    if not chunks:
+        return int(np.prod(shape)) * itemsize
+    n_chunks = int(np.prod([-(-n // c) for n, c in zip(shape, chunks, strict=True)]))
+    return n_chunks * (int(np.prod(chunks)) * itemsize + 4)
+
+
+def _reserve(f, nbytes: int) -> None:
+    """Reserve the disk blocks for the next ``nbytes`` of the archive ``f`` being written.
+
+    HDF5 must never meet a full disk: a failed write leaves objects it can no longer close (their
+    finalizers print a traceback each) and the interpreter's exit then crashes inside HDF5 (a
+    segfault). Reserved first, a full disk is an ``OSError`` here, before HDF5 writes."""
+    fd = f.id.get_vfd_handle()
+    reserve(fd, max(int(f.id.get_filesize()), os.fstat(fd).st_size) + nbytes + _RESERVE_MARGIN)
+
+
+def _as_disk_error(error: Exception) -> OSError | None:
+    """HDF5's report of a failed write (h5py raises it as ValueError or RuntimeError) as an OSError."""
+    found = re.search(r"errno = (\d+)", str(error))
+    if found is None or "write failed" not in str(error):
+        return None
+    code = int(found.group(1))
+    return OSError(code, os.strerror(code))
+
+
 def _write_file(result, path: str, *, force: bool, spare_rows: int):
     """Write a whole archive atomically; a sweep's stick variables get ``spare_rows`` free rows.
     Returns the sweep's per-point ``(stick_first, stick_count)`` (None for a curve)."""
@@ -420,12 +479,40 @@ def _write_file(result, path: str, *, force: bool, spare_rows: int):
         if not force and os.path.isfile(path) and not _is_archive(path):
             raise ValueError(f"path = {path!r} exists and is not a phaseimpact archive; refusing to replace it "
                              "(force=True replaces it)")
-        with h5py.File(tmp, "w") as f:
-            if layout is None:
-                _write_curve(f, result, created)
-            else:
-                _write_sweep(f, result, created, layout, spare_rows)
+        try:
+            with h5py.File(tmp, "w", libver=_LIBVER) as f:
+                _reserve(f, 0)  # the header, attributes and small datasets
+                if layout is None:
+                    _write_curve(f, result, created)
+                else:
+                    _write_sweep(f, result, created, layout, spare_rows)
+                f.attrs[_TEXT_DIGEST] = _texts_digest(f)
+                _reserve(f, 0)  # what the close writes
+        except (ValueError, RuntimeError) as error:
+            disk = _as_disk_error(error)
+            if disk is None:
+                raise
+            raise disk from None  # atomic_path names the path
+        release_reserve(tmp)
     return None if layout is None else (layout.first, layout.count)
+
+
+def _texts_digest(f) -> str:
+    """SHA-256 of the text attributes :func:`load` reads: the root's (but the digest's own) and those of
+    ``/extras`` (object path, name, value)."""
+    h = hashlib.sha256()
+
+    def add(name, node):
+        for key in sorted(node.attrs):
+            value = node.attrs[key] if key != _TEXT_DIGEST else None
+            if isinstance(value, str):
+                h.update(json.dumps([name, key, value]).encode())
+
+    add("/", f)
+    if "extras" in f:
+        add("extras", f["extras"])
+        f["extras"].visititems(add)
+    return h.hexdigest()
 
 
 def _header(f, kind: str, law: ContactLaw, base, t_end, rtol, engine: str, created: str, settings=None) -> None:
@@ -504,7 +591,7 @@ def _write_sweep(f, r: SweepResult, created: str, layout: _Layout, spare_rows: i
     f.attrs["extras_digest"] = _digest(r.extras)
     scales = []
     for axis, dim in zip(grid.axes, dims, strict=True):
-        d = f.create_dataset(dim, data=np.asarray(axis.values, dtype=float))
+        d = f.create_dataset(dim, data=np.asarray(axis.values, dtype=float), **_CHECKED)
         d.make_scale(dim)
         d.attrs["units"] = axis_units(axis.name, alpha)
         d.attrs["long_name"] = axis.name
@@ -553,7 +640,7 @@ def _write_tree(group, tree: dict) -> None:
             continue
         array = np.asarray(value) if isinstance(value, (np.ndarray, list, tuple)) else None
         if array is not None and array.dtype.kind in "biuf" and array.size:
-            d = group.create_dataset(key, data=array.astype(np.int8) if array.dtype.kind == "b" else array)
+            d = group.create_dataset(key, data=array.astype(np.int8) if array.dtype.kind == "b" else array, **_CHECKED)
             d.attrs["type"] = "bool" if array.dtype.kind == "b" else "array"
         else:
             rest[key] = value
@@ -568,19 +655,19 @@ def _write_curve(f, c: CriticalCurve, created: str) -> None:
     f.attrs["what"] = c.what
     f.attrs["contact_index"] = np.int64(c.contact_index)
     f.attrs["message"] = str(c.message)
-    values = f.create_dataset(dim, data=np.asarray(c.values, dtype=float))
+    values = f.create_dataset(dim, data=np.asarray(c.values, dtype=float), **_CHECKED)
     values.make_scale(dim)
     values.attrs["units"] = axis_units(c.param, alpha)
     values.attrs["long_name"] = c.param
     values.attrs["parameter"] = c.param
     for name in ("kappa", "closed_form", "predicted"):
-        d = f.create_dataset(name, data=np.asarray(getattr(c, name), dtype=float))
+        d = f.create_dataset(name, data=np.asarray(getattr(c, name), dtype=float), **_CHECKED)
         d.attrs["_FillValue"] = np.float64(np.nan)
         d.attrs["units"] = kappa_units(alpha)
         d.attrs["long_name"] = {"kappa": c.what, "closed_form": "closed-form kappa_c (docs/physics.md section 5)",
                                 "predicted": "the continuation's prediction"}[name]
         d.dims[0].attach_scale(values)
-    d = f.create_dataset("requested", data=np.asarray(c.requested, dtype=bool).astype(np.int8))
+    d = f.create_dataset("requested", data=np.asarray(c.requested, dtype=bool).astype(np.int8), **_CHECKED)
     d.attrs["flag_values"] = np.array([0, 1], dtype=np.int8)
     d.attrs["flag_meanings"] = "intermediate requested"
     d.attrs["long_name"] = "asked for (0: an intermediate step of the continuation)"
@@ -924,11 +1011,21 @@ def _open(path):
     if os.path.isdir(path):
         raise ValueError(f"archive {path!r} is a folder, not a file")
     try:
-        return h5py.File(path, "r")
+        mode = os.stat(path).st_mode
     except FileNotFoundError:
         raise ValueError(f"archive {path!r} does not exist") from None
     except OSError as error:
-        raise ValueError(f"{path!r} is not a readable HDF5 file (truncated or foreign): {error}") from None
+        raise ValueError(f"archive {path!r} cannot be read: {error.strerror or error}") from None
+    if not stat.S_ISREG(mode):  # opening a FIFO waits for a writer forever; a device is no archive
+        raise ValueError(f"archive {path!r} is not a regular file (a FIFO, device or socket); allowed: an HDF5 file")
+    try:
+        return h5py.File(path, "r")
+    except FileNotFoundError:
+        raise ValueError(f"archive {path!r} does not exist") from None
+    except MemoryError:
+        raise
+    except Exception as error:  # OSError mostly; a damaged superblock can surface as other h5py errors
+        raise ValueError(f"{path!r} is not a readable HDF5 file (truncated, damaged or foreign): {error}") from None
 
 
 def _is_archive(path) -> bool:
@@ -941,125 +1038,348 @@ def _is_archive(path) -> bool:
     return False
 
 
-def _attr_str(f, key) -> str:
-    value = f.attrs[key]
-    return value.decode() if isinstance(value, bytes) else str(value)
+class _Refusal(ValueError):
+    """A refusal whose message is complete (it names the file): passed on unchanged."""
+
+
+class _Damaged(ValueError):
+    """What is wrong with the content of an archive (the message does not name the file)."""
+
+    def __init__(self, reason: str, *, checksum: bool = False):
+        super().__init__(reason)
+        self.checksum = checksum
+
+
+class DamagedArchiveError(ValueError):
+    """An archive whose bytes or content are damaged; the message names the file and the damage.
+    ``reason`` is the damage alone."""
+
+    def __init__(self, path: str, reason: str, *, checksum: bool = False):
+        super().__init__(f"{path!r} is an incomplete or damaged phaseimpact archive: {reason}")
+        self.path, self.reason, self.checksum = path, reason, checksum
+
+
+#: A read that fails a checksum is tried again after these pauses (s): a reader may catch a chunk
+#: while a checkpoint rewrites it in place; damage on disk fails every time.
+_RETRY_PAUSES = (0.05, 0.25)
+
+
+def _why(error: BaseException) -> str:
+    if isinstance(error, KeyError) and error.args:
+        return str(error.args[0])
+    text = str(error) or type(error).__name__
+    if "checksum" in text.lower():
+        return f"HDF5 metadata does not match its checksum (the file's bytes were changed): {text}"
+    return text
+
+
+@contextlib.contextmanager
+def _reading(path: str):
+    """The archive at ``path`` open for reading. Whatever goes wrong while it is read (an HDF5 error, a
+    checksum, a malformed attribute, content out of range) becomes a :class:`DamagedArchiveError`."""
+    f = _open(path)
+    try:
+        with f:
+            yield f
+    except (_Refusal, MemoryError):
+        raise
+    except _Damaged as error:
+        raise DamagedArchiveError(path, str(error), checksum=error.checksum) from None
+    except Exception as error:  # a damaged file reaches h5py, json and numpy in many ways: all are damage
+        raise DamagedArchiveError(path, _why(error)) from None
+
+
+def _retrying(read, path: str):
+    for pause in (*_RETRY_PAUSES, None):
+        try:
+            return read(path)
+        except DamagedArchiveError as error:
+            if not error.checksum or pause is None:
+                raise
+            time.sleep(pause)
+
+
+def _short(value) -> str:
+    if isinstance(value, np.ndarray):
+        value = value.tolist()
+    elif isinstance(value, np.generic):
+        value = value.item()
+    text = repr(value)
+    return text if len(text) <= 60 else text[:57] + "..."
+
+
+def _attr_str(node, key) -> str:
+    value = node.attrs[key]
+    if isinstance(value, bytes):
+        value = value.decode("utf-8")
+    if not isinstance(value, str):
+        raise _Damaged(f"attribute {key} = {_short(value)} is out of range; allowed: a text")
+    return value
 
 
 def _strings(dataset) -> np.ndarray:
     return np.asarray(dataset.asstr()[()], dtype=object)
 
 
+def _int_attr(node, key) -> int:
+    value = node.attrs[key]
+    if isinstance(value, (int, np.integer)) and not isinstance(value, (bool, np.bool_)):
+        return int(value)
+    raise _Damaged(f"attribute {key} = {_short(value)} is out of range; allowed: an integer")
+
+
+def _real_attr(node, key) -> float:
+    value = node.attrs[key]
+    if isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(value, (bool, np.bool_)):
+        return float(value)
+    raise _Damaged(f"attribute {key} = {_short(value)} is out of range; allowed: a number")
+
+
+def _json_attr(node, key, kind: type):
+    try:
+        value = json.loads(_attr_str(node, key))
+    except json.JSONDecodeError as error:
+        raise _Damaged(f"attribute {key} is not valid JSON ({error})") from None
+    if not isinstance(value, kind):
+        raise _Damaged(f"attribute {key} = {_short(value)} is out of range; allowed: a JSON {kind.__name__}")
+    return value
+
+
+def _rtol(node) -> float:
+    rtol = _real_attr(node, "rtol")
+    if not (math.isfinite(rtol) and rtol > 0):
+        raise _Damaged(f"attribute rtol = {rtol!r} is out of range; allowed: a positive number")
+    return rtol
+
+
+def _data(node, name: str, *, ndim: int | None = None, kinds: str = "fiub") -> np.ndarray:
+    """All of dataset ``name`` (each chunk is read, so each chunk's checksum is checked)."""
+    dataset = node.get(name)
+    if not isinstance(dataset, h5py.Dataset):
+        raise _Damaged(f"variable {name} is missing")
+    try:
+        data = dataset[()]
+    except OSError as error:
+        if "filter" in str(error) or "checksum" in str(error).lower():
+            raise _Damaged(f"variable {name}: its bytes do not match their Fletcher-32 checksum (they were changed "
+                           "after it was written)", checksum=True) from None
+        raise _Damaged(f"variable {name} cannot be read: {error}") from None
+    data = np.asarray(data)
+    if (ndim is not None and data.ndim != ndim) or data.dtype.kind not in kinds:
+        raise _Damaged(f"variable {name} has shape {data.shape} and type {data.dtype}; allowed: {ndim}-d numbers")
+    return data
+
+
+def _gridded(f, name: str, shape: tuple, kinds: str = "fiu") -> np.ndarray:
+    data = _data(f, name, kinds=kinds)
+    if data.shape != tuple(shape):
+        raise _Damaged(f"variable {name} has shape {data.shape}; allowed: {tuple(shape)}, the grid's")
+    return data.reshape(-1)
+
+
+def _checked_axis(name: str, values: np.ndarray, log: bool) -> Axis:
+    values = np.asarray(values)
+    if values.ndim != 1 or values.size == 0 or values.dtype.kind not in "fiu":
+        raise _Damaged(f"axis {name} has shape {values.shape} and type {values.dtype}; allowed: a non-empty 1-d "
+                       "array of numbers")
+    if values.dtype.kind != "f":
+        values = values.astype(float)
+    bad = ~np.isfinite(values)
+    if bad.any():
+        i = int(np.argmax(bad))
+        raise _Damaged(f"axis {name} holds {_short(values[i])} at index {i}; allowed: finite numbers")
+    if log and not np.all(values > 0):
+        raise _Damaged(f"axis {name} is marked log but holds {_short(values.min())}; allowed: positive numbers")
+    return Axis(name, values, log)
+
+
+def _log_flag(node) -> bool:
+    return bool(_int_attr(node, "log")) if "log" in node.attrs else False
+
+
 def _checked_header(f, path) -> int:
     if "schema_version" not in f.attrs or "kind" not in f.attrs:
-        raise ValueError(f"{path!r} is not a phaseimpact archive (no schema_version attribute)")
-    version = int(f.attrs["schema_version"])
+        raise _Refusal(f"{path!r} is not a phaseimpact archive (no schema_version attribute)")
+    version = _int_attr(f, "schema_version")
     if version > SCHEMA_VERSION:
-        raise ValueError(f"{path!r} has schema_version {version}; this phaseimpact reads up to "
-                         f"{SCHEMA_VERSION}: upgrade phaseimpact")
+        raise _Refusal(f"{path!r} has schema_version {version}; this phaseimpact reads up to "
+                       f"{SCHEMA_VERSION}: upgrade phaseimpact")
+    if version < 1:
+        raise _Damaged(f"attribute schema_version = {version} is out of range; allowed: 1 to {SCHEMA_VERSION}")
     kind = _attr_str(f, "kind")
     if kind not in KINDS:
-        raise ValueError(f"{path!r} has unknown kind {kind!r}; allowed: {', '.join(KINDS)}")
+        raise _Damaged(f"attribute kind = {kind!r} is out of range; allowed: one of {', '.join(KINDS)}")
     return version
 
 
 def _law(f) -> ContactLaw:
-    return ContactLaw(**json.loads(_attr_str(f, "law")))
+    return ContactLaw(**_json_attr(f, "law", dict))
 
 
 def _base(f):
     from .case import case_from_dict
 
     if "base" in f.attrs:  # schema 3: case holds the Case, or the Parameters
-        data = json.loads(_attr_str(f, "case"))
+        data = _json_attr(f, "case", dict)
         return case_from_dict(data, origin="archive") if _attr_str(f, "base") == "case" else Parameters(**data)
     if "case" in f.attrs:  # schema 2: case only when the base is a case
-        return case_from_dict(json.loads(_attr_str(f, "case")), origin="archive")
-    return Parameters(**json.loads(_attr_str(f, "parameters")))
+        return case_from_dict(_json_attr(f, "case", dict), origin="archive")
+    return Parameters(**_json_attr(f, "parameters", dict))
 
 
 def load(path):
     """Read an archive back: a :class:`SweepResult` (with its :class:`Grid`) or a :class:`CriticalCurve`.
 
     Points of an archive in progress that are not committed (status -1) come back as not computed,
-    whatever else a killed checkpoint left of them. Raises ``ValueError`` for a missing, foreign,
-    truncated, damaged or newer-schema file.
+    whatever else a killed checkpoint left of them. Every chunk's checksum and the content are
+    checked (codes in range, finite axes, scalar attributes, stick rows that belong to their points).
+
+    Raises ``ValueError`` naming the file for a missing, foreign, truncated, damaged or newer-schema
+    file (:class:`DamagedArchiveError`, naming the damage too, for a damaged one).
     """
-    path = os.fspath(path)
-    with _open(path) as f:
+    return _retrying(_load, os.fspath(path))
+
+
+def _load(path: str):
+    with _reading(path) as f:
         version = _checked_header(f, path)
         kind = _attr_str(f, "kind")
-        try:
-            if version == 1:
-                return _read_sweep_v1(f) if kind == "sweep" else _read_curve_v1(f)
-            if version == 2:
-                return _read_sweep_v2(f) if kind == "sweep" else _read_curve_v2(f)
-            return _read_curve(f) if kind == "critical-curve" else _read_sweep(f)
-        except (KeyError, OSError, TypeError, ValueError, IndexError, json.JSONDecodeError) as error:
-            raise ValueError(f"{path!r} is an incomplete or damaged phaseimpact archive: {error}") from None
+        if version == 1:
+            result = _read_sweep_v1(f) if kind == "sweep" else _read_curve_v1(f)
+        elif version == 2:
+            result = _read_sweep_v2(f) if kind == "sweep" else _read_curve_v2(f)
+        else:
+            result = _read_curve(f) if kind == "critical-curve" else _read_sweep(f)
+        if isinstance(result, SweepResult):
+            _check_sweep(result)
+        else:
+            _check_curve(result)
+        if version >= 3:  # last: a value out of range is named as such, not as a changed digest
+            _rtol(f)  # the header's copy (describe reads it); a sweep reads its settings
+            _check_metadata(f)
+    return result
+
+
+def _check_metadata(f, *, chunks: bool = True) -> None:
+    """The parts of the metadata that HDF5's own checksums leave out: the text attributes (against
+    :data:`_TEXT_DIGEST`, where the file has one) and the chunk index of every checksummed dataset."""
+    if _TEXT_DIGEST in f.attrs and _attr_str(f, _TEXT_DIGEST) != _texts_digest(f):
+        raise _Damaged("its text attributes (case, law, settings, ...) do not match their SHA-256 digest "
+                       f"{_TEXT_DIGEST} (the file's bytes were changed)")
+    if chunks:
+        _check_storage(f)
+
+
+def _check_storage(f) -> None:
+    """Each chunk of each checksummed dataset is found by its coordinates where HDF5's index says, whole,
+    filtered, inside the file and apart from every other chunk. The index (a v1 B-tree) has no checksum:
+    a changed key or address would read another dataset's chunk, or nothing, as this one's data."""
+    end = f.id.get_filesize()
+    spans = []
+
+    def visit(name, node):
+        if not isinstance(node, h5py.Dataset) or node.chunks is None or node.size == 0 or not node.fletcher32:
+            return
+        size = int(np.prod(node.chunks)) * node.dtype.itemsize + 4  # the data and its Fletcher-32 sum
+        listed = []
+        node.id.chunk_iter(listed.append)  # the chunks found by walking the index
+        corners = list(itertools.product(*(range(0, n, c) for n, c in zip(node.shape, node.chunks, strict=True))))
+        if sorted(tuple(info.chunk_offset) for info in listed) != corners:
+            raise _Damaged(f"variable {name}: its chunk index does not list each chunk once")
+        for info in listed:
+            try:  # and found by looking each up, as a read does (which compares every field of the keys)
+                mask, raw = node.id.read_direct_chunk(info.chunk_offset)
+            except (OSError, RuntimeError, ValueError):
+                mask, raw = None, b""
+            if (info.filter_mask != 0 or info.size != size or mask != 0 or len(raw) != size
+                    or info.byte_offset + info.size > end):
+                raise _Damaged(f"variable {name}: the index entry of its chunk at {tuple(info.chunk_offset)} is "
+                               "damaged")
+            spans.append((info.byte_offset, info.size, name))
+
+    f.visititems(visit)
+    spans.sort()
+    for (a, size, name), (b, _, other) in zip(spans, spans[1:], strict=False):
+        if a + size > b:
+            raise _Damaged(f"variables {name} and {other}: chunks overlap in the file (a damaged chunk index)")
 
 
 def _t_end(f):
-    t_end = float(f.attrs["t_end"])
-    return None if math.isnan(t_end) else t_end
+    t_end = _real_attr(f, "t_end")
+    if math.isnan(t_end):
+        return None
+    if not (math.isfinite(t_end) and t_end > 0):
+        raise _Damaged(f"attribute t_end = {t_end!r} is out of range; allowed: a positive number (s), or NaN")
+    return t_end
 
 
 def _settings(f) -> dict:
     if "settings" in f.attrs:
-        return json.loads(_attr_str(f, "settings"))
-    return {"rtol": float(f.attrs["rtol"]), "engine": _attr_str(f, "engine"),
-            "version": _attr_str(f, "package_version")}
+        return _json_attr(f, "settings", dict)
+    return {"rtol": _rtol(f), "engine": _attr_str(f, "engine"), "version": _attr_str(f, "package_version")}
 
 
 def _axes(f) -> tuple:
-    names = json.loads(_attr_str(f, "axes"))
-    dims = json.loads(_attr_str(f, "dimensions"))
-    return tuple(Axis(name, f[dim][()], bool(f[dim].attrs.get("log", 0))) for name, dim in zip(names, dims,
-                                                                                             strict=True))
+    names = _json_attr(f, "axes", list)
+    dims = _json_attr(f, "dimensions", list)
+    if not names or len(names) != len(dims) or not all(isinstance(x, str) for x in names + dims):
+        raise _Damaged(f"attributes axes = {_short(names)} and dimensions = {_short(dims)} are out of range; "
+                       "allowed: two lists of as many names")
+    return tuple(_checked_axis(name, _data(f, dim, ndim=1), _log_flag(f[dim])) for name, dim in zip(names, dims,
+                                                                                                  strict=True))
+
+
+_STICK_VARIABLES = ("stick_point", "stick_t", "stick_delta", "stick_dwell")
 
 
 def _read_sweep(f) -> SweepResult:
     grid = Grid(_base(f), _law(f), _axes(f))
-    status = f["status"][()].reshape(-1).astype(np.int8)
+    shape = grid.shape
+    status = _gridded(f, "status", shape, "i").astype(np.int8)
     computed = status >= 0
     codes = {}
     for name in ("outcome", "stop_reason"):
-        codes[name] = np.where(computed, f[name][()].reshape(-1), -1).astype(np.int8)
+        codes[name] = np.where(computed, _gridded(f, name, shape, "i"), -1).astype(np.int8)
     values = {}
-    for name in json.loads(_attr_str(f, "columns")):
-        column = f[name][()].reshape(-1)
+    for name in _json_attr(f, "columns", list):
+        if not isinstance(name, str) or name in _RESERVED:
+            raise _Damaged(f"attribute columns names {name!r}; allowed: summary columns")
+        column = _gridded(f, name, shape)
         if not computed.all():
             column = np.where(computed, column, _fill_of(column.dtype))
         values[name] = column
-    first = f["stick_first"][()].reshape(-1).astype(np.int64)
-    count = f["stick_count"][()].reshape(-1).astype(np.int64)
+    first = _gridded(f, "stick_first", shape, "i").astype(np.int64)
+    count = _gridded(f, "stick_count", shape, "i").astype(np.int64)
+    stick = {name: _data(f, name, ndim=1, kinds="i" if name == "stick_point" else "f") for name in _STICK_VARIABLES}
+    capacity = stick["stick_point"].shape[0]
+    if any(column.shape != (capacity,) for column in stick.values()):
+        raise _Damaged("variables " + ", ".join(_STICK_VARIABLES) + " differ in length")
     rows = _owned_rows(first, count, computed)
     owner = np.repeat(np.flatnonzero(computed & (count > 0) & (first >= 0)),
                       count[computed & (count > 0) & (first >= 0)])
     order = np.argsort(rows, kind="stable")
     rows, owner = rows[order], owner[order]
-    capacity = f["stick_point"].shape[0]
-    if rows.size and (rows[-1] >= capacity or np.any(np.diff(rows) == 0)):
-        raise ValueError("stick_first/stick_count point outside the stick rows or overlap")
-    point = f["stick_point"][()][rows] if rows.size else np.empty(0, dtype=np.int64)
+    if rows.size and (rows[0] < 0 or rows[-1] >= capacity or np.any(np.diff(rows) == 0)):
+        raise _Damaged("stick_first/stick_count point outside the stick rows or overlap")
+    point = stick["stick_point"][rows]
     if not np.array_equal(point, owner):
-        raise ValueError("stick_point disagrees with stick_first/stick_count")
-    sticks = {name: (f[f"stick_{name}"][()][rows] if rows.size else np.empty(0)) for name in ("t", "delta", "dwell")}
+        raise _Damaged("stick_point disagrees with stick_first/stick_count")
     result = SweepResult(grid, _t_end(f), _settings(f), status=status, outcome=codes["outcome"],
-                         stop_reason=codes["stop_reason"], stick_point=point.astype(np.int64), stick_t=sticks["t"],
-                         stick_delta=sticks["delta"], stick_dwell=sticks["dwell"],
+                         stop_reason=codes["stop_reason"], stick_point=point.astype(np.int64),
+                         stick_t=stick["stick_t"][rows], stick_delta=stick["stick_delta"][rows],
+                         stick_dwell=stick["stick_dwell"][rows],
                          extras=_read_tree(f["extras"]) if "extras" in f else {})
     result.values.update(values)
     return result
 
 
 def _read_tree(group) -> dict:
-    tree = json.loads(_attr_str(group, "json")) if "json" in group.attrs else {}
+    tree = _json_attr(group, "json", dict) if "json" in group.attrs else {}
     for key, item in group.items():
         if isinstance(item, h5py.Group):
             tree[key] = _read_tree(item)
         else:
-            data = item[()]
+            data = _data(group, key)
             tree[key] = data.astype(bool) if _attr_str(item, "type") == "bool" else data
     return tree
 
@@ -1067,9 +1387,51 @@ def _read_tree(group) -> dict:
 def _read_curve(f) -> CriticalCurve:
     param = _attr_str(f, "param")
     dim = _axis_names([param])[0]
-    return CriticalCurve(param, f[dim][()], f["kappa"][()], f["requested"][()].astype(bool), f["closed_form"][()],
-                         f["predicted"][()], _attr_str(f, "what"), _law(f), _base(f), float(f.attrs["rtol"]),
-                         int(f.attrs["contact_index"]), _attr_str(f, "message"))
+    values = _checked_axis(param, _data(f, dim, ndim=1), False).values
+    requested = _data(f, "requested", ndim=1, kinds="iub")
+    _out_of_range("requested", requested, ~np.isin(requested, (0, 1)), "0 or 1")
+    return CriticalCurve(param, values, _data(f, "kappa", ndim=1, kinds="f"), requested.astype(bool),
+                         _data(f, "closed_form", ndim=1, kinds="f"),
+                         _data(f, "predicted", ndim=1, kinds="f"), _attr_str(f, "what"), _law(f), _base(f), _rtol(f),
+                         _int_attr(f, "contact_index"), _attr_str(f, "message"))
+
+
+# -- what a loaded result may hold ------------------------------------------------------------------
+
+def _out_of_range(name: str, values: np.ndarray, bad: np.ndarray, allowed: str) -> None:
+    if np.any(bad):
+        i = int(np.argmax(bad))
+        raise _Damaged(f"{name} = {_short(values[i])} at point {i} is out of range; allowed: {allowed}")
+
+
+def _check_sweep(r: SweepResult) -> None:
+    """Codes within their tables (the figures and summaries index tables with them). The columns are
+    not judged: NaN and -1 are legitimate values (not measured, or not stored by schema 1)."""
+    status = np.asarray(r.status)
+    computed = status >= 0
+    _out_of_range("status", status, (status < -1) | (status >= len(STATUSES)),
+                  f"0 to {len(STATUSES) - 1} ({', '.join(STATUSES)}), or -1 (not computed)")
+    for name, names in (("outcome", OUTCOMES), ("stop_reason", STOP_REASONS)):
+        codes = np.asarray(getattr(r, name))
+        _out_of_range(name, codes, computed & ((codes < 0) | (codes >= len(names))),
+                      f"0 to {len(names) - 1} ({', '.join(names)}) at a computed point")
+
+
+def _check_curve(c: CriticalCurve) -> None:
+    k = len(c.values)
+    for name in ("kappa", "closed_form", "predicted", "requested"):
+        values = np.asarray(getattr(c, name))
+        if values.shape != (k,):
+            raise _Damaged(f"variable {name} has shape {values.shape}; allowed: ({k},), one per value of {c.param}")
+        if name != "requested":
+            _out_of_range(name, values, ~np.isnan(values) & ~(np.isfinite(values) & (values > 0)),
+                          "a positive number, or NaN (lost)")
+    if c.what not in ("kappa_c", "kappa_2", "grazing"):
+        raise _Damaged(f"attribute what = {c.what!r} is out of range; allowed: kappa_c, kappa_2 or grazing")
+    if c.contact_index < 0:
+        raise _Damaged(f"attribute contact_index = {c.contact_index} is out of range; allowed: an integer >= 0")
+    if not (math.isfinite(c.rtol) and c.rtol > 0):
+        raise _Damaged(f"attribute rtol = {c.rtol!r} is out of range; allowed: a positive number")
 
 
 # -- schema 2 (groups /sweep and /curve, codes as strings) ------------------------------------------
@@ -1167,33 +1529,38 @@ def describe(path) -> dict:
 
     Returns ``{"kind", "law", "parameters", "axes", "t_end", "rtol", "schema_version"}``
     (``axes``: ``{name: values}``, names as given, e.g. ``plate.E``). Raises ``ValueError`` if
-    ``path`` is not a phaseimpact archive.
+    ``path`` is not a phaseimpact archive, or its header or axes are damaged.
     """
-    path = os.fspath(path)
-    with _open(path) as f:
+    return _retrying(_describe, os.fspath(path))
+
+
+def _describe(path: str) -> dict:
+    def axis(node, name, dataset):
+        return _checked_axis(name, _data(node, dataset, ndim=1), False).values
+
+    with _reading(path) as f:
         version = _checked_header(f, path)
         kind = _attr_str(f, "kind")
-        try:
-            law = ContactLaw(**json.loads(_attr_str(f, "law"))).as_dict()
-            params = json.loads(_attr_str(f, "parameters"))
-            if version >= 3:
-                if kind == "critical-curve":
-                    param = _attr_str(f, "param")
-                    axes = {param: f[_axis_names([param])[0]][()]}
-                else:
-                    axes = {axis.name: axis.values for axis in _axes(f)}
-            elif kind == "sweep":
-                g = f["sweep"]
-                names = ["kappa"] if version == 1 else json.loads(_attr_str(g, "axes"))
-                axes = {name: g[name][()] for name in names}
+        law = _law(f).as_dict()
+        params = _json_attr(f, "parameters", dict)
+        if version >= 3:
+            if kind == "critical-curve":
+                param = _attr_str(f, "param")
+                axes = {param: axis(f, param, _axis_names([param])[0])}
             else:
-                g = f["curve"]
-                param = "v" if version == 1 else _attr_str(g, "param")
-                axes = {param: g[param][()]}
-            return {"kind": kind, "law": law, "parameters": params, "axes": axes, "t_end": float(f.attrs["t_end"]),
-                    "rtol": float(f.attrs["rtol"]), "schema_version": version}
-        except (KeyError, OSError, TypeError, ValueError, json.JSONDecodeError) as error:
-            raise ValueError(f"{path!r} is an incomplete or damaged phaseimpact archive: {error}") from None
+                axes = {a.name: a.values for a in _axes(f)}
+        elif kind == "sweep":
+            g = f["sweep"]
+            names = ["kappa"] if version == 1 else _json_attr(g, "axes", list)
+            axes = {name: axis(g, name, name) for name in names}
+        else:
+            g = f["curve"]
+            param = "v" if version == 1 else _attr_str(g, "param")
+            axes = {param: axis(g, param, param)}
+        if version >= 3:
+            _check_metadata(f, chunks=False)
+        return {"kind": kind, "law": law, "parameters": params, "axes": axes, "t_end": _real_attr(f, "t_end"),
+                "rtol": _real_attr(f, "rtol"), "schema_version": version}
 
 
 def _same_number(a, b) -> bool:
@@ -1240,6 +1607,9 @@ def check_overwrite(path, kind: str, law: ContactLaw, params: Parameters, axes: 
         return
     try:
         held = describe(path)
+    except DamagedArchiveError as error:
+        raise ValueError(f"{name} = {path!r} exists and is a damaged phaseimpact archive ({error.reason}); refusing "
+                         "to overwrite it (choose another path, or add --force to replace it)") from None
     except ValueError:
         raise ValueError(f"{name} = {path!r} exists and is not a phaseimpact archive; refusing to overwrite it "
                          "(choose another path, or add --force to replace it)") from None

@@ -3,7 +3,7 @@
 A case file has this schema (SI units; ``[projectile]`` and ``[plate]`` take the same keys)::
 
     name = "5 mm steel ball on the seed plate"   # optional (default: the file name)
-    description = "..."                          # optional, one line
+    description = "..."                          # optional, one line (no line break)
     source = "..."                               # optional, free text: where the numbers come from
     [projectile]   # E (Pa), nu (0 <= nu < 0.5), rho (kg/m^3); optional yield_strength (Pa)
     E = 2.1e11
@@ -20,11 +20,13 @@ A case file has this schema (SI units; ``[projectile]`` and ``[plate]`` take the
     R2 = 2000.0
     [impact]       # v (m/s); optional kappa (N s/m^2.5, default 0), target (plate|rigid|free,
     v = 13.0       # default plate), law (default paper), contact (printed|unilateral, default
-                   # printed), restitution (0 < e <= 1, default none)
+                   # printed), restitution (1e-6 <= e <= 1, default none)
 
 Unknown keys, missing keys, wrong types and values out of range raise ``ValueError`` naming the
-dotted key, its value and the allowed range. Named cases ship in ``phaseimpact/cases/``
-(:func:`list_cases`); :func:`load_case` takes a name or a path.
+dotted key, its value and the allowed range; so does an ``[impact]`` value its law never reads
+(``kappa`` with ``abrate``, ``restitution`` with ``paper``...), which would be silently ignored.
+Named cases ship in ``phaseimpact/cases/`` (:func:`list_cases`); :func:`load_case` takes a name or a
+path.
 
 Hertz scales and validity (docs/physics.md §4; Johnson 1985, *Contact Mechanics*, §4.2, §11.4) are
 pure functions of :class:`~phaseimpact.parameters.Parameters` and the materials:
@@ -48,8 +50,10 @@ else:  # pragma: no cover - Python 3.10
     import tomli as tomllib
 
 from .parameters import (
+    KAPPA_MAX,
     STEEL,
     TARGETS,
+    V_RANGE,
     Geometry,
     Material,
     Parameters,
@@ -58,8 +62,8 @@ from .parameters import (
     parameters_with,
     require,
     require_choice,
+    require_in,
     require_nonnegative,
-    require_positive,
     validate_geometry,
     validate_material,
 )
@@ -67,6 +71,7 @@ from .parameters import (
 __all__ = [
     "Case",
     "SETTABLE",
+    "QUANTITIES",
     "CONTACTS",
     "FIRST_YIELD_FACTOR",
     "CONTACT_RATIO_LIMIT",
@@ -80,13 +85,18 @@ __all__ = [
     "hertz_contact",
     "validity",
     "validity_for_force",
+    "R1_TO_PLATE_LIMIT",
+    "THICKNESS_TO_PLATE_LIMIT",
 ]
 
-#: Every name ``--set NAME=VALUE`` accepts: ``{name: (unit, description)}`` (SI units).
+#: Every name ``--set NAME=VALUE`` accepts (each key of the case schema but the text ones):
+#: ``{name: (unit, description)}`` (SI units). The schema's own spellings ``geometry.a`` and
+#: ``impact.v`` are accepted too.
 SETTABLE = {
     "projectile.E": ("Pa", "Young's modulus of the projectile"),
     "projectile.nu": ("-", "Poisson's ratio of the projectile (0 <= nu < 0.5)"),
     "projectile.rho": ("kg/m^3", "density of the projectile"),
+    "projectile.yield_strength": ("Pa", "yield (or crushing) strength of the projectile; drives the validity check"),
     "plate.E": ("Pa", "Young's modulus of the plate (target)"),
     "plate.nu": ("-", "Poisson's ratio of the plate (0 <= nu < 0.5)"),
     "plate.rho": ("kg/m^3", "density of the plate"),
@@ -96,7 +106,18 @@ SETTABLE = {
     "R1": ("m", "radius of the spherical projectile"),
     "R2": ("m", "radius of curvature of the target surface"),
     "v": ("m/s", "impact speed"),
+    "kappa": ("N s/m^2.5", "damping coefficient (read by paper and hunt-crossley)"),
+    "restitution": ("-", "coefficient of restitution (the restitution laws, hunt-crossley)"),
+    "target": ("", "what is hit: plate, rigid or free"),
+    "law": ("", "contact law"),
+    "contact": ("", "law paper's reading of |delta|^alpha: printed or unilateral"),
 }
+#: The settable quantities the equations of motion read (axes of an atlas, parameters of a curve);
+#: a yield strength only drives the validity check.
+QUANTITIES = ("projectile.E", "projectile.nu", "projectile.rho", "plate.E", "plate.nu", "plate.rho",
+              "a", "h", "R1", "R2", "v")
+_TEXT_SETTINGS = ("target", "law", "contact")
+_IMPACT_SETTINGS = ("v", "kappa", "restitution", "target", "law", "contact")
 
 CONTACTS = ("printed", "unilateral")
 #: First yield under a Hertz contact at ``p0 = 1.60 Y`` (von Mises, nu = 0.3; Johnson 1985, §4.2 and §11.4).
@@ -104,6 +125,12 @@ FIRST_YIELD_FACTOR = 1.60
 #: Hertz theory assumes a contact radius small against the radius: ``a0 / R`` above this is out of range
 #: (assumed limit; Johnson 1985, §4.1 requires ``a << R``).
 CONTACT_RATIO_LIMIT = 0.3
+#: The plate model (a clamped plate struck at its centre, a quarter of its mass moving) needs the ball
+#: to fit on the plate: ``R1 <= a`` (assumed limit).
+R1_TO_PLATE_LIMIT = 1.0
+#: Kirchhoff bending (eq. 5a) needs a thin plate: ``h <= 0.2 a``, a span of ten thicknesses (assumed
+#: limit; thick plates need shear deformation, Timoshenko & Woinowsky-Krieger 1959, §§ 39-40).
+THICKNESS_TO_PLATE_LIMIT = 0.2
 
 _MATERIAL_KEYS = {"E": "Pa", "nu": "-", "rho": "kg/m^3", "yield_strength": "Pa"}
 _MATERIAL_REQUIRED = ("E", "nu", "rho")
@@ -188,17 +215,37 @@ def _impact_from(table) -> dict:
         raise _missing("impact.v", "a finite number > 0 (m/s)")
     out = {**_IMPACT_DEFAULTS, **table}
     out["v"] = _number("impact.v", out["v"], "a finite number > 0 (m/s)")
-    require_positive("impact.v", out["v"])
+    require_in("impact.v", out["v"], V_RANGE, "m/s")
     out["kappa"] = _number("impact.kappa", out["kappa"], "a finite number >= 0 (N s/m^2.5)")
-    require_nonnegative("impact.kappa", out["kappa"])
+    require("impact.kappa", out["kappa"], f"0 <= impact.kappa <= {KAPPA_MAX:g} (N s/m^2.5)",
+            math.isfinite(out["kappa"]) and 0 <= out["kappa"] <= KAPPA_MAX)
     for key, choices in (("target", TARGETS), ("law", _laws()), ("contact", CONTACTS)):
         _string(f"impact.{key}", out[key], "one of " + ", ".join(choices))
         require_choice(f"impact.{key}", out[key], choices)
     if out["restitution"] is not None:
-        e = _number("impact.restitution", out["restitution"], "a number with 0 < e <= 1")
-        require("impact.restitution", e, "0 < e <= 1", math.isfinite(e) and 0 < e <= 1)
+        e = _number("impact.restitution", out["restitution"], "a number with 1e-6 <= e <= 1")
+        require("impact.restitution", e, "1e-6 <= impact.restitution <= 1", math.isfinite(e) and 1e-6 <= e <= 1)
         out["restitution"] = e
     return {key: out[key] for key in _IMPACT_KEYS}
+
+
+def _check_read_by_law(impact: dict) -> None:
+    """Refuse an ``[impact]`` value that its law never reads: it would be silently ignored."""
+    from .model import REGISTRY
+
+    law, e, kappa = impact["law"], impact["restitution"], impact["kappa"]
+    entry = REGISTRY[law]
+    if e is not None and entry.damping != "restitution" and law != "hunt-crossley":
+        raise ValueError(f"impact.restitution = {e!r} is not read by law {law!r}; allowed: restitution with "
+                         "hunt-crossley or a restitution law ("
+                         + ", ".join(n for n, x in REGISTRY.items() if x.damping == "restitution") + ")")
+    if kappa != 0 and not (entry.damping == "kappa" and e is None):
+        source = "its damping comes from impact.restitution" if e is not None or entry.damping else "it is undamped"
+        raise ValueError(f"impact.kappa = {kappa!r} is not read by law {law!r} ({source}); allowed: no kappa "
+                         "with this law, or kappa with paper or hunt-crossley (without restitution)")
+    if impact["contact"] != "printed" and not entry.filippov:
+        raise ValueError(f"impact.contact = {impact['contact']!r} is not read by law {law!r}; allowed: contact "
+                         "with law paper")
 
 
 # ---------------------------------------------------------------------------------------------
@@ -237,7 +284,9 @@ class Case:
     def __post_init__(self):
         for key in ("name", "description", "source"):
             _string(key, getattr(self, key))
-        require("name", self.name, "a non-empty string", bool(self.name.strip()))
+        require("name", self.name, "a non-empty string on one line",
+                bool(self.name.strip()) and len(self.name.splitlines()) == 1)
+        require("description", self.description, "one line (no line break)", len(self.description.splitlines()) <= 1)
         for key, cls in (("projectile", Material), ("plate", Material), ("geometry", Geometry)):
             if not isinstance(getattr(self, key), cls):
                 raise _wrong_type(key, getattr(self, key), f"a {cls.__name__}")
@@ -324,6 +373,8 @@ def case_from_dict(data, origin: str = "<dict>") -> Case:
             if table not in data:
                 raise ValueError(f"missing table [{table}]")
         text = {key: _string(key, data[key]) for key in ("name", "description", "source") if key in data}
+        impact = _impact_from(data["impact"])
+        _check_read_by_law(impact)
         return Case(
             name=text.get("name", Path(origin).stem if origin != "<dict>" else "case"),
             description=text.get("description", ""),
@@ -331,7 +382,7 @@ def case_from_dict(data, origin: str = "<dict>") -> Case:
             projectile=_material_from(data["projectile"], "projectile"),
             plate=_material_from(data["plate"], "plate"),
             geometry=_geometry_from(data["geometry"]),
-            impact=_impact_from(data["impact"]),
+            impact=impact,
         )
     except ValueError as exc:
         raise ValueError(f"{origin}: {exc}") from None
@@ -413,24 +464,36 @@ def _settable_list() -> str:
     return ", ".join(f"{name} ({unit})" for name, (unit, _) in SETTABLE.items())
 
 
-def parse_setting(text: str) -> tuple[str, float]:
+_ALIASES = {**{f"geometry.{n}": n for n in _GEOMETRY_KEYS}, **{f"impact.{n}": n for n in _IMPACT_SETTINGS}}
+
+
+def setting_name(name: str) -> str:
+    """The name of a setting as :data:`SETTABLE` spells it (``geometry.a`` is ``a``, ``impact.v`` is ``v``)."""
+    name = str(name).strip()
+    return _ALIASES.get(name, name)
+
+
+def parse_setting(text: str) -> tuple[str, float | str]:
     """Parse one ``NAME=VALUE`` (``--set``) into ``(name, value)``; the range is checked later.
 
     Raises
     ------
     ValueError
         Without ``=``, for a name not in :data:`SETTABLE` (the message lists them), or a value that
-        is not a number.
+        is not a number (the text settings ``target``, ``law``, ``contact`` take a word).
     """
     if not isinstance(text, str) or "=" not in text:
         raise ValueError(f"a setting is NAME=VALUE, got {text!r}; names: {_settable_list()}")
     name, _, raw = text.partition("=")
-    return name.strip(), _setting_value(name.strip(), raw)
+    name = setting_name(name)
+    return name, _setting_value(name, raw)
 
 
-def _setting_value(name: str, raw) -> float:
+def _setting_value(name: str, raw) -> float | str:
     if name not in SETTABLE:
         raise ValueError(f"unknown setting {name!r}; allowed: {_settable_list()}")
+    if name in _TEXT_SETTINGS:
+        return str(raw).strip()  # checked against its choices with the case
     unit = SETTABLE[name][0]
     if is_number(raw):
         return float(raw)
@@ -449,7 +512,8 @@ def apply_settings(case: Case, settings) -> Case:
         The base case.
     settings : iterable of str, or Mapping
         ``["plate.E=1e9", "R1=0.001", ...]``, or ``{"plate.E": 1e9, ...}`` (values numbers or
-        strings). Names are the keys of :data:`SETTABLE` (SI units). Later settings win.
+        strings). Names are the keys of :data:`SETTABLE` (SI units), or the schema's spellings
+        (``geometry.a``, ``impact.kappa``). Later settings win.
 
     Raises
     ------
@@ -457,7 +521,7 @@ def apply_settings(case: Case, settings) -> Case:
         Naming the setting, its value and the allowed range.
     """
     if isinstance(settings, Mapping):
-        pairs = [(str(name).strip(), _setting_value(str(name).strip(), raw)) for name, raw in settings.items()]
+        pairs = [(setting_name(name), _setting_value(setting_name(name), raw)) for name, raw in settings.items()]
     elif isinstance(settings, str):
         pairs = [parse_setting(settings)]
     else:
@@ -472,14 +536,14 @@ def apply_settings(case: Case, settings) -> Case:
         if "." in name:
             body, _, key = name.partition(".")
             values[body][key] = value
-        elif name == "v":
-            values["impact"]["v"] = value
+        elif name in _IMPACT_SETTINGS:
+            values["impact"][name] = value
         else:
             values["geometry"][name] = value
     for body in ("projectile", "plate"):
         validate_material(values[body], f"{body}.")
     validate_geometry(values["geometry"])
-    require_positive("v", values["impact"]["v"])
+    require_in("v", values["impact"]["v"], V_RANGE, "m/s")
     return dataclasses.replace(
         case,
         projectile=Material(**values["projectile"]),
@@ -573,7 +637,8 @@ def hertz_contact(force: float, params: Parameters) -> dict:
     return {"contact_radius": a, "peak_pressure": 3.0 * force / (2.0 * math.pi * a * a)}
 
 
-def _reasons(pressure: float, radius: float, params: Parameters, plate_material, projectile_material) -> str:
+def _reasons(pressure: float, radius: float, params: Parameters, plate_material, projectile_material,
+             geometry: Geometry | None) -> str:
     reasons = []
     for role, material in (("target", plate_material), ("projectile", projectile_material)):
         if material is not None and material.yield_strength is not None:
@@ -585,11 +650,28 @@ def _reasons(pressure: float, radius: float, params: Parameters, plate_material,
     if ratio > CONTACT_RATIO_LIMIT:
         reasons.append(f"contact radius {radius:.3g} m is {ratio:.2g} R (Hertz needs a << R; limit "
                        f"{CONTACT_RATIO_LIMIT:g} R)")
-    return "; ".join(reasons) + ": elastic Hertz contact is out of its range" if reasons else "ok"
+    verdicts = ["; ".join(reasons) + ": elastic Hertz contact is out of its range"] if reasons else []
+    plate = _plate_reasons(geometry, params.target) if geometry is not None else []
+    if plate:
+        verdicts.append("; ".join(plate) + ": the plate model is out of its range")
+    return "; ".join(verdicts) or "ok"
+
+
+def _plate_reasons(g: Geometry, target: str) -> list:
+    """Where the geometry leaves the plate model (seed eq. 5, 7): a ball wider than the plate, a
+    plate too thick for thin-plate bending (read only when the plate's springs are)."""
+    reasons = []
+    if g.R1 > R1_TO_PLATE_LIMIT * g.a:
+        reasons.append(f"projectile radius R1 = {g.R1:.3g} m exceeds the plate radius a = {g.a:.3g} m (the ball "
+                       "must fit on the plate: R1 <= a)")
+    if target == "plate" and g.h > THICKNESS_TO_PLATE_LIMIT * g.a:
+        reasons.append(f"plate thickness h = {g.h:.3g} m is {g.h / g.a:.2g} a (thin-plate bending, eq. 5a, needs "
+                       f"h <= {THICKNESS_TO_PLATE_LIMIT:g} a)")
+    return reasons
 
 
 def validity(params: Parameters, plate_material: Material | None,
-             projectile_material: Material | None = None) -> str:
+             projectile_material: Material | None = None, geometry: Geometry | None = None) -> str:
     """Whether elastic Hertz contact holds at the closed-form peak of :func:`hertz_scales`.
 
     Parameters
@@ -600,22 +682,26 @@ def validity(params: Parameters, plate_material: Material | None,
         Its ``yield_strength`` ``Y`` (Pa), if given, is checked: ``p0 <= 1.6 Y``.
     projectile_material : Material, optional
         The same check for the projectile (a hailstone crushes before the plate yields).
+    geometry : Geometry, optional
+        Checked against the plate model: ``R1 <= a`` (:data:`R1_TO_PLATE_LIMIT`) and, on a plate
+        target, ``h <= 0.2 a`` (:data:`THICKNESS_TO_PLATE_LIMIT`).
 
     Returns
     -------
     str
-        ``"ok"``, or the reasons (joined by ``"; "``): peak pressure beyond first yield, or a
-        contact radius beyond ``CONTACT_RATIO_LIMIT * R``. Without any yield strength only the
-        geometric check applies.
+        ``"ok"``, or the reasons (joined by ``"; "``): peak pressure beyond first yield, a
+        contact radius beyond ``CONTACT_RATIO_LIMIT * R``, a geometry outside the plate model.
+        Without any yield strength the pressure is not checked.
     """
     scales = hertz_scales(params)
     if scales["peak_pressure"] is None:
         raise ValueError("R = None: validity needs the effective radius R")
-    return _reasons(scales["peak_pressure"], scales["contact_radius"], params, plate_material, projectile_material)
+    return _reasons(scales["peak_pressure"], scales["contact_radius"], params, plate_material, projectile_material,
+                    geometry)
 
 
 def validity_for_force(force: float, params: Parameters, plate_material: Material | None,
-                       projectile_material: Material | None = None) -> str:
+                       projectile_material: Material | None = None, geometry: Geometry | None = None) -> str:
     """Like :func:`validity`, for an actual peak force ``force`` (N), e.g. from a simulation.
 
     The pressure is Hertz's ``p0 = 3 F / (2 pi a^2)`` with ``a = (3 F R / (4 E*))^(1/3)``
@@ -623,5 +709,5 @@ def validity_for_force(force: float, params: Parameters, plate_material: Materia
     """
     contact = hertz_contact(force, params)
     return _reasons(contact["peak_pressure"], contact["contact_radius"], params, plate_material,
-                    projectile_material)
+                    projectile_material, geometry)
 

@@ -1,5 +1,5 @@
-"""Command line: ``phaseimpact {cases, params, simulate, critical, transitions, sweep, atlas, critical-curve,
-plot, portrait}``.
+"""Command line: ``phaseimpact {cases, warmup, params, simulate, fixed-points, critical, transitions, sweep, atlas,
+critical-curve, plot, portrait}``.
 
 A contract other tools rely on: SI units; ``--json`` prints one JSON object whose numbers are
 finite or ``null``. Every argument is checked before any work: bad input prints one line naming
@@ -23,23 +23,20 @@ import math
 import os
 import re
 import shlex
+import signal
 import sys
+import threading
 
 import numpy as np
 
 from . import __version__
 from ._atomic import check_target, exclusive
-from .case import SETTABLE
-from .integrate import RTOL_RANGE, STATUSES
+from .case import QUANTITIES, SETTABLE, setting_name
 from .model import LAWS
-from .parameters import TARGETS
+from .parameters import KAPPA_MAX, TARGETS, V_RANGE
 
 EXIT_OK, EXIT_FAILURE, EXIT_USAGE, EXIT_INTERRUPTED = 0, 1, 2, 130
 
-#: Impact speeds the model is meant for, m/s (quasi-static to far beyond any Hertz contact).
-V_RANGE = (1e-6, 1e4)
-#: Largest damping coefficient, N s/m^2.5 (the seed's kappa_c is about 1.5e12).
-KAPPA_MAX = 1e18
 #: Relative width of kappa_c's bracket (critical, critical-curve), or of a transition's location.
 KAPPA_RTOL_RANGE = (1e-14, 1e-2)
 #: Coefficient of restitution.
@@ -68,7 +65,34 @@ FIGURE_FORMATS = {".png": (b"\x89PNG",), ".pdf": (b"%PDF",), ".svg": (b"<?xml", 
 KAPPA_UNIT = "N s/m^2.5"
 
 
+#: argparse takes "-inf" or "-1e-300" for an option (its own pattern knows "-1" and "-.5" only): every
+#: negative number float() reads is a value here, so that its range can be named.
+_NEGATIVE_NUMBER = re.compile(r"^-(\d+\.?\d*|\.\d+)(e[-+]?\d+)?$|^-(inf|infinity|nan)$", re.IGNORECASE)
+
+
+def _check_environment() -> None:
+    """The environment this process runs in, checked before any work (``ValueError`` names it)."""
+    from ._environment import source_date_epoch
+    from ._jit import processes
+
+    if sys.stdout is None:  # started with stdout closed (cmd >&-): nothing could be reported
+        raise ValueError("stdout is closed; allowed: an open standard output (redirect it to a file or /dev/null)")
+    source_date_epoch()
+    processes()  # PHASEIMPACT_COMPILE_PROCESSES: read only by a first-ever compile, checked every time
+
+
 class _Parser(argparse.ArgumentParser):
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, **kwargs)
+        self._negative_number_matcher = _NEGATIVE_NUMBER
+
+    def parse_args(self, args=None, namespace=None):
+        try:
+            _check_environment()
+        except ValueError as error:
+            self.error(str(error))
+        return super().parse_args(args, namespace)
+
     def error(self, message):
         choice = re.fullmatch(r"(argument (\S+)): invalid choice: (.*) \(choose from (.*)\)", message)
         if choice:  # the same wording as every other range message
@@ -224,7 +248,25 @@ _kappa_list.__name__ = "kappa"
 _V = _real("v", *V_RANGE, unit="m/s")
 _KAPPA = _real("kappa", 0.0, KAPPA_MAX, unit=KAPPA_UNIT)
 _T_END = _real("t-end", 0.0, low_open=True, unit="s")
-_RTOL = _real("rtol", *RTOL_RANGE)
+
+
+class _Rtol:
+    """argparse type of --rtol, reading the engine's range only when --rtol is given or its help is
+    shown (importing the engine costs 0.3 s, which the commands that integrate nothing do not pay).
+    No ``__name__``: argparse would show that for %(type)s."""
+
+    def __call__(self, text):
+        from .integrate import RTOL_RANGE
+
+        return _real("rtol", *RTOL_RANGE)(text)
+
+    def __str__(self):  # the help's %(type)s
+        from .integrate import RTOL_RANGE
+
+        return f"{RTOL_RANGE[0]:g} <= RTOL <= {RTOL_RANGE[1]:g}"
+
+
+_RTOL = _Rtol()
 _KAPPA_RTOL = _real("kappa-rtol", *KAPPA_RTOL_RANGE)
 _RESTITUTION = _real("restitution", *RESTITUTION_RANGE)
 
@@ -283,7 +325,7 @@ def _given(args, name):
 
 
 def _setting_names(args) -> list[str]:
-    return [text.partition("=")[0].strip() for text in (getattr(args, "set", None) or [])]
+    return [setting_name(text.partition("=")[0]) for text in (getattr(args, "set", None) or [])]
 
 
 def _check_in_range(name, value, low, high, unit, source):
@@ -295,17 +337,25 @@ def _check_in_range(name, value, low, high, unit, source):
 def _resolve_law(args, impact: dict):
     """The contact law from the options, else from the case; refuse options the law would ignore."""
     from .model import REGISTRY, ContactLaw
+    from .model.restitution import check_attainable
 
     name = args.law if _given(args, "law") else impact["law"]
     restitution_laws = [n for n, entry in REGISTRY.items() if entry.damping == "restitution"]
-    if _given(args, "contact") and name != "paper":
-        raise ValueError(f"contact = {args.contact!r} is not read by law {name!r}; allowed: --contact with law paper")
+    settings = _setting_names(args)
+    contact_given = _given(args, "contact") or "contact" in settings
+    if contact_given and name != "paper":
+        raise ValueError(f"contact = {impact['contact'] if 'contact' in settings else args.contact!r} is not read by "
+                         f"law {name!r}; allowed: --contact with law paper")
     contact = args.contact if _given(args, "contact") else (impact["contact"] if name == "paper" else "printed")
+    # a value given by --set is the user's as much as an option's: refused where the law ignores it
+    kappa_given = _given(args, "kappa") or "kappa" in settings
     restitution = getattr(args, "restitution", None)
+    if restitution is None and "restitution" in settings:
+        restitution = impact["restitution"]
     if restitution is not None and name == "abrate":
         raise ValueError(f"restitution = {restitution!r} is not read by law 'abrate' (undamped Hertz contact); "
                          "allowed: --restitution with hunt-crossley or a restitution law")
-    if restitution is None and impact["restitution"] is not None and not _given(args, "kappa") and (
+    if restitution is None and impact["restitution"] is not None and not kappa_given and (
             name in restitution_laws or name == "hunt-crossley"):
         restitution = impact["restitution"]  # the case's: its law reads it
     if restitution is None and name in restitution_laws:
@@ -313,11 +363,12 @@ def _resolve_law(args, impact: dict):
         raise ValueError(f"restitution = None is out of range for law {name!r} (its only damping); allowed: "
                          f"--restitution E with {lo:g} <= E <= {hi:g}")
     law = ContactLaw(name, restitution=restitution, contact=contact)
-    if _given(args, "kappa") and not law.reads("kappa"):
+    if kappa_given and not law.reads("kappa"):
         source = "its damping comes from the restitution" if law.damping_source == "restitution" else "it is undamped"
-        raise ValueError(f"kappa = {args.kappa!r} is not read by law {law.label()!r} ({source}); allowed: "
+        raise ValueError(f"kappa = {impact['kappa']!r} is not read by law {law.label()!r} ({source}); allowed: "
                          + ("--kappa or --restitution, not both" if restitution is not None
                             else "--kappa with paper or hunt-crossley"))
+    check_attainable(law)
     return law
 
 
@@ -331,23 +382,34 @@ def _setup(args, *, law=True) -> Setup:
     case = args.case if getattr(args, "case", None) is not None else load_case("seed")
     settings = getattr(args, "set", None) or []
     names = _setting_names(args)
-    if "v" in names and _given(args, "v"):
-        raise ValueError(f"v is given twice (--v {args.v!r} and --set v=...); allowed: one of them")
+    for key in ("v", "kappa", "target", "law", "contact", "restitution"):
+        if key in names and _given(args, key):
+            raise ValueError(f"{key} is given twice (--{key} {getattr(args, key)!r} and --set {key}=...); allowed: "
+                             "one of them")
     if settings:
         case = case.with_settings(settings)
     impact = dict(case.impact)
     for key in ("v", "kappa", "target"):
         if _given(args, key):
             impact[key] = getattr(args, key)
-    source = "from --v" if _given(args, "v") else ("from --set" if "v" in names else f"from case {case.name!r}")
-    _check_in_range("v", impact["v"], *V_RANGE, "m/s", source)
-    _check_in_range("kappa", impact["kappa"], 0.0, KAPPA_MAX, KAPPA_UNIT, f"from case {case.name!r}")
+
+    def source(key):
+        return f"from --{key}" if _given(args, key) else ("from --set" if key in names else f"from case {case.name!r}")
+    _check_in_range("v", impact["v"], *V_RANGE, "m/s", source("v"))
+    _check_in_range("kappa", impact["kappa"], 0.0, KAPPA_MAX, KAPPA_UNIT, source("kappa"))
     contact_law = None
     if law:
         contact_law = _resolve_law(args, impact)
         impact.update(law=contact_law.name, contact=contact_law.contact, restitution=contact_law.restitution)
+        if not contact_law.reads("kappa"):  # the case's kappa, under a law the options chose that ignores it
+            impact["kappa"] = 0.0
     case = dataclasses.replace(case, impact=impact)  # validated again: the case as used
-    return Setup(case, contact_law, case.parameters())
+    params = case.parameters()
+    if getattr(args, "t_end", None) is not None:  # a horizon shorter than the case can resolve
+        from .integrate.api import check_t_end, scales
+
+        check_t_end(args.t_end, scales(params).contact_time, name="t-end")
+    return Setup(case, contact_law, params)
 
 
 def _check_critical_law(law) -> None:
@@ -379,7 +441,11 @@ def _check_kappa_range(args) -> None:
 
 
 def _check_figure_target(path: str, force: bool) -> None:
-    """Refuse to replace an existing file that is not a figure of the format asked for, unless ``force``."""
+    """Refuse a format the plotting layer does not write, and to replace an existing file that is not a
+    figure of the format asked for, unless ``force``: before any work."""
+    from .plotting import figure_format
+
+    figure_format(path)
     if force or not os.path.isfile(path):
         return
     magic = FIGURE_FORMATS[os.path.splitext(path)[1].lower()]
@@ -417,10 +483,25 @@ def cmd_cases(args) -> int:
     return EXIT_OK
 
 
+def cmd_warmup(args) -> int:
+    from .integrate.precompile import warmup
+
+    out = warmup()
+    if args.json:
+        _print_json(out)
+    elif out["cache"] is None:
+        print(f"compiled in {out['seconds']:.1f} s for this process only: nothing is cached ({out['reason']})")
+    else:
+        done = "compiled" if out["compiled"] else "already compiled; loaded"
+        print(f"{done} in {out['seconds']:.1f} s; cache: {out['cache']} ({out['source']}"
+              f"{'' if out['writable'] else ', read-only'}; {out['files']} files, {out['bytes'] / 1e6:.1f} MB)")
+    return EXIT_OK
+
+
 PARAM_UNITS = {"M1": "kg", "M2": "kg", "K": "N/m^1.5", "Kb": "N/m", "Km": "N/m^3", "alpha": "", "kappa": KAPPA_UNIT,
                "v": "m/s", "R": "m", "contact_time": "s", "plate_period": "s", "indentation": "m", "peak_force": "N",
                "contact_radius": "m", "peak_pressure": "Pa", "first_yield_pressure": "Pa",
-               "pressure_to_first_yield": ""}
+               "pressure_to_first_yield": "", "hertz_mass": "kg"}
 
 
 def cmd_params(args) -> int:
@@ -429,18 +510,24 @@ def cmd_params(args) -> int:
     setup = _setup(args, law=False)
     p, case = setup.params, setup.case
     out = {k: getattr(p, k) for k in ("M1", "M2", "K", "Kb", "Km", "alpha", "kappa", "v", "target", "R")}
+    # The Hertz scales are those of the relative motion: the reduced mass M1 M2/(M1+M2) unless the
+    # target is rigid (docs/physics.md §4); say which, since a plate's figures differ from a rigid one's.
+    out["hertz_mass"] = p.reduced_mass
+    out["hertz_mass_is"] = ("M1 (rigid target)" if p.target == "rigid"
+                            else f"reduced mass M1 M2/(M1+M2) ({p.target} target)")
     out.update(hertz_scales(p, case.plate))
-    out["validity"] = validity(p, case.plate, case.projectile)
+    out["validity"] = validity(p, case.plate, case.projectile, case.geometry)
     out["case"] = case.as_dict()
     if args.json:
         _print_json(out)
     else:
         print(f"case {case.name}: {case.description}" if case.description else f"case {case.name}")
         for k, value in out.items():
-            if k in ("case", "validity", "target"):
+            if k in ("case", "validity", "target", "hertz_mass_is"):
                 continue
             print(f"  {k:>23} = {_fmt(value, PARAM_UNITS.get(k, ''))}".rstrip())
         print(f"  {'target':>23} = {p.target}")
+        print(f"  Hertz scales (contact_time ... peak_pressure) use hertz_mass, the {out['hertz_mass_is']}")
         print(f"  validity: {out['validity']}")
     return EXIT_OK
 
@@ -456,7 +543,7 @@ def _contact_reading(trajectory, setup: Setup) -> dict:
     force = max(force, 0.0)
     case = setup.case
     return {**hertz_contact(force, setup.params),
-            "validity": validity_for_force(force, setup.params, case.plate, case.projectile)}
+            "validity": validity_for_force(force, setup.params, case.plate, case.projectile, case.geometry)}
 
 
 def cmd_simulate(args) -> int:
@@ -506,6 +593,36 @@ def cmd_simulate(args) -> int:
     return EXIT_OK
 
 
+def _eigenvalue_text(z) -> str:
+    re_, im = float(z.real) + 0.0, float(z.imag) + 0.0  # + 0.0: no "-0"
+    return f"{re_:.6g}" if im == 0 else (f"{im:+.6g}i" if re_ == 0 else f"{re_:.6g}{im:+.6g}i")
+
+
+def cmd_fixed_points(args) -> int:
+    from .analysis import fixed_points
+
+    setup = _setup(args)
+    law, p = setup.law, setup.params
+    found = fixed_points(p, law)
+    out = {**_law_fields(setup), "v": p.v, "kappa": law.kappa(p), "target": p.target,
+           "equilibria": [e.as_dict() for e in found], "case": setup.case.as_dict()}
+    if args.json:
+        _print_json(out)
+        return EXIT_OK
+    print(f"equilibria of {law.label()} on a {p.target} target ({setup.case.name}), docs/physics.md §5 "
+          "(kappa and v move none: the damping acts through deltadot, zero at rest)")
+    for e in found:
+        conditions = ", ".join(f"{k} {c}" for k, c in e.conditions.items())
+        shape = "isolated point" if e.kind == "point" else f"set of dimension {e.dimension}"
+        print(f"  {e.name}: {shape}: {conditions}")
+        print(f"    {e.description}")
+        at = ", ".join(f"{x:.4g}" for x in e.state)
+        eig = ", ".join(_eigenvalue_text(z) for z in e.eigenvalues) or "none"
+        print(f"    eigenvalues (1/s) in ({', '.join(e.coordinates)}) at (x1, x2, x1dot, x2dot) = ({at}): {eig}")
+        print(f"    linearisation: {e.stability}; {e.note}")
+    return EXIT_OK
+
+
 def cmd_critical(args) -> int:
     from .continuation import critical_damping
 
@@ -513,12 +630,18 @@ def cmd_critical(args) -> int:
     law, params = setup.law, setup.params
     _check_critical_law(law)
     _check_kappa_range(args)
+    from .continuation.transition import default_kappa_range
+
+    # a default end beyond the one given is named as the default it is, with the range it comes from
+    default_kappa_range(params, args.kappa_min, args.kappa_max, names=("kappa-min", "kappa-max"))
     _note(f"locating kappa_c and kappa_2 of {law.label()} at v = {params.v:g} m/s"
           + (" and measuring the exponents (about 1 s)" if args.exponents else ""))
     result = critical_damping(params, law, kappa_min=args.kappa_min, kappa_max=args.kappa_max,
                               rtol=args.kappa_rtol, integrator_rtol=args.rtol, with_kappa_2=True,
                               with_exponents=args.exponents)
-    out = {**_law_fields(setup), "v": result.v, "kappa_c": result.kappa_c, "kappa_2": result.kappa_2,
+    out = {**_law_fields(setup), "v": result.v, "kappa_c": result.kappa_c,
+           "kappa_c_accuracy": result.kappa_c_accuracy, "kappa_2": result.kappa_2,
+           "kappa_2_accuracy": result.kappa_2_accuracy, "n_below": result.n_below, "n_above": result.n_above,
            "closed_form": result.closed_form, "classification": result.classification,
            "status": result.status, "message": result.message, "bracket": list(result.bracket),
            "margins": list(result.margins), "kappa_rtol": result.rtol, "rtol": args.rtol,
@@ -533,9 +656,11 @@ def cmd_critical(args) -> int:
         print(f"  closed form {_fmt(result.closed_form, KAPPA_UNIT)}; kappa_2 (N = 2 from here on) "
               f"{_fmt(result.kappa_2, KAPPA_UNIT, '.10g')}; classification {result.classification or 'none'}")
         if result.n_staircase:
-            steps = [f"{s['n_stick']}{'+' if s['cut'] else ''}" for s in result.n_staircase]
+            steps = [("?" if s["n_stick"] is None else f"{s['n_stick']}") + ("+" if s["cut"] else "")
+                     for s in result.n_staircase]
             eps = [s["kappa"] / result.kappa_c - 1 for s in result.n_staircase]
-            print(f"  stick phases at kappa/kappa_c - 1 = {eps[0]:.3g} .. {eps[-1]:.3g} ('+': a lower bound): "
+            print(f"  stick phases at kappa/kappa_c - 1 = {eps[0]:.3g} .. {eps[-1]:.3g} ('+': a lower bound, "
+                  "'?': not confirmed at a tighter tolerance): "
                   + " ".join(steps))
         if args.exponents and result.exponents:
             e = result.exponents
@@ -550,21 +675,35 @@ def cmd_critical(args) -> int:
 
 
 def cmd_transitions(args) -> int:
+    import warnings
+
     from .continuation import transitions
+    from .continuation.transition import RunFailed, SamplingWarning, check_samples
 
     setup = _setup(args)
     law, params = setup.law, setup.params
     _check_reads_kappa(law, "kappa")
     _check_grazing_target(law, params)
     _check_kappa_range(args)
+    if not law.is_filippov:  # a grazing search samples kappa: enough samples per decade, or refused now
+        check_samples(args.samples, args.kappa_min, args.kappa_max, names=("kappa-min", "kappa-max", "samples"))
     _note(f"locating the transitions of {law.label()} at v = {params.v:g} m/s for kappa in "
           f"[{args.kappa_min:g}, {args.kappa_max:g}]")
-    found = transitions(params, law, args.kappa_min, args.kappa_max, rtol=args.kappa_rtol,
-                        integrator_rtol=args.rtol, num=args.samples)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", SamplingWarning)
+        try:
+            found = transitions(params, law, args.kappa_min, args.kappa_max, rtol=args.kappa_rtol,
+                                integrator_rtol=args.rtol, num=args.samples, progress=sys.stderr.isatty())
+        except RunFailed as error:  # every input was checked: this is the search's own failure
+            print(f"phaseimpact: the transition search failed: {error}", file=sys.stderr)
+            return EXIT_FAILURE
+    notes = [str(w.message) for w in caught if issubclass(w.category, SamplingWarning)]
+    for note in notes:
+        print(f"phaseimpact: warning: {note}", file=sys.stderr)
     count = "stick phases" if law.is_filippov else "contacts"
     out = {**_law_fields(setup), "v": params.v, "kappa_min": args.kappa_min, "kappa_max": args.kappa_max,
            "count": count, "transitions": [t.as_dict() for t in found], "kappa_rtol": args.kappa_rtol,
-           "rtol": args.rtol, "samples": args.samples, "case": setup.case.as_dict()}
+           "rtol": args.rtol, "samples": args.samples, "warnings": notes, "case": setup.case.as_dict()}
     if args.json:
         _print_json(out)
     else:
@@ -640,7 +779,7 @@ def _run_grid(args, setup: Setup, axes: list):
             result = atlas(setup.case, setup.law, axes, t_end=args.t_end, n_jobs=args.jobs, backend=args.backend,
                            scheduler=args.scheduler, rtol=args.rtol, progress=not args.no_progress,
                            previous=previous, on_chunk=checkpoint)
-        except KeyboardInterrupt:
+        except KeyboardInterrupt as stop:  # Ctrl-C or SIGTERM: one line, the checkpoint stays
             saved = ""
             if os.path.exists(out):
                 try:
@@ -648,8 +787,9 @@ def _run_grid(args, setup: Setup, axes: list):
                     saved = f"; {done} of {size} points are saved in {out}"
                 except ValueError:
                     saved = ""
-            print(f"phaseimpact: interrupted{saved}. Resume with:\n  {_resume_command(args.argv)}", file=sys.stderr)
-            return None
+            print(f"phaseimpact: {_stopped(stop)}{saved}; resume with: {_resume_command(args.argv)}", file=sys.stderr)
+            stop.reported = True
+            raise
         del checkpoint  # its record of the file (per-point arrays) is not needed for the final write
         archive.save(result, out, force=args.force)
     return result
@@ -671,6 +811,8 @@ def _grid_summary(result, out_path, setup: Setup) -> dict:
     failed = result.failed
     failures = {}
     for code in result.status[failed]:
+        from .integrate import STATUSES
+
         name = STATUSES[int(code)]
         failures[name] = failures.get(name, 0) + 1
     axes = [{"name": a.name, "num": len(a.values), "start": float(a.values[0]), "stop": float(a.values[-1]),
@@ -771,7 +913,13 @@ def cmd_atlas(args) -> int:
         from .continuation import refine_boundaries
 
         _note(f"refining the class boundaries along {args.refine}")
-        found = refine_boundaries(result, args.refine, rtol=args.refine_rtol, integrator_rtol=args.rtol)
+        try:
+            found = refine_boundaries(result, args.refine, rtol=args.refine_rtol, integrator_rtol=args.rtol)
+        except KeyboardInterrupt as stop:
+            print(f"phaseimpact: {_stopped(stop)} while refining; the atlas is saved in {args.out} without its "
+                  f"boundaries; resume with: {_resume_command(args.argv)}", file=sys.stderr)
+            stop.reported = True
+            raise
         result.extras["boundaries"] = {"axis": found.axis, "points": found.points, "below": found.below,
                                        "above": found.above, "rtol": found.rtol}
         with exclusive(args.out, "out"):
@@ -801,7 +949,7 @@ def _curve_values(args, setup: Setup):
                              "--to B (or --v-min A --v-max B)")
         param, start, stop, log = args.param, args.from_, args.to, args.log
         label = ("from", "to")
-    allowed = [*CURVE_PARAMETERS, *(n for n in SETTABLE if n not in CURVE_PARAMETERS and n != "plate.yield_strength")]
+    allowed = [*CURVE_PARAMETERS, *(n for n in QUANTITIES if n not in CURVE_PARAMETERS)]
     if param not in allowed:
         raise ValueError(f"param = {param!r} is out of range; allowed: one of {', '.join(allowed)}"
                          + (" (kappa is what the curve continues)" if param == "kappa" else ""))
@@ -922,7 +1070,9 @@ def cmd_critical_curve(args) -> int:
         unit = SETTABLE.get(param, (PARAM_UNITS.get(param, ""),))[0]
         for x, k, closed in zip(curve.values[asked], curve.kappa[asked], curve.closed_form[asked], strict=True):
             line = f"{param} = {x:10.6g} {unit}   {what} = {_fmt(k, '', '.10g'):>16}"
-            print(line + (f"   closed-form kappa_c {_fmt(closed, '', '.6g')}" if np.isfinite(closed) else ""))
+            # the closed form (docs/physics.md §5) is of kappa_c, whatever the curve continues: kappa_2 has none
+            label = "closed-form kappa_c" if what == "kappa_c" else "kappa_c's closed form (none for kappa_2)"
+            print(line + (f"   {label} {_fmt(closed, '', '.6g')}" if np.isfinite(closed) else ""))
         note = f"; {curve.message}" if curve.message else ""
         print(f"wrote {out} ({len(curve.values)} continuation steps{note})")
     if curve.message or not np.all(np.isfinite(curve.kappa[asked])):
@@ -1103,9 +1253,8 @@ def build_parser() -> argparse.ArgumentParser:
                        help="what is hit (default: the case's, else plate)")
 
     def tolerance(p):
-        lo, hi = RTOL_RANGE
         p.add_argument("--rtol", type=_RTOL, default=1e-10,
-                       help=f"integrator tolerance (relative), {lo:g} <= RTOL <= {hi:g} (default: %(default)s)")
+                       help="integrator tolerance (relative), %(type)s (default: %(default)s)")
 
     def kappa_tolerance(p, what="width of kappa_c's final bracket"):
         lo, hi = KAPPA_RTOL_RANGE
@@ -1175,6 +1324,14 @@ def build_parser() -> argparse.ArgumentParser:
     json_option(p)
     p.set_defaults(func=cmd_cases)
 
+    p = sub.add_parser("warmup", help="compile the engine ahead, and say where its cache is",
+                       description="Compile every entry of the engine into its cache now (the first command that "
+                                   "integrates would otherwise do it, ~20 s), and say where the cache is: for shared "
+                                   "installs (run it as the install's owner: other users read that cache), containers "
+                                   "and cluster workers. On a warm cache it only loads.")
+    json_option(p)
+    p.set_defaults(func=cmd_warmup)
+
     p = add("params", "a case's derived parameters, Hertz scales and validity",
             "The derived parameters (seed eq. 3-5) of a case, its Hertz scales (contact time, plate period, "
             "indentation, peak force, contact radius, peak pressure) and whether elastic Hertz contact holds.")
@@ -1196,6 +1353,18 @@ def build_parser() -> argparse.ArgumentParser:
     tolerance(p)
     json_option(p)
     p.set_defaults(func=cmd_simulate)
+
+    p = add("fixed-points", "the equilibria (points or sets) with eigenvalues and stability",
+            "The equilibria of eq. 1 under the law, from its equations: isolated points or sets (the separated set "
+            "of a unilateral law, the stuck set of paper), each with the eigenvalues of its linearisation and a "
+            "stability label (docs/physics.md §5).")
+    case_options(p)
+    law_options(p)
+    speed(p)
+    damping(p, "moves no equilibrium")
+    target(p)
+    json_option(p)
+    p.set_defaults(func=cmd_fixed_points)
 
     p = add("critical", "the critical damping kappa_c and kappa_2 at one speed (law paper)",
             "The critical damping kappa_c of eq. 8 (law paper): where the first stick stops being permanent "
@@ -1279,8 +1448,7 @@ def build_parser() -> argparse.ArgumentParser:
     law_options(p, restitution=False)
     speed(p)
     target(p)
-    curve_params = ", ".join([*CURVE_PARAMETERS, *(n for n in SETTABLE if n not in CURVE_PARAMETERS
-                                                   and n != "plate.yield_strength")])
+    curve_params = ", ".join([*CURVE_PARAMETERS, *(n for n in QUANTITIES if n not in CURVE_PARAMETERS)])
     p.add_argument("--param", default=None, metavar="NAME",
                    help=f"the parameter the curve runs over: {curve_params} (default: none; --v-min/--v-max "
                         "imply v)")
@@ -1341,19 +1509,38 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+#: Commands that compile and integrate nothing: they start without the engine (numba, SciPy).
+_INTEGRATE_NOTHING = ("cases", "params")
+
+
+def _stopped(stop: KeyboardInterrupt) -> str:
+    from . import _signals
+
+    return "terminated (SIGTERM)" if isinstance(stop, _signals.Terminated) else "interrupted"
+
+
 def main(argv=None) -> int:
-    argv = list(sys.argv[1:] if argv is None else argv)
-    parser = build_parser()
-    args = parser.parse_args(argv)
-    args.argv = argv
+    # Ctrl-C and SIGTERM, wherever they arrive (compiled runs included): one line, exit 130 or 143
+    previous_term = signal.getsignal(signal.SIGTERM)
     try:
+        argv = list(sys.argv[1:] if argv is None else argv)
+        parser = build_parser()
+        args = parser.parse_args(argv)
+        args.argv = argv
+        if args.command not in _INTEGRATE_NOTHING:  # _signals imports numba (0.2 s): only where runs are stopped
+            from . import _signals
+
+            _signals.install_command_line()
         return args.func(args)
     except ValueError as error:
         print(f"phaseimpact: error: {error}", file=sys.stderr)
         return EXIT_USAGE
-    except KeyboardInterrupt:
-        print("phaseimpact: interrupted", file=sys.stderr)
-        return EXIT_INTERRUPTED
+    except KeyboardInterrupt as stop:
+        if not getattr(stop, "reported", False):
+            print(f"phaseimpact: {_stopped(stop)}", file=sys.stderr)
+        from . import _signals
+
+        return _signals.exit_code(stop)
     except BrokenPipeError:  # the reader of stdout went away (| head): nothing more to say
         try:
             os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
@@ -1363,6 +1550,9 @@ def main(argv=None) -> int:
     except OSError as error:  # the disk, not the input: full, gone, permissions changed under us
         print(f"phaseimpact: error: {error}", file=sys.stderr)
         return EXIT_FAILURE
+    finally:
+        if previous_term is not None and threading.current_thread() is threading.main_thread():
+            signal.signal(signal.SIGTERM, previous_term)  # main() called in-process (tests) leaves it as it was
 
 
 if __name__ == "__main__":

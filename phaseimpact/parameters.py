@@ -9,7 +9,10 @@ The seed's formulas are used as printed except where docs/physics.md §2 correct
   ``membrane="shivakumar"``.
 
 All quantities are SI: m, kg, Pa, N/m^alpha, N s/m^(1+alpha). Every numeric field accepts any
-real number type (Python or NumPy; ``bool`` is not a number) and is stored as a plain ``float``.
+real number type (Python or NumPy, a 0-d array included; ``bool`` is not a number) and is stored as a
+plain ``float``. Materials, geometry and the impact speed are bounded by generous physical ranges
+(:data:`MODULUS_RANGE`, ...): a value beyond them is a typo or a unit slip, refused with its own name
+instead of overflowing a derived quantity.
 """
 
 from __future__ import annotations
@@ -19,6 +22,8 @@ import math
 import numbers
 from collections.abc import Mapping
 from dataclasses import dataclass
+
+import numpy as np
 
 __all__ = [
     "Material",
@@ -34,6 +39,13 @@ __all__ = [
     "seed_parameters",
     "dotted_overrides",
     "STEEL",
+    "MODULUS_RANGE",
+    "DENSITY_RANGE",
+    "STRENGTH_RANGE",
+    "LENGTH_RANGE",
+    "R2_RANGE",
+    "V_RANGE",
+    "KAPPA_MAX",
 ]
 
 TARGETS = ("plate", "rigid", "free")
@@ -41,6 +53,23 @@ MEMBRANE_FORMULAS = ("printed", "shivakumar")
 BODIES = ("projectile", "plate")
 MATERIAL_FIELDS = ("E", "nu", "rho", "yield_strength")
 GEOMETRY_NAMES = ("a", "h", "R1", "R2")
+
+# Physical ranges of the inputs (SI). Every real material and size lies well inside them; beyond
+# them a derived quantity (M1, K, Kb...) overflows or underflows, or the run cannot be resolved.
+#: Young's modulus, Pa: soft gels (1e3) to beyond diamond (1.2e12).
+MODULUS_RANGE = (1e3, 1e13)
+#: Density, kg/m^3: aerogels (0.1) to beyond osmium (2.26e4).
+DENSITY_RANGE = (1e-1, 1e5)
+#: Yield (or compressive) strength, Pa.
+STRENGTH_RANGE = (1e3, 1e12)
+#: Plate radius, thickness and projectile radius, m: a nanometre to a kilometre.
+LENGTH_RANGE = (1e-9, 1e3)
+#: Radius of curvature of the target, m (a flat target is a large R2).
+R2_RANGE = (1e-9, 1e12)
+#: Impact speed, m/s: quasi-static to far beyond any Hertz contact.
+V_RANGE = (1e-6, 1e4)
+#: Largest damping coefficient of the inputs, N s/m^(1+alpha) (the seed's kappa_c is about 1.5e12).
+KAPPA_MAX = 1e18
 
 
 def require(name: str, value, allowed: str, ok: bool) -> None:
@@ -57,13 +86,22 @@ def require_nonnegative(name: str, value) -> None:
     require(name, value, "a finite number >= 0", _is_finite(value) and value >= 0)
 
 
+def require_in(name: str, value, bounds: tuple, unit: str = "") -> None:
+    """``low <= value <= high`` for finite numbers; the message gives the range and the unit."""
+    low, high = bounds
+    require(name, value, f"{low:g} <= {name} <= {high:g}" + (f" ({unit})" if unit else ""),
+            _is_finite(value) and low <= value <= high)
+
+
 def require_choice(name: str, value, choices) -> None:
     require(name, value, "one of " + ", ".join(map(str, choices)), value in choices)
 
 
 def is_number(value) -> bool:
-    """True for any real number type (int, float, NumPy scalars), False for ``bool``."""
-    return isinstance(value, numbers.Real) and not isinstance(value, bool)
+    """True for any real number type (int, float, NumPy scalars and 0-d arrays), False for ``bool``."""
+    if isinstance(value, np.ndarray):  # a 0-d array is a scalar (np.array(1.0), a reduction's result)
+        return value.ndim == 0 and value.dtype.kind in "iuf"
+    return isinstance(value, numbers.Real) and not isinstance(value, (bool, np.bool_))
 
 
 def _is_finite(value) -> bool:
@@ -94,20 +132,22 @@ def validate_material(values: Mapping, prefix: str = "") -> None:
     ValueError
         Naming the (prefixed) field, its value and the allowed range.
     """
-    require_positive(prefix + "E", values["E"])
+    require_in(prefix + "E", values["E"], MODULUS_RANGE, "Pa")
     nu = values["nu"]
     require(prefix + "nu", nu, "0 <= nu < 0.5", _is_finite(nu) and 0 <= nu < 0.5)
-    require_positive(prefix + "rho", values["rho"])
+    require_in(prefix + "rho", values["rho"], DENSITY_RANGE, "kg/m^3")
     strength = values.get("yield_strength")
     if strength is not None:
-        require(prefix + "yield_strength", strength, "a finite number > 0, or absent",
-                _is_finite(strength) and strength > 0)
+        low, high = STRENGTH_RANGE
+        require(prefix + "yield_strength", strength, f"{low:g} <= {prefix}yield_strength <= {high:g} (Pa), or absent",
+                _is_finite(strength) and low <= strength <= high)
 
 
 def validate_geometry(values: Mapping, prefix: str = "") -> None:
-    """Check the fields of a :class:`Geometry` (all > 0, m); messages name ``prefix + field``."""
+    """Check the fields of a :class:`Geometry` (m, within :data:`LENGTH_RANGE`, ``R2`` within
+    :data:`R2_RANGE`); messages name ``prefix + field``."""
     for name in GEOMETRY_NAMES:
-        require_positive(prefix + name, values[name])
+        require_in(prefix + name, values[name], R2_RANGE if name == "R2" else LENGTH_RANGE, "m")
 
 
 @dataclass(frozen=True)
@@ -117,13 +157,14 @@ class Material:
     Attributes
     ----------
     E : float
-        Young's modulus, Pa (> 0).
+        Young's modulus, Pa (:data:`MODULUS_RANGE`).
     nu : float
         Poisson's ratio, dimensionless (0 <= nu < 0.5).
     rho : float
-        Density, kg/m^3 (> 0).
+        Density, kg/m^3 (:data:`DENSITY_RANGE`).
     yield_strength : float or None
-        Yield (or, for brittle and polymeric materials, compressive) strength, Pa (> 0), if known.
+        Yield (or, for brittle and polymeric materials, compressive) strength, Pa
+        (:data:`STRENGTH_RANGE`), if known.
         It drives the validity check of elastic Hertz contact (first yield at ``p0 ≈ 1.6 Y``).
     """
 
@@ -143,7 +184,8 @@ STEEL = Material(E=2.1e11, nu=0.3, rho=7850.0)
 
 @dataclass(frozen=True)
 class Geometry:
-    """Projectile and plate geometry (seed eq. 7).
+    """Projectile and plate geometry (seed eq. 7); lengths within :data:`LENGTH_RANGE` (``R2``:
+    :data:`R2_RANGE`).
 
     Attributes
     ----------
@@ -193,7 +235,7 @@ class Parameters:
     kappa : float
         Damping characteristic of eq. 8, N s/m^(1+alpha) (>= 0).
     v : float
-        Impact speed of the projectile, m/s (initial condition eq. 6).
+        Impact speed of the projectile, m/s (initial condition eq. 6; :data:`V_RANGE`).
     target : str
         ``"plate"`` (eq. 1), ``"rigid"`` (target held fixed) or ``"free"`` (no springs).
     R : float or None
@@ -214,8 +256,9 @@ class Parameters:
     R: float | None = None
 
     def __post_init__(self):
-        for name in ("M1", "M2", "K", "alpha", "v"):
+        for name in ("M1", "M2", "K", "alpha"):
             require_positive(name, getattr(self, name))
+        require_in("v", self.v, V_RANGE, "m/s")
         for name in ("Kb", "Km", "kappa"):
             require_nonnegative(name, getattr(self, name))
         require_choice("target", self.target, TARGETS)
@@ -353,6 +396,9 @@ def parameters_with(
         if changes:
             materials[body] = _replace_material(materials[body], f"{body}_", changes)
     passed = {name: overrides.pop(name) for name in ("alpha", "kappa", "target", "membrane") if name in overrides}
+    if "kappa" in passed:  # an input: bounded as on the command line (searches may go beyond it)
+        require("kappa", passed["kappa"], f"0 <= kappa <= {KAPPA_MAX:g} (N s/m^(1+alpha))",
+                _is_finite(passed["kappa"]) and 0 <= passed["kappa"] <= KAPPA_MAX)
     if "v" in overrides:
         v = overrides.pop("v")
     params = derive_parameters(materials["projectile"], materials["plate"], geometry, v=v, **passed)

@@ -2,7 +2,7 @@
 the command line (``phaseimpact plot``, ``phaseimpact portrait``).
 
 Uses the non-interactive ``Agg`` backend. Lengths are drawn in µm, times in ms, velocities in
-m/s and forces in N. The only I/O is :func:`save` (PNG) and :func:`save_h5` (HDF5 data).
+m/s and forces in N. The only I/O is :func:`save` (PNG, PDF or SVG) and :func:`save_h5` (HDF5 data).
 
 Archives and trajectories: :func:`plot_atlas` (two axes: outcome classes as a categorical colour
 map), :func:`plot_sweep` (one axis: counts and max force), :func:`plot_curve` (a continued
@@ -24,8 +24,8 @@ import numpy as np  # noqa: E402
 from ._atomic import atomic_path  # noqa: E402
 
 __all__ = ["STYLE", "style", "figure", "plot_displacements", "plot_force", "plot_phase", "plot_hysteresis",
-           "mark_points", "save", "save_h5", "UM", "MS", "OUTCOME_COLOURS", "axis_label", "plot_atlas",
-           "plot_sweep", "plot_curve", "plot_portraits"]
+           "mark_points", "save", "save_h5", "figure_format", "FIGURE_FORMATS", "UM", "MS", "OUTCOME_COLOURS",
+           "axis_label", "plot_atlas", "plot_sweep", "plot_curve", "plot_portraits"]
 
 UM = 1e6  #: m -> µm
 MS = 1e3  #: s -> ms
@@ -111,20 +111,38 @@ def plot_phase(ax, trajectory, plane=("delta", "deltadot"), *, mark_events=True,
     return points
 
 
+#: The formats :func:`save` writes, each with the metadata that keeps its bytes the same from run to
+#: run (no matplotlib version, no creation date; each backend names these keys its own way).
+FIGURE_FORMATS = {
+    "png": {"Software": None},
+    "pdf": {"Creator": None, "Producer": None, "CreationDate": None},
+    "svg": {"Creator": None, "Date": None},
+}
+
+
+def figure_format(path) -> str:
+    """The format of a figure ``path`` from its suffix (``png`` when it has none); ``ValueError`` for a
+    format :func:`save` does not write (call it before the work that makes the figure)."""
+    suffix = os.path.splitext(os.fspath(path))[1].lstrip(".").lower()
+    fmt = suffix or "png"
+    if fmt not in FIGURE_FORMATS:
+        raise ValueError(f"figure {os.fspath(path)!r} has format {suffix!r}; allowed: "
+                         + ", ".join(f".{name}" for name in FIGURE_FORMATS))
+    return fmt
+
+
 def save(fig, path, dpi=110):
-    """Write ``fig`` to ``path`` (PNG unless the suffix says otherwise; directories created) and close it.
+    """Write ``fig`` to ``path`` (.png, .pdf or .svg; PNG without a suffix; directories created) and close it.
 
     Written atomically (temporary file, then rename) and without the matplotlib version or a
-    creation date in its metadata, so the same figure gives the same bytes on every run.
+    creation date in its metadata, so the same figure gives the same bytes on every run (SVG: its
+    element ids are hashed with a fixed salt, not a random one).
     """
     path = os.fspath(path)
-    fmt = os.path.splitext(path)[1].lstrip(".").lower() or "png"
-    metadata = {"Software": None}
-    if fmt in ("pdf", "svg", "eps", "ps"):
-        metadata["CreationDate"] = None
     try:
-        with atomic_path(path) as tmp:
-            fig.savefig(tmp, dpi=dpi, format=fmt, metadata=metadata)
+        fmt = figure_format(path)
+        with atomic_path(path) as tmp, plt.rc_context({"svg.hashsalt": "phaseimpact"}):
+            fig.savefig(tmp, dpi=dpi, format=fmt, metadata=FIGURE_FORMATS[fmt])
     finally:
         plt.close(fig)
     return path

@@ -52,6 +52,9 @@ class ImpactQuantities:
 def impact_quantities(trajectory: Trajectory) -> ImpactQuantities:
     """Derive :class:`ImpactQuantities` from ``trajectory`` (its summary; energies from its own
     initial state, docs/physics.md §4)."""
+    if not isinstance(trajectory, Trajectory):
+        raise TypeError(f"trajectory = {trajectory!r} has the wrong type ({type(trajectory).__name__}); allowed: a "
+                        "Trajectory (from simulate())")
     duration = trajectory.contact_duration
     t_equal = None
     if duration is not None:

@@ -4,6 +4,7 @@ import importlib
 import importlib.util
 import json
 import os
+import re
 import shlex
 import subprocess
 import sys
@@ -346,7 +347,7 @@ def test_ctrl_c_during_a_sweep_prints_the_resume_command(tmp_path, monkeypatch, 
     assert main([*SWEEP, "--out", str(out)]) == 130
     err = capsys.readouterr().err
     assert "8 of 40 points are saved" in err
-    command = err.strip().splitlines()[-1].strip()
+    command = re.split(r"[Rr]esume with:\s*", err.strip().splitlines()[-1])[-1]  # one line or two
     words = shlex.split(command)
     assert words[0] == "phaseimpact" and words[-1] == "--resume"
     monkeypatch.setattr(archive.Checkpoint, "__call__", save)
@@ -401,6 +402,41 @@ def test_figures_are_written_atomically_without_version_metadata(tmp_path):
     a, b = (open(p, "rb").read() for p in paths)
     assert a == b and b"Matplotlib" not in a
     assert sorted(os.listdir(tmp_path)) == ["a.png", "b.png"]  # no temporaries, no lock files left
+
+
+@pytest.mark.parametrize("suffix", [".png", ".pdf", ".svg"])
+def test_plot_writes_each_advertised_format_reproducibly(tmp_path, small_sweep, suffix):
+    """Each format --out advertises is written (SVG used to fail on PNG's metadata keys), with the same
+    bytes twice and no matplotlib version in them."""
+    import matplotlib
+
+    from phaseimpact.cli import FIGURE_FORMATS
+    from phaseimpact.plotting import FIGURE_FORMATS as WRITTEN
+
+    assert {s.lstrip(".") for s in FIGURE_FORMATS} == set(WRITTEN)
+    source = archive.save(small_sweep, tmp_path / "s.h5")
+    written = []
+    for name in ("a", "b"):
+        out = tmp_path / f"{name}{suffix}"
+        assert main(["plot", source, "--out", str(out)]) == 0
+        written.append(out.read_bytes())
+    assert written[0] == written[1] and written[0].lstrip().startswith(FIGURE_FORMATS[suffix])
+    assert f"Matplotlib v{matplotlib.__version__}".encode() not in written[0]
+
+
+def test_portrait_writes_svg_and_refuses_other_formats_before_computing(tmp_path, monkeypatch):
+    out = tmp_path / "p.svg"
+    assert main(["portrait", "--kappa", "1e9", "--out", str(out)]) == 0
+    assert out.read_bytes().startswith(b"<?xml")
+    from phaseimpact import cli
+
+    def no_work(*args, **kwargs):
+        raise AssertionError("computed before refusing the format")
+
+    monkeypatch.setattr(cli, "_portrait_runs", no_work)
+    with pytest.raises(SystemExit) as exit_:
+        main(["portrait", "--kappa", "1e9", "--out", str(tmp_path / "p.jpg")])
+    assert exit_.value.code == 2
 
 
 def test_quick_previews_go_to_the_preview_folder():

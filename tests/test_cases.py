@@ -11,6 +11,7 @@ from __future__ import annotations
 import dataclasses
 import json
 import math
+import re
 from pathlib import Path
 
 import numpy as np
@@ -100,16 +101,17 @@ def test_case_parameters_overrides():
 # TOML round trip and bad files
 # ---------------------------------------------------------------------------------------------
 
-def _custom_case() -> Case:
+def _custom_case(**impact) -> Case:
     return Case(name="custom \"quoted\" ünïcode", description="tab\there", source="line1\nline2 \\ backslash",
                 projectile=Material(E=np.float32(7e10), nu=np.int64(0), rho=2700),
                 plate=Material(E=3e9, nu=0.35, rho=1200.0, yield_strength=8e7),
                 geometry=Geometry(a=0.2, h=0.002, R1=1e-4, R2=0.5),
-                impact={"v": 42, "kappa": 1e6, "target": "free", "law": "hunt-crossley", "contact": "unilateral",
-                        "restitution": 0.5})
+                impact={"v": 42, "kappa": 1e6, "target": "free", "law": "paper", "contact": "unilateral", **impact})
 
 
-@pytest.mark.parametrize("case", [load_case(n) for n in SHIPPED] + [_custom_case()], ids=SHIPPED + ["custom"])
+@pytest.mark.parametrize("case", [load_case(n) for n in SHIPPED] + [
+    _custom_case(), _custom_case(law="hunt-crossley", kappa=0.0, contact="printed", restitution=0.5)],
+    ids=SHIPPED + ["custom", "custom-restitution"])
 def test_toml_round_trip(case, tmp_path):
     """as_dict -> TOML -> load_case gives an equal case; as_dict is plain JSON."""
     path = case.save(tmp_path / "case.toml")
@@ -166,20 +168,39 @@ BAD_FILES = {
     "missing [plate]": (lambda t: _drop_table(t, "plate"), ["[plate]"]),
     "missing plate.E": (lambda t: _replace_line(t, "plate", "E", None), ["'plate.E'"]),
     "missing geometry.h": (lambda t: _replace_line(t, "geometry", "h", None), ["'geometry.h'", "> 0"]),
+    # physical ranges (issue 24): the input is named, never a derived quantity ("Kb = inf", "M1 = 0.0")
+    "E huge": (lambda t: _replace_line(t, "plate", "E", "E = 1e308"), ["plate.E = 1e+308", "1000 <= plate.E <= 1e+13"]),
+    "E tiny": (lambda t: _replace_line(t, "plate", "E", "E = 1e-308"), ["plate.E = 1e-308", "(Pa)"]),
+    "rho tiny": (lambda t: _replace_line(t, "plate", "rho", "rho = 1e-300"), ["plate.rho = 1e-300", "kg/m^3"]),
+    "R1 huge": (lambda t: _replace_line(t, "geometry", "R1", "R1 = 1e308"), ["geometry.R1 = 1e+308", "<= 1000 (m)"]),
+    "v huge": (lambda t: _replace_line(t, "impact", "v", "v = 1e300"), ["impact.v = 1e+300", "<= 10000 (m/s)"]),
+    "kappa huge": (lambda t: t + "kappa = 1e30\n", ["impact.kappa = 1e+30", "<= 1e+18"]),
+    # values the case's law never reads (issue 24): refused, not silently ignored
+    "abrate with kappa": (lambda t: t + 'law = "abrate"\nkappa = 1e9\n', ["impact.kappa = 1000000000.0",
+                                                                        "not read by law 'abrate'", "undamped"]),
+    "flores with kappa": (lambda t: t + 'law = "flores"\nrestitution = 0.5\nkappa = 1e9\n',
+                          ["impact.kappa", "not read by law 'flores'", "restitution"]),
+    "paper with restitution": (lambda t: t + "restitution = 0.5\n", ["impact.restitution = 0.5",
+                                                                     "not read by law 'paper'", "gonthier"]),
+    "hunt-crossley with contact": (lambda t: t + 'law = "hunt-crossley"\ncontact = "unilateral"\n',
+                                   ["impact.contact = 'unilateral'", "not read by law 'hunt-crossley'"]),
+    "multiline description": (lambda t: re.sub(r"^description = .*$", 'description = """two\nlines"""', t,
+                                               flags=re.M),
+                              ["description = 'two\\nlines'", "one line"]),
     "missing impact.v": (lambda t: _replace_line(t, "impact", "v", None), ["'impact.v'"]),
     "nu = 0.7": (lambda t: _replace_line(t, "plate", "nu", "nu = 0.7"), ["plate.nu = 0.7", "0 <= nu < 0.5"]),
-    "E = -1": (lambda t: _replace_line(t, "projectile", "E", "E = -1"), ["projectile.E = -1", "> 0"]),
+    "E = -1": (lambda t: _replace_line(t, "projectile", "E", "E = -1"), ["projectile.E = -1", "<= projectile.E <="]),
     "E a string": (lambda t: _replace_line(t, "plate", "E", 'E = "2e11"'), ["plate.E = '2e11'", "wrong type"]),
     "E a boolean": (lambda t: _replace_line(t, "plate", "E", "E = true"), ["plate.E = True", "wrong type"]),
-    "R1 = 0": (lambda t: _replace_line(t, "geometry", "R1", "R1 = 0.0"), ["geometry.R1 = 0.0", "> 0"]),
+    "R1 = 0": (lambda t: _replace_line(t, "geometry", "R1", "R1 = 0.0"), ["geometry.R1 = 0.0", "1e-09 <= geometry.R1"]),
     "yield_strength = 0": (lambda t: t.replace("[plate]", "[plate]\nyield_strength = 0.0", 1),
-                           ["plate.yield_strength = 0.0", "> 0"]),
-    "v = nan": (lambda t: _replace_line(t, "impact", "v", "v = nan"), ["impact.v = nan", "> 0"]),
+                           ["plate.yield_strength = 0.0", "1000 <= plate.yield_strength"]),
+    "v = nan": (lambda t: _replace_line(t, "impact", "v", "v = nan"), ["impact.v = nan", "1e-06 <= impact.v"]),
     "target": (lambda t: t + 'target = "wall"\n', ["impact.target = 'wall'", "plate, rigid, free"]),
     "contact": (lambda t: t + 'contact = "both"\n', ["impact.contact = 'both'", "printed, unilateral"]),
     "law": (lambda t: t + 'law = "newton"\n', ["impact.law = 'newton'", "paper"]),
-    "restitution": (lambda t: t + "restitution = 1.5\n", ["impact.restitution = 1.5", "0 < e <= 1"]),
-    "kappa < 0": (lambda t: t + "kappa = -1.0\n", ["impact.kappa = -1.0", ">= 0"]),
+    "restitution": (lambda t: t + "restitution = 1.5\n", ["impact.restitution = 1.5", "<= impact.restitution <= 1"]),
+    "kappa < 0": (lambda t: t + "kappa = -1.0\n", ["impact.kappa = -1.0", "0 <= impact.kappa"]),
     "name not a string": (lambda t: t.replace('name = "seed"', "name = 3"), ["name = 3", "wrong type"]),
     "table not a table": (lambda t: "geometry = 1.0\n" + _drop_table(t, "geometry"), ["geometry = 1.0"]),
     "syntax error": (lambda t: t.replace("E = 2.1e11", "E = 2.1e11 Pa", 1), ["TOML syntax error", "line"]),
@@ -210,11 +231,22 @@ def test_unknown_name_and_missing_file():
 # --set NAME=VALUE
 # ---------------------------------------------------------------------------------------------
 
-def test_settable_names_are_the_issue_s_list_with_units():
-    """Issue 12 §1 (+ plate.yield_strength and v): every name with an SI unit for --help."""
-    assert list(SETTABLE) == ["projectile.E", "projectile.nu", "projectile.rho", "plate.E", "plate.nu", "plate.rho",
-                              "plate.yield_strength", "a", "h", "R1", "R2", "v"]
+def test_settable_names_are_every_key_of_the_case_schema():
+    """Issue 24: --set takes every key of the schema but the text ones (name, description, source)."""
+    schema = [f"{body}.{key}" for body in ("projectile", "plate") for key in ("E", "nu", "rho", "yield_strength")]
+    schema += ["a", "h", "R1", "R2", "v", "kappa", "restitution", "target", "law", "contact"]
+    assert sorted(SETTABLE) == sorted(schema)
     assert SETTABLE["plate.E"][0] == "Pa" and SETTABLE["R1"][0] == "m" and SETTABLE["v"][0] == "m/s"
+
+
+def test_impact_settings_and_the_schema_s_own_spellings():
+    case = seed_case().with_settings(["impact.law=flores", "restitution=0.5", "geometry.R1=0.01",
+                                      "projectile.yield_strength=1e9", "impact.target=rigid"])
+    assert (case.impact["law"], case.impact["restitution"], case.impact["target"]) == ("flores", 0.5, "rigid")
+    assert case.geometry.R1 == 0.01 and case.projectile.yield_strength == 1e9
+    assert parse_setting("impact.kappa=1e9") == ("kappa", 1e9)
+    with pytest.raises(ValueError, match="impact.target = 'wall'"):
+        seed_case().with_settings(["target=wall"])
 
 
 def test_settings_apply_and_leave_the_rest():
@@ -232,14 +264,18 @@ def test_settings_apply_and_leave_the_rest():
 
 @pytest.mark.parametrize(("setting", "expected"), [
     ("plate.G=1e9", ["unknown setting 'plate.G'", "projectile.E (Pa)", "R2 (m)"]),
-    ("kappa=1e9", ["unknown setting 'kappa'"]),
+    ("impact.damping=1e9", ["unknown setting 'impact.damping'"]),
     ("R1=abc", ["R1 = 'abc' is not a number", "m"]),
     ("plate.E", ["NAME=VALUE", "plate.nu"]),
     ("plate.nu=0.7", ["plate.nu = 0.7", "0 <= nu < 0.5"]),
-    ("plate.E=-1", ["plate.E = -1.0", "> 0"]),
-    ("h=0", ["h = 0.0", "> 0"]),
-    ("v=inf", ["v = inf", "> 0"]),
-    ("plate.yield_strength=0", ["plate.yield_strength = 0.0", "> 0"]),
+    ("plate.E=-1", ["plate.E = -1.0", "1000 <= plate.E"]),
+    ("h=0", ["h = 0.0", "1e-09 <= h"]),
+    ("v=inf", ["v = inf", "1e-06 <= v <= 10000"]),
+    ("plate.yield_strength=0", ["plate.yield_strength = 0.0", "1000 <= plate.yield_strength"]),
+    ("R1=1e308", ["R1 = 1e+308", "R1 <= 1000 (m)"]),
+    ("a=1e-308", ["a = 1e-308", "1e-09 <= a"]),
+    ("projectile.rho=1e-300", ["projectile.rho = 1e-300", "0.1 <= projectile.rho"]),
+    ("plate.E=1e308", ["plate.E = 1e+308", "plate.E <= 1e+13"]),
 ])
 def test_bad_settings_raise_naming_the_setting(setting, expected):
     with pytest.raises(ValueError) as info:

@@ -9,9 +9,7 @@ runs on either side, continuation against independent searches, and atlas points
 
 from __future__ import annotations
 
-import contextlib
 import importlib
-import io
 import json
 import math
 import shlex
@@ -20,13 +18,13 @@ from pathlib import Path
 import h5py
 import numpy as np
 import pytest
+from _cli import run
 
 import phaseimpact.analysis as analysis
 import phaseimpact.continuation as continuation
 import phaseimpact.integrate as integrate
 from phaseimpact import archive
 from phaseimpact.case import SETTABLE
-from phaseimpact.cli import main
 from phaseimpact.plotting import OUTCOME_COLOURS
 
 CASES_DIR = Path(__file__).resolve().parents[1] / "phaseimpact" / "cases"
@@ -34,15 +32,6 @@ SHIPPED = sorted(p.stem for p in CASES_DIR.glob("*.toml"))
 KAPPA_C_V1 = 1.4994e12  # REFERENCE §5 / README: kappa_c of the seed case at 1 m/s
 
 
-def run(argv):
-    """``main(argv)`` in-process: (exit code, stdout, stderr)."""
-    out, err = io.StringIO(), io.StringIO()
-    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
-        try:
-            code = main([str(a) for a in argv])
-        except SystemExit as exit_:
-            code = exit_.code if isinstance(exit_.code, int) else (0 if exit_.code is None else 2)
-    return code, out.getvalue(), err.getvalue()
 
 
 def _no_constant(name):
@@ -351,8 +340,8 @@ def test_atlas_ctrl_c_prints_the_resume_command_that_completes_it(tmp_path, monk
     monkeypatch.setattr(archive.Checkpoint, "__call__", save_then_interrupt)
     path = tmp_path / "a.h5"
     code, _, err = run([*ATLAS, "--out", path])
-    assert code == 130 and "4 of 9 points are saved" in err
-    words = shlex.split(err.strip().splitlines()[-1].strip())
+    assert code == 130 and "4 of 9 points are saved" in err and len(err.strip().splitlines()) == 1
+    words = shlex.split(err.strip().split("resume with: ", 1)[1])
     assert words[0] == "phaseimpact" and words[-1] == "--resume"
     monkeypatch.setattr(archive.Checkpoint, "__call__", save)
     assert run(words[1:])[0] == 0

@@ -6,10 +6,13 @@ import contextlib
 import io
 import json
 import os
+import re
+import shlex
 import subprocess
 import sys
 import tempfile
 import time
+from pathlib import Path
 
 import pytest
 from hypothesis import HealthCheck, given, settings
@@ -107,6 +110,33 @@ BAD = [
     (["sweep", "--kappa-min", "0", "--kappa-max", "1e9", "--out", "a.h5"], "kappa-min"),
     (["critical-curve", "--v-min", "5", "--v-max", "1", "--out", "a.h5"], "v-min"),
     (["critical-curve", "--v-min", "0", "--v-max", "1", "--out", "a.h5"], "v-min"),
+    # issue 24: negative numbers are values (argparse read "-inf" as an option), and their range is named
+    (["simulate", "--v", "-inf"], "v = '-inf'"),
+    (["simulate", "--kappa", "-1e-300"], "kappa = '-1e-300'"),
+    (["simulate", "--t-end", "-1e-300"], "t-end = '-1e-300'"),
+    # issue 24: the input is named, not a derived quantity ("Kb = inf", "M1 = 0.0"), and no traceback
+    (["simulate", "--t-end", "1e-308"], "t-end = 1e-308"),
+    (["simulate", "--set", "R1=1e308"], "R1 = 1e+308"),
+    (["simulate", "--set", "R1=1e-308"], "R1 = 1e-308"),
+    (["simulate", "--set", "h=1e308"], "h = 1e+308"),
+    (["simulate", "--set", "a=1e-308"], "a = 1e-308"),
+    (["simulate", "--set", "projectile.rho=1e-300", "--set", "plate.rho=1e-300"], "projectile.rho = 1e-300"),
+    (["simulate", "--set", "projectile.rho=1e308"], "projectile.rho = 1e+308"),
+    (["simulate", "--set", "plate.E=1e308"], "plate.E = 1e+308"),
+    (["params", "--set", "plate.E=1e-308"], "plate.E = 1e-308"),
+    # issue 24: a restitution the law cannot deliver, values given twice or to a law that ignores them
+    (["simulate", "--law", "lankarani-nikravesh", "--restitution", "1e-6"], "restitution = 1e-06"),
+    (["simulate", "--set", "kappa=1e9", "--kappa", "1e9"], "kappa is given twice"),
+    (["simulate", "--law", "abrate", "--set", "kappa=1e9"], "kappa = 1000000000.0"),
+    (["simulate", "--set", "restitution=0.5"], "restitution = 0.5"),
+    # issue 24: a default end named as the default; a kappa span too wide for its samples
+    (["critical", "--kappa-max", "1e-3"], "default kappa-min"),
+    (["transitions", "--law", "hunt-crossley", "--kappa-min", "1e-300", "--kappa-max", "1e18"], "kappa-min = 1e-300"),
+    (["transitions", "--law", "hunt-crossley", "--kappa-min", "1e-300", "--kappa-max", "1e13"], "samples >= 1252"),
+    # issue 24: atlas axes the dynamics never read, or with one value twice
+    (["atlas", "--axis", "plate.yield_strength=1e7:1e9:3", "--axis", "v=1,2", "--out", "a.h5"],
+     "plate.yield_strength"),
+    (["atlas", "--axis", "kappa=1e9,1e9", "--axis", "v=1,2", "--out", "a.h5"], "distinct values"),
 ]
 
 
@@ -310,3 +340,100 @@ def test_a_failed_trajectory_is_reported_with_exit_1(monkeypatch):
     assert json.loads(out)["status"] == "step-size-collapse"  # the result is still printed
     assert "numerical failure: step-size-collapse" in err and "Traceback" not in err
     assert "the step size collapsed" in err  # the message follows the status
+
+
+# ------------------------------------------------------------------------------------------------
+# Issue 24: case files, the environment, plausibility, numerical failures of a transition search
+# ------------------------------------------------------------------------------------------------
+
+SEED_TOML = (Path(__file__).resolve().parents[1] / "phaseimpact" / "cases" / "seed.toml").read_text(encoding="utf-8")
+
+
+@pytest.mark.parametrize(("extra", "command", "name"), [
+    ('law = "abrate"\nkappa = 1e9\n', "simulate", "impact.kappa = 1000000000.0"),
+    ('law = "abrate"\nkappa = 1e9\n', "params", "impact.kappa = 1000000000.0"),
+    ("restitution = 0.5\n", "simulate", "impact.restitution = 0.5"),
+    ("restitution = 0.5\n", "params", "impact.restitution = 0.5"),
+])
+def test_case_file_values_its_law_ignores_are_refused(extra, command, name, tmp_path, no_work):
+    path = tmp_path / "c.toml"
+    path.write_text(SEED_TOML + extra, encoding="utf-8")
+    code, _, err = run([command, "--case", str(path)])
+    assert code == 2 and name in err and "not read by law" in err and len(err.strip().splitlines()) == 1
+
+
+def test_multiline_description_of_a_case_file_is_refused(tmp_path, no_work):
+    path = tmp_path / "c.toml"
+    path.write_text(re.sub(r"^description = .*$", 'description = """two\nlines"""', SEED_TOML, flags=re.M),
+                    encoding="utf-8")
+    code, _, err = run(["params", "--case", str(path)])
+    assert code == 2 and "description" in err and "one line" in err
+
+
+def test_a_law_chosen_by_option_drops_the_case_s_kappa_it_does_not_read(tmp_path):
+    path = tmp_path / "c.toml"
+    path.write_text(SEED_TOML + "kappa = 1e9\n", encoding="utf-8")
+    code, out, _ = run(["simulate", "--case", str(path), "--law", "abrate", "--t-end", "1e-4", "--json"])
+    assert code == 0
+    result = json.loads(out)
+    assert result["case"]["impact"]["kappa"] == 0.0 and result["case"]["impact"]["law"] == "abrate"
+
+
+@pytest.mark.parametrize(("setting", "verdict"), [
+    ("R1=0.5", "projectile radius R1 = 0.5 m exceeds the plate radius a = 0.1 m"),
+    ("h=1", "plate thickness h = 1 m is 10 a"),
+])
+def test_implausible_geometry_gets_a_validity_verdict(setting, verdict):
+    code, out, _ = run(["params", "--set", setting, "--json"])
+    assert code == 0 and verdict in json.loads(out)["validity"]
+    code, out, _ = run(["simulate", "--set", setting, "--t-end", "1e-4", "--json"])
+    assert code == 0 and verdict in json.loads(out)["validity"]
+
+
+def test_thickness_is_not_judged_without_the_plate_s_springs():
+    code, out, _ = run(["params", "--set", "h=1", "--target", "rigid", "--json"])
+    assert code == 0 and json.loads(out)["validity"] == "ok"
+
+
+@pytest.mark.parametrize("epoch", ["abc", "1e20", "99999999999999999"])
+def test_bad_source_date_epoch_refused_before_numpy_reads_it(epoch, tmp_path):
+    """NumPy's f2py crashed at import on these, before the project's own check could run."""
+    result = subprocess.run([*CLI, *SWEEP, "--out", "s.h5"], capture_output=True, text=True, cwd=tmp_path,
+                            timeout=120, env={**os.environ, "SOURCE_DATE_EPOCH": epoch})
+    assert result.returncode == 2 and "Traceback" not in result.stderr
+    assert result.stderr.strip().splitlines() == [
+        f"phaseimpact: error: SOURCE_DATE_EPOCH = {epoch!r} is out of range; allowed: an integer number of seconds "
+        "since 1970-01-01 UTC, 0 <= SOURCE_DATE_EPOCH <= 253402300799 (the year 9999), as 'date +%s' prints it, "
+        "or unset"]
+    assert not (tmp_path / "s.h5").exists()
+
+
+def test_bad_compile_processes_refused(monkeypatch, no_work):
+    monkeypatch.setenv("PHASEIMPACT_COMPILE_PROCESSES", "abc")
+    code, _, err = run(["simulate"])
+    assert code == 2 and "PHASEIMPACT_COMPILE_PROCESSES = 'abc'" in err
+
+
+def test_closed_stdout_is_an_error(tmp_path):
+    result = subprocess.run(["sh", "-c", f"exec {shlex.join(CLI)} cases >&-"], capture_output=False, cwd=tmp_path,
+                            stderr=subprocess.PIPE, text=True, timeout=120)
+    assert result.returncode == 2 and "stdout is closed" in result.stderr
+
+
+def test_a_failed_transition_search_exits_1_naming_kappa(monkeypatch):
+    from phaseimpact.continuation.transition import RunFailed
+
+    def failing(*args, **kwargs):
+        raise RunFailed("kappa = 1.5e+15: step-size-collapse: the step size collapsed")
+
+    monkeypatch.setattr(continuation, "transitions", failing)
+    code, _, err = run(["transitions", "--law", "hunt-crossley", "--kappa-min", "1e9", "--kappa-max", "1e10"])
+    assert code == 1 and "transition search failed: kappa = 1.5e+15" in err and "Traceback" not in err
+
+
+def test_coarse_transition_sampling_is_warned_about():
+    code, out, err = run(["transitions", "--law", "hunt-crossley", "--kappa-min", "1e9", "--kappa-max", "1e10",
+                          "--samples", "8", "--json"])
+    assert code == 0 and "phaseimpact: warning: 8 samples" in err and "per decade" in err
+    assert any("per decade" in w for w in json.loads(out)["warnings"])
+

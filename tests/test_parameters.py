@@ -79,13 +79,18 @@ NONNEGATIVE_BAD = (-1.0, -1e-300, NAN, INF, -INF)
 
 def _bad_cases():
     cases = []  # (class, valid base fields, field, bad value, allowed range as printed)
-    for name in ("E", "rho"):
-        cases += [(Material, MATERIAL, name, bad, "> 0") for bad in POSITIVE_BAD]
+    # physical ranges: beyond them a derived quantity over- or underflows (issue 24)
+    for name, allowed, beyond in (("E", "1000 <= E <= 1e+13 (Pa)", (1e-308, 1e308, 999.0, 1.1e13)),
+                                  ("rho", "0.1 <= rho <= 100000 (kg/m^3)", (1e-300, 1e308, 0.09))):
+        cases += [(Material, MATERIAL, name, bad, allowed) for bad in POSITIVE_BAD + beyond]
     cases += [(Material, MATERIAL, "nu", bad, "0 <= nu < 0.5") for bad in (-0.1, 0.5, 0.7, NAN, INF)]
     for name in GEOMETRY:
-        cases += [(Geometry, GEOMETRY, name, bad, "> 0") for bad in POSITIVE_BAD]
-    for name in ("M1", "M2", "K", "alpha", "v"):
+        high = "1e+12" if name == "R2" else "1000"
+        cases += [(Geometry, GEOMETRY, name, bad, f"1e-09 <= {name} <= {high} (m)")
+                  for bad in POSITIVE_BAD + (1e-308, 1e308)]
+    for name in ("M1", "M2", "K", "alpha"):
         cases += [(Parameters, PARAMETERS, name, bad, "> 0") for bad in POSITIVE_BAD]
+    cases += [(Parameters, PARAMETERS, "v", bad, "1e-06 <= v <= 10000 (m/s)") for bad in POSITIVE_BAD + (1e300, 1e-7)]
     for name in ("Kb", "Km", "kappa"):
         cases += [(Parameters, PARAMETERS, name, bad, ">= 0") for bad in NONNEGATIVE_BAD]
     cases += [(Parameters, PARAMETERS, "target", bad, "plate, rigid, free")
@@ -315,8 +320,8 @@ def test_bools_strings_and_none_are_not_numbers(cls, base, name, bad):
 def test_yield_strength_is_optional_and_positive():
     assert STEEL.yield_strength is None
     assert Material(**MATERIAL, yield_strength=2.5e8).yield_strength == 2.5e8
-    for bad in (0.0, -1.0, NAN, INF, True):
-        with pytest.raises(ValueError, match="yield_strength =.*> 0"):
+    for bad in (0.0, -1.0, NAN, INF, True, 1e308):
+        with pytest.raises(ValueError, match=r"yield_strength =.*1000 <= yield_strength <= 1e\+12"):
             Material(**MATERIAL, yield_strength=bad)
 
 

@@ -1,18 +1,27 @@
 """The two-process first compile (phaseimpact/integrate/precompile.py): from an empty numba cache,
 every kernel is compiled once, this process compiles none of the helper's, and the compiled engine
-gives bit for bit the results of the project's cache."""
+gives bit for bit the results of the project's cache.
+
+A cold session costs a whole first compile (20-50 s on two cores). What it checks depends only on
+the engine's sources (the digest that also names the cache, phaseimpact/_jit.py), this file's
+session and the versions of Python, numba and llvmlite: its output is kept in pytest's cache under
+that key, and a test run on unchanged sources reuses it (``PHASEIMPACT_COLD_TESTS=1`` runs it
+anyway; ``pytest --cache-clear`` forgets it).
+"""
 
 from __future__ import annotations
 
+import hashlib
 import json
 import os
+import platform
 import subprocess
 import sys
 
 import numpy as np
 import pytest
 
-from phaseimpact import seed_parameters, simulate, simulate_many
+from phaseimpact import _jit, seed_parameters, simulate, simulate_many
 from phaseimpact.integrate import precompile
 
 # Runs one cold session: records every phaseimpact function numba compiles in this process, then
@@ -39,15 +48,32 @@ print(json.dumps({"compiled": compiled,
                   "max_force": [float(x) for x in cols.max_force], "t_run": [float(x) for x in cols.t_run]}))
 """
 
+def _session_key() -> str:
+    import llvmlite
+    import numba
+
+    parts = (_jit.engine_digest(), COLD_SESSION, sys.version, numba.__version__, llvmlite.__version__,
+             platform.machine(), platform.processor())
+    return hashlib.sha256(repr(parts).encode()).hexdigest()[:24]
+
+
 @pytest.fixture(scope="module")
-def cold_session(tmp_path_factory):
+def cold_session(tmp_path_factory, request):
+    key = f"phaseimpact/cold-session/{_session_key()}"
+    kept = request.config.cache.get(key, None)
+    if kept is not None and not os.environ.get("PHASEIMPACT_COLD_TESTS"):
+        return kept
     env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path_factory.mktemp("numba-cache")),
                PHASEIMPACT_COMPILE_PROCESSES="2")
     env.pop("NUMBA_DISABLE_JIT", None)
     out = subprocess.run([sys.executable, "-c", COLD_SESSION], env=env, capture_output=True, text=True, timeout=900)
     assert out.returncode == 0, out.stderr[-3000:]
     assert "RuntimeWarning" not in out.stderr, out.stderr[-3000:]  # the helper started and succeeded
-    return json.loads(out.stdout.strip().splitlines()[-1])
+    assert "compiling the engine once for this machine" in out.stderr  # the cold cache said so, once
+    assert out.stderr.count("phaseimpact: compiling") == 1, out.stderr[-3000:]
+    session = json.loads(out.stdout.strip().splitlines()[-1])
+    request.config.cache.set(key, session)
+    return session
 
 
 def test_cold_compile_compiles_every_kernel_once_and_none_of_the_helpers(cold_session):

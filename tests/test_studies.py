@@ -6,8 +6,10 @@ folder global that ``--quick`` can redirect to ``figures/preview/``.
 """
 
 import ast
+import importlib.util
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 STUDIES = Path(__file__).resolve().parents[1] / "studies"
@@ -46,3 +48,50 @@ def test_no_pitchfork_and_no_general_runaway_claim():
         text = path.read_text(encoding="utf-8").lower()
         assert "pitchfork" not in text, path.name
         assert "runaway above kappa_c" not in text and "runaway above κc" not in text, path.name
+
+
+def _study_helpers():
+    spec = importlib.util.spec_from_file_location("studies_plots", STUDIES / "_plots.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_fitted_values_are_kept_to_the_digits_they_are_known():
+    plots = _study_helpers()
+    assert plots.known(1.4836952594860489) == 1.483695259 and plots.known(-0.0) == 0.0
+    assert plots.known(plots.known(2 / 3)) == plots.known(2 / 3) and np.isnan(plots.known(np.nan))
+    x = np.geomspace(1e-6, 1e-3, 9)
+    slope, intercept = plots.loglog_fit(x, 3.0 * x ** -1.75)
+    assert abs(slope + 1.75) < 1e-9 and abs(intercept - np.log(3.0)) < 1e-8
+    assert slope == plots.known(slope) and intercept == plots.known(intercept)
+
+
+def test_staircase_fits_regenerate_from_the_archived_data_and_ignore_last_bit_differences():
+    """make reproduce on another machine of the kind changed three fitted exponents of staircase.h5 in
+    their 16th digit (the data were identical): the fits are stored to the digits they are known, so
+    they follow from the archived data whatever the last bits of the inputs."""
+    h5py = pytest.importorskip("h5py")
+    plots = _study_helpers()
+    with h5py.File(STUDIES.parent / "figures" / "data" / "staircase.h5", "r") as f:
+        attrs = dict(f.attrs)
+        eps, t_run = f["eps"][()], f["t_run"][()]
+        usable = ~f["cut"][()].astype(bool) & ~f["engine_missed_restick"][()].astype(bool) & np.isfinite(t_run)
+        local = {name: (f["exponents/eps"][()], f[f"exponents/{name}"][()])
+                 for name in ("slip_speed", "stick_offset", "slip_duration")}
+    fit = usable & (eps <= attrs["t_run_fit_max_eps"])
+
+    def fits(nudge):
+        out = {"t_run_exponent": plots.loglog_fit(nudge(eps[fit]), nudge(t_run[fit]))[0],
+               "t_run_exponent_below_2e-5": plots.loglog_fit(nudge(eps[fit & (eps <= 2e-5)]),
+                                                             nudge(t_run[fit & (eps <= 2e-5)]))[0]}
+        for name, (x, y) in local.items():  # the local slopes: the three smallest offsets
+            out[f"{name}_exponent"] = plots.loglog_fit(nudge(x[:3]), nudge(y[:3]))[0]
+        return out
+
+    regenerated = fits(lambda a: a)
+    last_bit = fits(lambda a: np.nextafter(a, np.inf))  # every input one ulp up: what another CPU may give
+    for name, value in regenerated.items():
+        assert value == plots.known(attrs[name]), name  # the fit of the archived data
+        assert last_bit[name] == value, name
+        assert attrs[name] == plots.known(attrs[name]), f"{name} = {attrs[name]!r}: stored beyond its digits"

@@ -18,7 +18,6 @@ from phaseimpact.continuation import (
     grazing_transitions,
     locate_kappa_2,
     refine_boundaries,
-    stick_count,
     transitions,
 )
 from phaseimpact.continuation.transition import contact_count
@@ -98,17 +97,17 @@ def test_kappa_c_of_named_cases_without_failure():
 def test_kappa_2_is_where_exactly_two_stick_phases_start(critical):
     k2 = critical.kappa_2
     assert k2 > critical.kappa_c
-    assert stick_count(SEED.replace(kappa=k2 * (1 + 1e-7)), "paper")[0] == 2
-    assert stick_count(SEED.replace(kappa=k2 * (1 - 1e-7)), "paper")[0] > 2
+    assert simulate(SEED.replace(kappa=k2 * (1 + 1e-7)), "paper").n_stick == 2
+    assert simulate(SEED.replace(kappa=k2 * (1 - 1e-7)), "paper").n_stick > 2
     for factor in (1.01, 1.1, 1.3):
-        assert stick_count(SEED.replace(kappa=k2 * factor), "paper")[0] == 2
-    counts = [row["n_stick"] for row in critical.n_staircase if not row["cut"]]
+        assert simulate(SEED.replace(kappa=k2 * factor), "paper").n_stick == 2
+    counts = [row["n_stick"] for row in critical.n_staircase if not row["cut"] and row["n_stick"] is not None]
     assert counts == sorted(counts, reverse=True)  # a staircase down to 2
     assert counts[-1] == 2 and counts[0] > 100
 
 
 def test_kappa_2_from_an_independent_bisection(critical):
-    again, _, _ = locate_kappa_2(SEED, "paper", critical.kappa_c * (1 + 1e-12), samples=0)
+    again = locate_kappa_2(SEED, "paper", critical.kappa_c * (1 + 1e-12), samples=0).kappa_2
     assert again == pytest.approx(critical.kappa_2, rel=1e-7)
 
 

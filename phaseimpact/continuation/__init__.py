@@ -4,6 +4,7 @@ two-parameter continuation (:mod:`.curve`). Only :mod:`._parallel` knows about j
 
 from ._parallel import BACKENDS
 from .boundary import Boundaries, refine_boundaries
+from .confirm import ConfirmedCount, confirmed_count, stick_sequence_violation
 from .curve import CURVE_QUANTITIES, CriticalCurve, critical_curve
 from .grid import Axis, Grid, parse_axis
 from .sweep import SweepResult, atlas, sweep
@@ -17,7 +18,6 @@ from .transition import (
     first_stick_margin,
     grazing_transitions,
     locate_kappa_2,
-    stick_count,
     transitions,
 )
 
@@ -26,5 +26,5 @@ __all__ = [
     "Grid", "SweepResult",
     "Transition", "adding_sliding_exponents", "atlas", "closed_form_kappa_c", "critical_curve",
     "critical_damping", "first_stick_margin", "delta_extremum", "grazing_transitions", "locate_kappa_2",
-    "parse_axis", "stick_count", "sweep", "transitions",
+    "parse_axis", "sweep", "transitions", "ConfirmedCount", "confirmed_count", "stick_sequence_violation",
 ]

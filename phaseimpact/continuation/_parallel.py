@@ -54,8 +54,11 @@ def check_scheduler(address: str) -> None:
     try:
         answer = asyncio.run(identity())
     except Exception as error:  # any failure to talk to it means: not a usable scheduler
-        reason = str(error) or f"no answer within {CONNECT_TIMEOUT:g} s"
-        raise ValueError(f"scheduler = {address!r} is out of reach ({type(error).__name__}: {reason}); "
+        # a timeout, or a MemoryError from a garbled reply ("Unable to allocate 3.07 EiB"), says nothing
+        # more to the user than that no scheduler answered
+        silent = isinstance(error, TimeoutError | asyncio.TimeoutError | MemoryError) or not str(error)
+        reason = f"no answer within {CONNECT_TIMEOUT:g} s" if silent else f"{type(error).__name__}: {error}"
+        raise ValueError(f"scheduler = {address!r} is out of reach ({reason}); "
                          "allowed: the address of a running Dask scheduler, e.g. tcp://host:8786") from None
     if not (isinstance(answer, dict) and answer.get("type") == "Scheduler"):
         raise ValueError(f"scheduler = {address!r} is out of range: it answers, but is not a Dask scheduler")

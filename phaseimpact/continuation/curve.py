@@ -176,8 +176,14 @@ def critical_curve(base: Parameters | Case, law: ContactLaw | str, param: str, v
     bar.close()
     walk_k = np.asarray(walk_k, dtype=float)
     if what == "kappa_2":
-        walk_k = np.array([locate_kappa_2(_parameters(base, param, x), law, kc, integrator_rtol=integrator_rtol,
-                                          samples=0)[0] or math.nan for x, kc in zip(walk_x, walk_k, strict=True)])
+        found = [locate_kappa_2(_parameters(base, param, x), law, kc, integrator_rtol=integrator_rtol, samples=0)
+                 for x, kc in zip(walk_x, walk_k, strict=True)]
+        # an unconfirmed kappa_2 (its bracket's counts move at a tighter tolerance) is left out, never guessed
+        walk_k = np.array([f.kappa_2 if f.kappa_2 is not None and not f.reason else math.nan for f in found])
+        unconfirmed = [f"{param} = {x:g} ({f.reason})" for x, f in zip(walk_x, found, strict=True) if f.reason]
+        if unconfirmed:
+            note = f"kappa_2 unconfirmed (left NaN) at {', '.join(unconfirmed)}"
+            message = f"{message}; {note}" if message else note
     walk_x = np.asarray(walk_x)
     closed = np.array([(closed_form_kappa_c(_parameters(base, param, x)) or math.nan) if what != "grazing"
                        else math.nan for x in walk_x])

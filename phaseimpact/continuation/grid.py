@@ -14,11 +14,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..case import SETTABLE, Case
+from ..case import QUANTITIES, SETTABLE, Case
 from ..integrate.api import Batch, check_rtol, hertz_contact_time, pack_batch, scales, state_tolerances
 from ..model.laws import ContactLaw
 from ..model.rhs import ALPHA_, DAMP_, K_, M1_, pack
-from ..parameters import PARAMETER_NAMES, Parameters
+from ..parameters import KAPPA_MAX, PARAMETER_NAMES, V_RANGE, Parameters, is_number
 
 __all__ = ["Axis", "Grid", "parse_axis", "MAX_POINTS"]
 
@@ -37,6 +37,13 @@ class Axis:
 
     @classmethod
     def make(cls, name: str, values, log: bool | None = None) -> Axis:
+        if not isinstance(name, str):
+            raise TypeError(f"axis name = {name!r} has the wrong type ({type(name).__name__}); allowed: a string")
+        numeric = (values.dtype.kind in "iuf" if isinstance(values, np.ndarray)
+                   else isinstance(values, list | tuple | range) and all(map(is_number, values)))
+        if not numeric:  # strings are not read as numbers, a generator is not a sequence
+            raise TypeError(f"axis {name} = {values!r} has the wrong type ({type(values).__name__}); allowed: a 1-d "
+                            "sequence or array of numbers")
         values = np.asarray(values, dtype=float)
         if values.ndim != 1 or values.size == 0 or not np.all(np.isfinite(values)):
             raise ValueError(f"axis {name} = {values!r} is out of range; allowed: a non-empty 1-d array of "
@@ -49,6 +56,9 @@ class Axis:
 
 def parse_axis(text: str) -> Axis:
     """``NAME=START:STOP:NUM[:log]`` (or ``NAME=V1,V2,...``) as an :class:`Axis`."""
+    if not isinstance(text, str):
+        raise TypeError(f"axis = {text!r} has the wrong type ({type(text).__name__}); allowed: a string "
+                        "NAME=START:STOP:NUM[:log] or NAME=V1,V2,...")
     match = re.fullmatch(r"\s*([A-Za-z_][\w.]*)\s*=\s*(.+)", text)
     if not match:
         raise ValueError(f"axis = {text!r} is out of range; allowed: NAME=START:STOP:NUM[:log] or NAME=V1,V2,...")
@@ -74,6 +84,14 @@ def parse_axis(text: str) -> Axis:
     return Axis(name, values, log)
 
 
+def _check_span(name: str, values: np.ndarray, low: float, high: float, unit: str) -> None:
+    """Every value of an axis the batch packs as an array (not through Parameters) within its range."""
+    bad = values[(values < low) | (values > high)]
+    if bad.size:
+        raise ValueError(f"axis {name} holds {name} = {float(bad[0])!r}, out of range; allowed: {low:g} <= {name} <= "
+                         f"{high:g} ({unit})")
+
+
 @dataclass(frozen=True)
 class Grid:
     """A grid of named axes over a base case (Parameters or Case), for one law.
@@ -86,29 +104,56 @@ class Grid:
     axes: tuple
 
     def __post_init__(self):
+        if not isinstance(self.base, Parameters | Case):
+            raise TypeError(f"base = {self.base!r} has the wrong type ({type(self.base).__name__}); allowed: "
+                            "Parameters or a Case")
         if not self.axes:
             raise ValueError("axes: allowed: at least one axis")
+        for axis in self.axes:
+            if not isinstance(axis, Axis):
+                raise TypeError(f"axis = {axis!r} has the wrong type ({type(axis).__name__}); allowed: an Axis "
+                                "(Axis.make(name, values) or parse_axis('NAME=START:STOP:NUM')), or give the axes as "
+                                "a dict name -> values")
         names = [a.name for a in self.axes]
         if len(set(names)) != len(names):
             raise ValueError(f"axes = {names!r} is out of range; allowed: distinct names")
         allowed = self.allowed_names()
         for axis in self.axes:
             if axis.name not in allowed:
+                if axis.name in SETTABLE and axis.name not in QUANTITIES:
+                    raise ValueError(f"axis {axis.name!r} is not read by the equations of motion (it sets the "
+                                     "validity check or the law, not the dynamics): every point would be the same; "
+                                     f"allowed: {', '.join(allowed)}")
+                if axis.name in QUANTITIES:
+                    raise ValueError(f"axis {axis.name!r} needs a Case base (materials and geometry, e.g. "
+                                     "phaseimpact.case.seed_case() or load_case(NAME)), not Parameters; allowed on "
+                                     f"Parameters: {', '.join(allowed)}")
                 raise ValueError(f"axis {axis.name!r} is out of range; allowed: {', '.join(allowed)}")
+            if np.unique(axis.values).size != axis.values.size:
+                raise ValueError(f"axis {axis.name} = {axis.values!r} is out of range; allowed: distinct values "
+                                 "(a repeated value computes the same points twice)")
+            if axis.name == "kappa":
+                _check_span("kappa", axis.values, 0.0, KAPPA_MAX, "N s/m^(1+alpha)")
+            elif axis.name == "v":
+                _check_span("v", axis.values, *V_RANGE, "m/s")
             if not self.law.reads(axis.name):
                 source = self.law.damping_source or "no damping"
                 raise ValueError(f"axis {axis.name!r} is not read by law {self.law.label()!r} (its damping "
                                  f"comes from {source}): every point would be the same")
         if self.size > MAX_POINTS:
             raise ValueError(f"grid of {self.size} points is out of range; allowed: at most {MAX_POINTS}")
-        # every corner must be a valid case (checked before any work)
+        # every corner must be a valid case, and each axis's smallest and largest value (a range of the
+        # inputs is an interval: both ends valid, all between valid), checked before any work
         for corner in np.ndindex(*(2,) * len(self.axes)):
             self.parameters_at({a.name: a.values[-1 if k else 0] for a, k in zip(self.axes, corner, strict=True)})
+        for axis in self.axes:
+            for value in (axis.values.min(), axis.values.max()):
+                self.parameters_at({axis.name: value})
 
     def allowed_names(self) -> tuple:
         names = ("kappa", "v", *[n for n in _NUMERIC_FIELDS if n not in ("kappa", "v")])
         if isinstance(self.base, Case):
-            names += tuple(n for n in SETTABLE if n not in names)
+            names += tuple(n for n in QUANTITIES if n not in names)
         return names
 
     @property

@@ -19,7 +19,7 @@ from tqdm.auto import tqdm
 from .. import __version__
 from ..case import Case
 from ..integrate import driver as drv
-from ..integrate.api import check_real, check_rtol
+from ..integrate.api import check_bool, check_rtol, check_t_end, scales
 from ..integrate.result import SUMMARY_COLUMNS, ColumnAccess
 from ..model.laws import ContactLaw, as_law
 from ..parameters import Parameters
@@ -180,17 +180,28 @@ def _append(array: np.ndarray, part: np.ndarray) -> np.ndarray:
     return buffer[:n + m]
 
 
-def _check_previous(previous: SweepResult, grid: Grid, t_end, rtol) -> None:
+def _axes_text(grid: Grid) -> str:
+    # repr digits: axes that differ in the 16th digit must not print alike
+    return ", ".join(f"{a.name} {len(a.values)} values {float(a.values[0])!r}..{float(a.values[-1])!r}"
+                     for a in grid.axes)
+
+
+def _check_previous(previous, grid: Grid, t_end, rtol) -> None:
+    if not isinstance(previous, SweepResult):
+        raise TypeError(f"previous = {previous!r} has the wrong type ({type(previous).__name__}); allowed: a "
+                        "SweepResult (an earlier result, or archive.load of its checkpoint) or None")
     same_axes = previous.grid.names == grid.names and all(
         np.array_equal(a.values, b.values) for a, b in zip(previous.grid.axes, grid.axes, strict=True))
     if not same_axes:
-        raise ValueError("resume: the archive's axes differ from the requested ones")
+        raise ValueError(f"resume: the archive's axes ({_axes_text(previous.grid)}) differ from the requested ones "
+                         f"({_axes_text(grid)})")
     if previous.grid.law != grid.law:
         raise ValueError(f"resume: the archive was computed with law {previous.grid.law.label()!r}, "
                          f"asked: {grid.law.label()!r}")
     if previous.t_end != t_end or previous.settings.get("rtol") != rtol:
         raise ValueError(f"resume: the archive was computed with t_end = {previous.t_end!r}, rtol = "
-                         f"{previous.settings.get('rtol')!r}; asked: t_end = {t_end!r}, rtol = {rtol!r}")
+                         f"{previous.settings.get('rtol')!r}; asked: t_end = {t_end!r}, rtol = {rtol!r} (t_end None: "
+                         "each run until its outcome settles)")
 
 
 def atlas(base: Parameters | Case, law: ContactLaw | str, axes, *, t_end: float | None = None, rtol: float = 1e-10,
@@ -222,11 +233,18 @@ def atlas(base: Parameters | Case, law: ContactLaw | str, axes, *, t_end: float 
     law = as_law(law)
     if isinstance(axes, dict):
         axes = [Axis.make(k, v) for k, v in axes.items()]
+    elif isinstance(axes, str) or not isinstance(axes, list | tuple):
+        raise TypeError(f"axes = {axes!r} has the wrong type ({type(axes).__name__}); allowed: a dict name -> values, "
+                        "or a list of Axis (parse_axis('kappa=1e9:1e12:50:log') makes one from text)")
     grid = Grid(base, law, tuple(axes))
     rtol = check_rtol(rtol)
     if t_end is not None:
-        t_end = check_real("t_end", t_end, "a finite number > 0", lambda x: x > 0)
+        t_end = check_t_end(t_end, scales(grid.base_parameters()).contact_time)
     jobs = check_jobs(n_jobs, backend, scheduler)
+    check_bool("progress", progress)
+    if on_chunk is not None and not callable(on_chunk):
+        raise TypeError(f"on_chunk = {on_chunk!r} has the wrong type ({type(on_chunk).__name__}); allowed: a "
+                        "function of the partial result, or None")
     if previous is not None:
         _check_previous(previous, grid, t_end, rtol)
         result = previous
@@ -254,8 +272,6 @@ def atlas(base: Parameters | Case, law: ContactLaw | str, axes, *, t_end: float 
 
 
 def sweep(params: Parameters | Case, law: ContactLaw | str, kappas, **options) -> SweepResult:
-    """:func:`atlas` over ``kappa`` alone (N s/m^(1+alpha)), e.g. ``np.geomspace(1e8, 1e13, 2000)``."""
-    kappas = np.asarray(kappas, dtype=float)
-    if kappas.ndim != 1 or kappas.size == 0 or not np.all(np.isfinite(kappas)) or np.any(kappas < 0):
-        raise ValueError("kappa values are out of range; allowed: a non-empty 1-d array of finite numbers >= 0")
+    """:func:`atlas` over ``kappa`` alone (N s/m^(1+alpha)), e.g. ``np.geomspace(1e8, 1e13, 2000)``:
+    distinct numbers in ``[0, KAPPA_MAX]``."""
     return atlas(params, law, [Axis.make("kappa", kappas)], **options)

@@ -15,6 +15,8 @@ root of that extremum (a smooth function of ``kappa``), not by counting.
 from __future__ import annotations
 
 import math
+import numbers
+import warnings
 from dataclasses import asdict, dataclass, field
 
 import numpy as np
@@ -22,12 +24,13 @@ import numpy as np
 from ..integrate import scales, simulate
 from ..integrate.events import EVENT_KINDS
 from ..model.laws import ContactLaw, as_law
-from ..parameters import Parameters
+from ..parameters import KAPPA_MAX, Parameters, is_number
+from .confirm import confirmed_count, stick_sequence_violation, tighter
 
 __all__ = [
-    "closed_form_kappa_c", "first_stick_margin", "critical_damping", "CriticalDamping", "locate_kappa_2",
-    "stick_count", "adding_sliding_exponents", "delta_extremum", "extrema", "grazing_transitions", "transitions",
-    "Transition", "check_kappa_range", "RunFailed",
+    "closed_form_kappa_c", "first_stick_margin", "critical_damping", "CriticalDamping", "Kappa2", "locate_kappa_2",
+    "adding_sliding_exponents", "delta_extremum", "extrema", "grazing_transitions", "transitions",
+    "Transition", "check_kappa_range", "check_samples", "RunFailed", "SamplingWarning", "SAMPLES_RANGE",
 ]
 
 _REVERSAL = EVENT_KINDS.index("reversal")
@@ -36,22 +39,60 @@ _REVERSAL = EVENT_KINDS.index("reversal")
 EXTREMA_PERIODS = 50
 #: Default search range of the damping number ``a = kappa v / K``.
 A_RANGE = (1e-8, 1e8)
+#: kappa samples of a grazing search (each is one run).
+SAMPLES_RANGE = (8, 10_000)
+#: A grazing search samples the extrema of delta on a log grid of kappa: a window between two grazing
+#: values narrower than the grid can be missed. Fewer samples per decade than the first are refused,
+#: fewer than the second are warned about (the default, 96 over 1e9..1e13, is 24 per decade).
+MIN_SAMPLES_PER_DECADE, WARN_SAMPLES_PER_DECADE = 4, 16
+#: Extrema of delta followed per run: an overdamped run creeps through thousands inside one contact,
+#: and following each of them across kappa would take hours (a warning says when some are left out).
+MAX_EXTREMA = 64
 
 
-def check_kappa_range(kappa_min, kappa_max) -> tuple[float, float]:
-    for name, value in (("kappa_min", kappa_min), ("kappa_max", kappa_max)):
-        if not (isinstance(value, (int, float, np.floating, np.integer)) and not isinstance(value, bool)
-                and math.isfinite(value) and value > 0):
-            raise ValueError(f"{name} = {value!r} is out of range; allowed: a finite number > 0")
+class SamplingWarning(UserWarning):
+    """A grazing search sampled more coarsely than the transitions it can resolve: some may be missed."""
+
+
+def check_params(params) -> Parameters:
+    if not isinstance(params, Parameters):
+        raise TypeError(f"params = {params!r} has the wrong type ({type(params).__name__}); allowed: Parameters "
+                        "(e.g. seed_parameters(), or Case.parameters())")
+    return params
+
+
+def check_kappa_range(kappa_min, kappa_max, names=("kappa_min", "kappa_max")) -> tuple[float, float]:
+    """``(kappa_min, kappa_max)`` as floats with ``0 < kappa_min < kappa_max <= KAPPA_MAX``."""
+    for name, value in zip(names, (kappa_min, kappa_max), strict=True):
+        if not (is_number(value) and math.isfinite(value) and 0 < value <= KAPPA_MAX):
+            raise ValueError(f"{name} = {value!r} is out of range; allowed: 0 < {name} <= {KAPPA_MAX:g} "
+                             "(N s/m^(1+alpha))")
     if not kappa_min < kappa_max:
-        raise ValueError(f"kappa_min = {kappa_min!r}, kappa_max = {kappa_max!r} are out of range; "
-                         "allowed: kappa_min < kappa_max")
+        raise ValueError(f"{names[0]} = {kappa_min!r}, {names[1]} = {kappa_max!r} are out of range; "
+                         f"allowed: {names[0]} < {names[1]}")
     return float(kappa_min), float(kappa_max)
 
 
+def check_samples(num, kappa_min: float, kappa_max: float, names=("kappa_min", "kappa_max", "num")) -> int:
+    """The sample count of a grazing search over ``[kappa_min, kappa_max]``: an integer in
+    :data:`SAMPLES_RANGE`, at least :data:`MIN_SAMPLES_PER_DECADE` per decade of kappa."""
+    lo, hi = SAMPLES_RANGE
+    if not (isinstance(num, numbers.Integral) and not isinstance(num, bool) and lo <= num <= hi):
+        raise ValueError(f"{names[2]} = {num!r} is out of range; allowed: an integer {lo} <= {names[2]} <= {hi}")
+    decades = math.log10(kappa_max) - math.log10(kappa_min)  # the ratio can overflow
+    if num < MIN_SAMPLES_PER_DECADE * decades:
+        raise ValueError(f"{names[0]} = {kappa_min:g}, {names[1]} = {kappa_max:g} span {decades:.3g} decades: "
+                         f"{num} samples are {num / decades:.2g} per decade, too few to find the grazing values; "
+                         f"allowed: at least {MIN_SAMPLES_PER_DECADE} per decade, i.e. a span of at most "
+                         f"{num / MIN_SAMPLES_PER_DECADE:.3g} decades with {names[2]} = {num}, or "
+                         f"{names[2]} >= {math.ceil(MIN_SAMPLES_PER_DECADE * decades)} (at most {hi})")
+    return int(num)
+
+
 def _default_range(params: Parameters) -> tuple[float, float]:
+    """The search range of damping numbers :data:`A_RANGE`, within the allowed kappa."""
     scale = params.K / params.v
-    return A_RANGE[0] * scale, A_RANGE[1] * scale
+    return min(A_RANGE[0] * scale, KAPPA_MAX / 10), min(A_RANGE[1] * scale, KAPPA_MAX)
 
 
 def closed_form_kappa_c(params: Parameters) -> float | None:
@@ -97,13 +138,6 @@ def first_stick_margin(params: Parameters, law: ContactLaw | str = "paper", *, r
     return -math.inf if margin is None else margin
 
 
-def stick_count(params: Parameters, law: ContactLaw | str = "paper", *, rtol: float = 1e-10):
-    """``(N, T_run, cut)``: stick phases until the outcome settles, escape time, and whether the
-    horizon cap cut the run (then N is a lower bound)."""
-    trajectory = simulate(params, law, None, rtol=rtol)
-    return trajectory.n_stick, trajectory.t_run, trajectory.cut
-
-
 @dataclass(frozen=True)
 class CriticalDamping:
     """The critical damping of ``paper`` at one case (docs/physics.md §5).
@@ -116,10 +150,20 @@ class CriticalDamping:
         docs/physics.md §5's closed-form estimate.
     margins : tuple
         Margin at the search range's ends (or at the final bracket).
+    kappa_c_accuracy : float or None
+        Estimated relative error of ``kappa_c``: the final bracket's width plus its change when the
+        root is solved again at a tighter integrator tolerance (:func:`.confirm.tighter`).
     kappa_2 : float or None
         Smallest ``kappa`` from which the trajectory makes exactly 2 stick phases.
+    kappa_2_accuracy : float or None
+        Relative width of ``kappa_2``'s final bracket, whose ends are confirmed (N = 2 above, N != 2
+        below) at the tighter tolerance; None when they are not.
+    n_below, n_above : int or None
+        Stick phases just below ``kappa_2`` (at its bracket's lower end, confirmed) and above it (2).
     n_staircase : list of dict
-        ``{"kappa", "n_stick", "t_run", "cut"}`` sampled between ``kappa_c`` and ``kappa_2``.
+        ``{"kappa", "relative", "n_stick", "t_run", "cut", "confirmed", "reason"}`` sampled from
+        above ``kappa_2`` down towards ``kappa_c`` until a run is cut by the horizon; ``n_stick`` is
+        None where the count is not confirmed (:func:`.confirm.confirmed_count`, ``reason`` says why).
     classification : str or None
         ``adding-sliding`` with :attr:`exponents` when measured.
     status : {"success", "not-found", "unconfirmed", "failed"}
@@ -137,7 +181,11 @@ class CriticalDamping:
     status: str
     message: str
     evaluations: int
+    kappa_c_accuracy: float | None = None
     kappa_2: float | None = None
+    kappa_2_accuracy: float | None = None
+    n_below: int | None = None
+    n_above: int | None = None
     n_staircase: list = field(default_factory=list)
     classification: str | None = None
     exponents: dict | None = None
@@ -157,14 +205,13 @@ def critical_damping(params: Parameters, law: ContactLaw | str = "paper", *, kap
     stick just below, two or more stick phases just above. No root in the range gives status
     ``not-found``, ``kappa_c`` None and the margins at both ends in the message.
     """
+    check_params(params)
     law = as_law(law)
     if not law.is_filippov:
         raise ValueError(f"law = {law.name!r} is out of range for the critical damping; allowed: paper "
                          "(unilateral laws have grazing transitions: use transitions())")
-    if not (isinstance(rtol, (int, float)) and 1e-14 <= rtol <= 1e-2):
-        raise ValueError(f"kappa_rtol = {rtol!r} is out of range; allowed: 1e-14 <= kappa_rtol <= 1e-2")
-    lo_default, hi_default = _default_range(params)
-    kappa_min, kappa_max = check_kappa_range(kappa_min or lo_default, kappa_max or hi_default)
+    check_rtol_of_kappa(rtol)
+    kappa_min, kappa_max = default_kappa_range(params, kappa_min, kappa_max)
     closed = closed_form_kappa_c(params)
     try:
         return _critical_damping(params, law, kappa_min, kappa_max, rtol, integrator_rtol, with_kappa_2,
@@ -172,6 +219,29 @@ def critical_damping(params: Parameters, law: ContactLaw | str = "paper", *, kap
     except RunFailed as error:
         return CriticalDamping(law.name, law.contact, params.v, None, rtol, closed, (kappa_min, kappa_max),
                                (math.nan, math.nan), "failed", f"a run of the search failed: {error}", 0)
+
+
+def check_rtol_of_kappa(rtol) -> float:
+    if not (is_number(rtol) and 1e-14 <= rtol <= 1e-2):
+        raise ValueError(f"kappa_rtol = {rtol!r} is out of range; allowed: 1e-14 <= kappa_rtol <= 1e-2")
+    return float(rtol)
+
+
+def default_kappa_range(params: Parameters, kappa_min=None, kappa_max=None,
+                        names=("kappa_min", "kappa_max")) -> tuple[float, float]:
+    """The search range of :func:`critical_damping`: the ends given, the others from the damping
+    numbers :data:`A_RANGE` (a default end on the wrong side of a given one is named as a default)."""
+    lo_default, hi_default = _default_range(params)
+    lo = lo_default if kappa_min is None else kappa_min
+    hi = hi_default if kappa_max is None else kappa_max
+    for given, default, name, other in ((kappa_max, lo_default, names[0], names[1]),
+                                        (kappa_min, hi_default, names[1], names[0])):
+        if (kappa_min is None) != (kappa_max is None) and given is not None and is_number(given) and (
+                (name == names[0] and not default < given) or (name == names[1] and not given < default)):
+            raise ValueError(f"{other} = {given!r} is out of range with the default {name} = {default:.4g} "
+                             f"(damping number kappa v/K = {A_RANGE[0 if name == names[0] else 1]:g}); allowed: "
+                             f"{other} {'>' if name == names[0] else '<'} {default:.4g}, or {name} given too")
+    return check_kappa_range(lo, hi, names)
 
 
 def _critical_damping(params, law, kappa_min, kappa_max, rtol, integrator_rtol, with_kappa_2, with_exponents,
@@ -207,20 +277,24 @@ def _critical_damping(params, law, kappa_min, kappa_max, rtol, integrator_rtol, 
                                + (" (the stick never breaks)" if m_max >= 0 else ""), evaluations)
     root = brentq(margin, min(a, b), max(a, b), xtol=rtol / 4, rtol=4 * np.finfo(float).eps, maxiter=200)
     kappa_c = math.exp(root)
-    # confirm with the counts either side (cheap: far enough from kappa_c for a short run)
-    below = simulate(params.replace(kappa=kappa_c * (1 - 1e-3)), law, None, rtol=integrator_rtol)
-    above = simulate(params.replace(kappa=kappa_c * (1 + 1e-3)), law, None, rtol=integrator_rtol)
-    evaluations += 2
-    ok = below.outcome == "permanent-stick" and below.n_stick == 1 and above.n_stick >= 2
-    message = (f"kappa_c = {kappa_c:.10g} N s/m^(1+alpha) (root of the first stick's margin, relative width "
-               f"{rtol:g}); just below: {below.n_stick} stick phase ({below.outcome}), just above: "
-               f"{above.n_stick} ({above.outcome})")
+    accuracy, spent = _kappa_c_accuracy(params, law, root, rtol, integrator_rtol)
+    evaluations += spent
+    # confirm with the counts either side, far enough from kappa_c for short runs
+    below = confirmed_count(params.replace(kappa=kappa_c * (1 - SIDE_OFFSET)), law, integrator_rtol)
+    above = confirmed_count(params.replace(kappa=kappa_c * (1 + SIDE_OFFSET)), law, integrator_rtol)
+    evaluations += 4
+    ok = below.confirmed and above.confirmed and below.n_stick == 1 and not below.cut and above.n_stick >= 2
+    message = (f"kappa_c = {kappa_c:.10g} N s/m^(1+alpha), estimated relative error {_fmt_accuracy(accuracy)} "
+               f"(root of the first stick's margin); at kappa_c (1 - {SIDE_OFFSET:g}): {below.n_stick} stick phase"
+               f" (permanent), at kappa_c (1 + {SIDE_OFFSET:g}): {above.n_stick}")
+    if not ok:
+        message += "; " + "; ".join(r for r in (below.reason, above.reason) if r) if (below.reason or above.reason) \
+            else "; the counts either side do not show a permanent stick below and a break above"
     result = CriticalDamping(law.name, law.contact, params.v, kappa_c, rtol, closed, (kappa_lo, kappa_hi),
-                             (float(m_a), float(m_b)), "success" if ok else "unconfirmed", message, evaluations)
+                             (float(m_a), float(m_b)), "success" if ok else "unconfirmed", message, evaluations,
+                             kappa_c_accuracy=accuracy)
     if with_kappa_2 and ok:
-        kappa_2, staircase, extra = locate_kappa_2(params, law, kappa_c, integrator_rtol=integrator_rtol)
-        result = _replace(result, kappa_2=kappa_2, n_staircase=staircase,
-                          evaluations=result.evaluations + extra)
+        result = _with_kappa_2(result, params, law, integrator_rtol)
     if with_exponents and ok:
         result = _replace(result, classification="adding-sliding",
                           exponents=adding_sliding_exponents(params, law, kappa_c, integrator_rtol=integrator_rtol))
@@ -229,16 +303,95 @@ def _critical_damping(params, law, kappa_min, kappa_max, rtol, integrator_rtol, 
     return result
 
 
+#: Doublings of kappa_2's bracket, at most, until the tighter tolerance confirms both its ends.
+WIDENINGS = 12
+#: Offset of the two counts that confirm kappa_c (one permanent stick below, a break above).
+SIDE_OFFSET = 1e-3
+
+
+def _fmt_accuracy(accuracy) -> str:
+    return "unknown" if accuracy is None else f"{accuracy:.1e}"
+
+
+def _kappa_c_accuracy(params, law, log_root, rtol, integrator_rtol):
+    """Relative error estimate of kappa_c: the bracket width plus the root's move at a tighter
+    integrator tolerance (Brent again, in a narrow bracket around the first root)."""
+    from scipy.optimize import brentq
+    tight = tighter(integrator_rtol)
+    spent = 0
+
+    def margin(log_kappa):
+        nonlocal spent
+        spent += 1
+        return first_stick_margin(params.replace(kappa=math.exp(log_kappa)), law, rtol=tight)
+
+    for width in (1e-7, 1e-5, 1e-3):
+        lo, hi = log_root - width, log_root + width
+        m_lo, m_hi = margin(lo), margin(hi)
+        if (m_lo >= 0) != (m_hi >= 0):
+            root = brentq(margin, lo, hi, xtol=rtol / 4, rtol=4 * np.finfo(float).eps, maxiter=200)
+            return rtol + abs(math.expm1(root - log_root)), spent
+    return None, spent
+
+
+def _with_kappa_2(result: CriticalDamping, params, law, integrator_rtol) -> CriticalDamping:
+    """``result`` with kappa_2, its accuracy and the staircase, and the status they allow."""
+    found = locate_kappa_2(params, law, result.kappa_c, integrator_rtol=integrator_rtol)
+    kappa_2, accuracy, staircase, reason = found.kappa_2, found.accuracy, found.staircase, found.reason
+    message = result.message + (f"; kappa_2 = {kappa_2:.10g}, estimated relative error {_fmt_accuracy(accuracy)}"
+                                if kappa_2 is not None else "")
+    unconfirmed = [s for s in staircase if not s["confirmed"]]
+    status = result.status
+    if reason:
+        status, message = "unconfirmed", f"{message}; kappa_2 unconfirmed: {reason}"
+    if unconfirmed:
+        status = "unconfirmed"
+        message += (f"; {len(unconfirmed)} of {len(staircase)} staircase counts unconfirmed (first: "
+                    f"{unconfirmed[0]['reason']})")
+    return _replace(result, kappa_2=kappa_2, kappa_2_accuracy=accuracy, n_below=found.n_below,
+                    n_above=2 if kappa_2 is not None else None, n_staircase=staircase,
+                    evaluations=result.evaluations + found.evaluations, status=status, message=message)
+
+
 def _replace(result: CriticalDamping, **changes) -> CriticalDamping:
     return CriticalDamping(**{**asdict(result), **changes})
 
 
-def locate_kappa_2(params: Parameters, law: ContactLaw | str, kappa_c: float, *, rtol: float = 1e-8,
+@dataclass(frozen=True)
+class Kappa2:
+    """What :func:`locate_kappa_2` found.
+
+    Attributes
+    ----------
+    kappa_2 : float or None
+    accuracy : float or None
+        Relative width of the final bracket, when both its ends are confirmed.
+    n_below : int or None
+        The confirmed count at the bracket's lower end (just below ``kappa_2``).
+    staircase : list of dict
+    evaluations : int
+    reason : str
+        Why the bracket is not confirmed ("" when it is).
+    """
+
+    kappa_2: float | None
+    accuracy: float | None
+    n_below: int | None
+    staircase: list
+    evaluations: int
+    reason: str
+
+
+def locate_kappa_2(params: Parameters, law: ContactLaw | str, kappa_c: float, *, rtol: float = 1e-10,
                    integrator_rtol: float = 1e-10, samples: int = 24):
     """``kappa_2``: the smallest ``kappa`` from which ``N = 2``, by bisection on ``N`` in
-    ``log(kappa/kappa_c - 1)``; and the staircase of ``N`` sampled between ``kappa_c`` and it.
+    ``log(kappa/kappa_c - 1)`` to a bracket of relative width ``rtol``, whose ends are then
+    confirmed (:func:`.confirm.confirmed_count`); and the staircase of ``N`` sampled from
+    ``1.5 (kappa_2/kappa_c - 1)`` down to ``min(1e-5, (kappa_2/kappa_c - 1)/10)``, each count
+    confirmed, stopping at the first run the horizon cuts (closer to ``kappa_c`` the escape only
+    takes longer).
 
-    Returns ``(kappa_2 or None, staircase, evaluations)``.
+    Returns a :class:`Kappa2`.
     """
     law = as_law(law)
     evaluations = 0
@@ -246,18 +399,25 @@ def locate_kappa_2(params: Parameters, law: ContactLaw | str, kappa_c: float, *,
     def count(eps):
         nonlocal evaluations
         evaluations += 1
-        return stick_count(params.replace(kappa=kappa_c * (1 + eps)), law, rtol=integrator_rtol)
+        run = simulate(params.replace(kappa=kappa_c * (1 + eps)), law, None, rtol=integrator_rtol)
+        violation = stick_sequence_violation(run) if run.status == "success" else run.message
+        return run.n_stick, violation
+
+    def confirmed(eps):
+        nonlocal evaluations
+        evaluations += 2
+        return confirmed_count(params.replace(kappa=kappa_c * (1 + eps)), law, integrator_rtol)
 
     eps_hi = 1e-3
     while count(eps_hi)[0] != 2:
         eps_hi *= 2
         if eps_hi > 1e3:
-            return None, [], evaluations
+            return Kappa2(None, None, None, [], evaluations, "no kappa up to kappa_c (1 + 1e3) gives N = 2")
     eps_lo = eps_hi / 2
     while count(eps_lo)[0] == 2:
         eps_hi, eps_lo = eps_lo, eps_lo / 2
         if eps_lo < 1e-12:
-            return None, [], evaluations
+            return Kappa2(None, None, None, [], evaluations, "N = 2 down to kappa_c (1 + 1e-12)")
     while (eps_hi - eps_lo) / (1 + eps_hi) > rtol:
         mid = math.sqrt(eps_lo * eps_hi)
         if mid in (eps_lo, eps_hi):
@@ -266,14 +426,48 @@ def locate_kappa_2(params: Parameters, law: ContactLaw | str, kappa_c: float, *,
             eps_hi = mid
         else:
             eps_lo = mid
+    # the ends confirmed; an end the tighter tolerance moves across kappa_2 lies within the
+    # integrator's uncertainty of it: the bracket widens, in doubling steps, until both ends hold
+    def holds(count, two):
+        if two:
+            return count.confirmed and not count.cut and count.n_stick == 2
+        # a lower bound above 2 (a run cut by the horizon) proves N != 2 as well as a count does
+        return count.n_stick_tight is not None and min(count.n_stick, count.n_stick_tight) > 2
+
+    def widens(count):  # a count the tolerance decides, or N on the wrong side: not a broken run
+        return not count.cut and (count.confirmed or count.disagree)
+
+    step = eps_hi - eps_lo
+    upper = confirmed(eps_hi)
+    for _ in range(WIDENINGS):
+        if holds(upper, True) or not widens(upper):
+            break
+        eps_hi, step = eps_hi + step, 2 * step
+        upper = confirmed(eps_hi)
+    step = eps_hi - eps_lo
+    lower = confirmed(eps_lo)
+    for _ in range(WIDENINGS):
+        if holds(lower, False) or not widens(lower) or eps_lo <= step:
+            break
+        eps_lo, step = eps_lo - step, 2 * step
+        lower = confirmed(eps_lo)
     kappa_2 = kappa_c * (1 + eps_hi)
+    reason = ""
+    if not holds(upper, True):
+        reason = f"at its upper end {upper.reason or ('cut by the horizon' if upper.cut else f'N = {upper.n_stick}')}"
+    elif not holds(lower, False):
+        reason = f"at its lower end {lower.reason or 'N = 2'}"
+    accuracy = None if reason else (eps_hi - eps_lo) / (1 + eps_hi)
     staircase = []
-    # from eps = 1e-5 up: closer to kappa_c the escape takes thousands of plate periods (N > 3000)
-    for eps in np.geomspace(min(1e-5, eps_hi / 10), eps_hi * 1.5, samples):
-        n, t_run, cut = count(float(eps))
-        staircase.append({"kappa": kappa_c * (1 + float(eps)), "relative": float(eps), "n_stick": int(n),
-                          "t_run": t_run, "cut": bool(cut)})
-    return kappa_2, staircase, evaluations
+    for eps in np.geomspace(eps_hi * 1.5, min(1e-5, eps_hi / 10), samples):
+        n = confirmed(float(eps))
+        staircase.append({"kappa": kappa_c * (1 + float(eps)), "relative": float(eps),
+                          "n_stick": n.n_stick if n.confirmed else None, "t_run": n.t_run, "cut": n.cut,
+                          "confirmed": n.confirmed, "reason": n.reason})
+        if n.cut:
+            break
+    n_below = lower.n_stick if lower.confirmed and not lower.cut else None
+    return Kappa2(kappa_2, accuracy, n_below, staircase[::-1], evaluations, reason)
 
 
 def adding_sliding_exponents(params: Parameters, law: ContactLaw | str, kappa_c: float, *,
@@ -326,10 +520,18 @@ def delta_extremum(params: Parameters, law: ContactLaw | str, j: int, *, rtol: f
     # the kappa where the projectile stops getting out of reach
     trajectory = simulate(params, law, _extrema_horizon(params), rtol=rtol, stop_on=("reversal", j),
                           stop_when_settled=False)
+    _check_ok(trajectory)
     if trajectory.stop_reason != "asked":
         return -math.inf
     y = trajectory.final_state
     return float(y[0] - y[1])
+
+
+def _check_ok(trajectory):
+    """The trajectory, or :class:`RunFailed` naming its kappa: a search must not read a failed run."""
+    if not trajectory.ok:
+        raise RunFailed(f"kappa = {trajectory.params.kappa:.6g}: {trajectory.status}: {trajectory.message}")
+    return trajectory
 
 
 def _extrema_horizon(params: Parameters) -> float:
@@ -341,12 +543,13 @@ def _extrema_horizon(params: Parameters) -> float:
 def extrema(params: Parameters, law: ContactLaw | str, *, rtol: float = 1e-10) -> np.ndarray:
     """``delta`` at every extremum of the trajectory until its outcome settles, and the next two
     after the projectile is out of reach (so that a grazing return is seen from both sides), m."""
-    trajectory = simulate(params, law, None, rtol=rtol)
+    trajectory = _check_ok(simulate(params, law, None, rtol=rtol))
     y = trajectory.event_y[trajectory.event_kind == _REVERSAL]
     values = list(y[:, 0] - y[:, 1])
     if trajectory.stop_reason == "settled" and trajectory.final_mode != 0:
-        after = simulate(params, law, _extrema_horizon(params), rtol=rtol,
-                         initial=trajectory.final_state[:4], stop_when_settled=False, stop_on=("reversal", 2))
+        after = _check_ok(simulate(params, law, _extrema_horizon(params), rtol=rtol,
+                                   initial=trajectory.final_state[:4], stop_when_settled=False,
+                                   stop_on=("reversal", 2)))
         y = after.event_y[after.event_kind == _REVERSAL]
         values += list(y[:, 0] - y[:, 1])
     return np.asarray(values)
@@ -371,31 +574,54 @@ class Transition:
 
 
 def grazing_transitions(params: Parameters, law: ContactLaw | str, kappa_min: float, kappa_max: float, *,
-                        num: int = 96, rtol: float = 1e-9, integrator_rtol: float = 1e-10) -> list[Transition]:
+                        num: int = 96, rtol: float = 1e-9, integrator_rtol: float = 1e-10,
+                        progress: bool = False) -> list[Transition]:
     """Every grazing value of a unilateral law in ``[kappa_min, kappa_max]``, in order.
 
-    The extrema of ``delta`` are sampled on a log grid of ``kappa``; wherever the ``j``-th changes
-    sign between neighbours, or comes close to zero at a local extreme in ``kappa`` without
-    crossing on the grid (a window narrower than the grid), its root is located by Brent's
-    method to ``rtol`` (relative): :func:`delta_extremum` is the smooth defining function.
+    The extrema of ``delta`` are sampled on a log grid of ``num`` values of ``kappa`` (at least
+    :data:`MIN_SAMPLES_PER_DECADE` per decade); wherever the ``j``-th changes sign between
+    neighbours, or comes close to zero at a local extreme in ``kappa`` without crossing on the grid
+    (a window narrower than the grid), its root is located by Brent's method to ``rtol``
+    (relative): :func:`delta_extremum` is the smooth defining function. A :class:`SamplingWarning`
+    says when the grid is coarser than what it can resolve; :class:`RunFailed` (naming the kappa)
+    when a run fails or the defining function does not bracket a root the samples showed.
     """
-    from scipy.optimize import brentq, minimize_scalar  # imported where used: 0.5 s at start-up
+    from scipy.optimize import minimize_scalar  # imported where used: 0.5 s at start-up
+    from tqdm.auto import tqdm
+
+    check_params(params)
     law = as_law(law)
     if law.is_filippov and law.contact == "printed":
         raise ValueError("grazing needs a unilateral law (abrate, the Hunt-Crossley family, or paper with "
                          "contact='unilateral')")
     kappa_min, kappa_max = check_kappa_range(kappa_min, kappa_max)
+    num = check_samples(num, kappa_min, kappa_max)
+    check_rtol_of_kappa(rtol)
+    density = num / (math.log10(kappa_max) - math.log10(kappa_min))
+    if density < WARN_SAMPLES_PER_DECADE:
+        warnings.warn(f"{num} samples over kappa {kappa_min:g}..{kappa_max:g} are {density:.2g} per decade: a window "
+                      f"between two grazing values narrower than a factor {10 ** (1 / density):.3g} in kappa can be "
+                      f"missed ({WARN_SAMPLES_PER_DECADE} per decade resolve a factor "
+                      f"{10 ** (1 / WARN_SAMPLES_PER_DECADE):.3g})", SamplingWarning, stacklevel=2)
     logk = np.linspace(math.log(kappa_min), math.log(kappa_max), num)
-    samples = [extrema(params.replace(kappa=math.exp(x)), law, rtol=integrator_rtol) for x in logk]
-    depth = max(len(e) for e in samples)
+    samples = [extrema(params.replace(kappa=math.exp(x)), law, rtol=integrator_rtol)
+               for x in tqdm(logk, desc=f"grazing {law.name}", unit="kappa", disable=not progress)]
+    deepest = max(len(e) for e in samples)
+    if deepest > MAX_EXTREMA:
+        where = math.exp(logk[int(np.argmax([len(e) for e in samples]))])
+        warnings.warn(f"runs make up to {deepest} extrema of delta (at kappa = {where:.4g}): the first {MAX_EXTREMA} "
+                      "are followed, a grazing of a later one is missed", SamplingWarning, stacklevel=2)
+    depth = min(deepest, MAX_EXTREMA)
     table = np.full((num, depth), -np.inf)
     for i, e in enumerate(samples):
-        table[i, :len(e)] = e
+        table[i, :min(len(e), depth)] = e[:depth]
     scale = params.hertz_indentation
-    eps = 4 * np.finfo(float).eps
 
     def g(x, j):
         return delta_extremum(params.replace(kappa=math.exp(x)), law, j, rtol=integrator_rtol)
+
+    def root(lo, hi, j):
+        return _grazing_root(g, lo, hi, j, rtol)
 
     found = []
     for j in range(1, depth + 1):
@@ -415,7 +641,7 @@ def grazing_transitions(params: Parameters, law: ContactLaw | str, kappa_min: fl
                 else:
                     hi, g_hi = mid, g_mid
             if np.isfinite(g_lo) and np.isfinite(g_hi) and (g_lo > 0) != (g_hi > 0):
-                found.append((math.exp(brentq(g, lo, hi, args=(j,), xtol=rtol / 4, rtol=eps)), j))
+                found.append((root(lo, hi, j), j))
         # windows narrower than the grid: an extreme in kappa of this extremum close to zero
         for i in range(1, num - 1):
             a, m, b = column[i - 1], column[i], column[i + 1]
@@ -428,8 +654,16 @@ def grazing_transitions(params: Parameters, law: ContactLaw | str, kappa_min: fl
                                    method="bounded", options={"xatol": 1e-12})
             if (-sign * best.fun > 0) != (m > 0):
                 for lo, hi in ((logk[i - 1], best.x), (best.x, logk[i + 1])):
-                    found.append((math.exp(brentq(g, lo, hi, args=(j,), xtol=rtol / 4, rtol=eps)), j))
+                    found.append((root(lo, hi, j), j))
     found.sort()
+    step = logk[1] - logk[0]
+    close = [(a, b) for (a, _), (b, _) in zip(found, found[1:], strict=False) if 10 * rtol * b < b - a
+             and math.log(b / a) < step]
+    if close:
+        a, b = close[0]
+        warnings.warn(f"grazing values at kappa = {a:.4g} and {b:.4g} lie closer than two samples: a window that "
+                      "narrow between two samples can be missed elsewhere; more samples resolve it", SamplingWarning,
+                      stacklevel=2)
     transitions = []
     for kappa, j in found:
         if transitions and abs(kappa - transitions[-1].kappa) <= 10 * rtol * kappa:
@@ -440,25 +674,53 @@ def grazing_transitions(params: Parameters, law: ContactLaw | str, kappa_min: fl
     return transitions
 
 
+def _grazing_root(g, lo: float, hi: float, j: int, rtol: float) -> float:
+    """The root of ``g(., j)`` in ``[lo, hi]`` (log kappa), ``kappa`` to ``rtol``; :class:`RunFailed`
+    naming the bracket when the defining function does not change sign there."""
+    from scipy.optimize import brentq  # imported where used: 0.5 s at start-up
+
+    g_lo, g_hi = g(lo, j), g(hi, j)
+    if not (np.isfinite(g_lo) and np.isfinite(g_hi)) or (g_lo > 0) == (g_hi > 0):
+        raise RunFailed(f"kappa = {math.exp(lo):.6g} to {math.exp(hi):.6g}: extremum {j} of delta changes sign between "
+                        f"the samples but not in single runs (delta = {g_lo:.3g} and {g_hi:.3g} m at the ends): no "
+                        "grazing can be located there")
+    return math.exp(brentq(g, lo, hi, args=(j,), xtol=rtol / 4, rtol=4 * np.finfo(float).eps))
+
+
 def transitions(params: Parameters, law: ContactLaw | str, kappa_min: float, kappa_max: float, *,
-                rtol: float = 1e-9, integrator_rtol: float = 1e-10, num: int = 96) -> list[Transition]:
+                rtol: float = 1e-9, integrator_rtol: float = 1e-10, num: int = 96,
+                progress: bool = False) -> list[Transition]:
     """Every transition of the long-time count in ``[kappa_min, kappa_max]``, in order.
 
     ``paper`` (either reading): the adding-sliding at ``kappa_c`` (one stick phase below,
     unboundedly many just above) and the end of the staircase at ``kappa_2`` (``N = 2`` above);
-    unilateral laws: every grazing value (contacts before the projectile is out of reach).
+    unilateral laws: every grazing value (contacts before the projectile is out of reach), by
+    :func:`grazing_transitions` with ``num`` samples (``progress``: a bar on stderr).
+
+    Raises
+    ------
+    ValueError
+        For a law that does not read ``kappa`` or any argument out of range.
+    RunFailed
+        When a run of the search fails numerically, naming the kappa.
     """
+    check_params(params)
     law = as_law(law)
+    if not law.reads("kappa"):
+        raise ValueError(f"law {law.label()!r} does not read kappa (its damping comes from "
+                         f"{law.damping_source or 'nowhere: it is undamped'}): no transition in kappa; allowed: a law "
+                         "that reads kappa (paper, hunt-crossley) without restitution")
     kappa_min, kappa_max = check_kappa_range(kappa_min, kappa_max)
     if not law.is_filippov:
         return grazing_transitions(params, law, kappa_min, kappa_max, num=num, rtol=rtol,
-                                   integrator_rtol=integrator_rtol)
+                                   integrator_rtol=integrator_rtol, progress=progress)
     critical = critical_damping(params, law, kappa_min=kappa_min, kappa_max=kappa_max, rtol=rtol,
                                 integrator_rtol=integrator_rtol, with_kappa_2=True)
+    if critical.status == "failed":
+        raise RunFailed(critical.message)
     out = []
     if critical.kappa_c is not None:
         out.append(Transition("adding-sliding", critical.kappa_c, 1, None))
     if critical.kappa_2 is not None and critical.kappa_2 <= kappa_max:
-        n_below = stick_count(params.replace(kappa=critical.kappa_2 * (1 - 1e-7)), law, rtol=integrator_rtol)[0]
-        out.append(Transition("staircase-end", critical.kappa_2, int(n_below), 2))
+        out.append(Transition("staircase-end", critical.kappa_2, critical.n_below, 2))
     return out

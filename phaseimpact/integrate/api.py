@@ -12,9 +12,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .. import _signals
 from ..model.laws import ContactLaw, as_law
 from ..model.rhs import initial_state, pack
-from ..parameters import Parameters
+from ..parameters import Parameters, is_number
 from . import driver as d
 from . import (
     precompile,  # noqa: F401  (registers the two-process first compile)
@@ -34,10 +35,35 @@ RTOL_RANGE = (1e-13, 1e-3)
 HORIZON_CAP_PERIODS = 1e4
 MAX_STEPS = 50_000_000
 MAX_EVENTS = 5_000_000
+#: Shortest horizon, in contact times: below it not even the time tolerance (``rtol`` times the
+#: contact time, rtol >= 1e-13) fits, and the step size underflows.
+MIN_HORIZON_CONTACT_TIMES = 1e-13
 
 
 def is_real(value) -> bool:
-    return isinstance(value, numbers.Real) and not isinstance(value, bool)
+    return is_number(value)
+
+
+def check_params(params, name: str = "params") -> Parameters:
+    """``params`` if it is :class:`Parameters`; else ``TypeError`` naming the argument."""
+    if not isinstance(params, Parameters):
+        raise TypeError(f"{name} = {params!r} has the wrong type ({type(params).__name__}); allowed: Parameters "
+                        "(e.g. seed_parameters(), or Case.parameters())")
+    return params
+
+
+def check_t_end(t_end, contact_time: float, name: str = "t_end") -> float:
+    """A horizon (s): a finite number no shorter than :data:`MIN_HORIZON_CONTACT_TIMES` contact times."""
+    shortest = MIN_HORIZON_CONTACT_TIMES * contact_time
+    return check_real(name, t_end, f"a finite number >= {shortest:.3g} s ({MIN_HORIZON_CONTACT_TIMES:g} of the "
+                                      f"contact time {contact_time:.3g} s: nothing shorter can be resolved)",
+                      lambda x: x >= shortest)
+
+
+def check_bool(name: str, value) -> bool:
+    if not isinstance(value, bool | np.bool_):
+        raise ValueError(f"{name} = {value!r} is out of range; allowed: True or False")
+    return bool(value)
 
 
 def check_real(name: str, value, allowed: str, ok) -> float:
@@ -87,9 +113,16 @@ def hertz_contact_time(alpha: float, indentation, v):
     return 2 * tau * indentation / v
 
 
-@functools.lru_cache(maxsize=1024)
 def scales(params: Parameters) -> Scales:
-    """The time and length scales of ``params`` (cached: a sweep asks for the same case often)."""
+    """The time and length scales of ``params``."""
+    if type(params) is not Parameters:  # the common case without the check's formatting
+        check_params(params)
+    return _scales(params)
+
+
+@functools.lru_cache(maxsize=1024)
+def _scales(params: Parameters) -> Scales:
+    # cached: a sweep asks for the same case often
     indentation = params.hertz_indentation
     contact_time = hertz_contact_time(params.alpha, indentation, params.v)
     period = params.target_period
@@ -126,8 +159,11 @@ def _packed(params: Parameters, law: ContactLaw, rtol: float) -> tuple:
 def _initial(params: Parameters, initial) -> np.ndarray:
     y = initial_state(params.v)
     if initial is not None:
-        state = np.asarray(initial, dtype=float)
-        if state.shape != (4,) or not np.all(np.isfinite(state)):
+        try:
+            state = np.asarray(initial, dtype=float)
+        except (TypeError, ValueError):
+            state = np.full(0, np.nan)
+        if isinstance(initial, str) or state.shape != (4,) or not np.all(np.isfinite(state)):
             raise ValueError(f"initial = {initial!r} is out of range; allowed: 4 finite numbers "
                              "(x1, x2, x1dot, x2dot)")
         y[:4] = state
@@ -138,11 +174,16 @@ def _stop_on(stop_on) -> tuple[int, int]:
     """``stop_on`` as (event kind code, count): stop at the n-th event of that kind."""
     if stop_on is None:
         return -1, 0
-    kind, n = (stop_on, 1) if isinstance(stop_on, str) else stop_on
-    if kind not in EVENT_KINDS:
+    if isinstance(stop_on, str):
+        kind, n = stop_on, 1
+    elif isinstance(stop_on, tuple | list) and len(stop_on) == 2:
+        kind, n = stop_on
+    else:
+        kind, n = None, None
+    if not isinstance(kind, str) or kind not in EVENT_KINDS:
         raise ValueError(f"stop_on = {stop_on!r} is out of range; allowed: an event kind "
                          f"({', '.join(EVENT_KINDS)}) or (kind, n)")
-    if not (isinstance(n, numbers.Integral) and n >= 1):
+    if not (isinstance(n, numbers.Integral) and not isinstance(n, bool) and n >= 1):
         raise ValueError(f"stop_on count = {n!r} is out of range; allowed: an integer >= 1")
     return EVENT_KINDS.index(kind), int(n)
 
@@ -150,14 +191,23 @@ def _stop_on(stop_on) -> tuple[int, int]:
 _NO_TIMES = np.empty(0)  # the driver only reads it
 
 
-def _save(save):
+def _save(save, horizon: float, t_end):
     if isinstance(save, str):
         if save not in ("summary", "steps"):
             raise ValueError(f"save = {save!r} is out of range; allowed: 'summary', 'steps' or an array of times")
         return (d.SAVE_SUMMARY if save == "summary" else d.SAVE_STEPS), _NO_TIMES
-    times = np.asarray(save, dtype=float)
+    try:
+        times = np.asarray(save, dtype=float)
+    except (TypeError, ValueError):
+        times = np.full((0, 0), np.nan)
     if times.ndim != 1 or not np.all(np.isfinite(times)) or np.any(np.diff(times) <= 0):
-        raise ValueError("save: output times must be a finite, strictly increasing 1-d array")
+        raise ValueError(f"save = {save!r} is out of range; allowed: 'summary', 'steps' or output times as a "
+                         "finite, strictly increasing 1-d array")
+    # the run starts at t = 0 and ends at the horizon: a time outside would be a sample invented or dropped
+    if times.size and (times[0] < 0 or times[-1] > horizon):
+        where = "t_end" if t_end is not None else "the horizon cap"
+        raise ValueError(f"save: output times {times[0]:.6g} .. {times[-1]:.6g} s are out of range; allowed: times "
+                         f"in [0, {horizon:.6g}] s ({where})")
     return d.SAVE_TIMES, times
 
 
@@ -209,17 +259,19 @@ def simulate(params: Parameters, law: ContactLaw | str = "paper", t_end: float |
         throughout (for comparisons).
     """
     law = as_law(law)
-    if not isinstance(params, Parameters):
-        raise ValueError(f"params = {params!r} is out of range; allowed: a Parameters instance")
-    if integrator not in INTEGRATORS:
+    check_params(params)
+    if not isinstance(integrator, str) or integrator not in INTEGRATORS:
         raise ValueError(f"integrator = {integrator!r} is out of range; allowed: one of {', '.join(INTEGRATORS)}")
     stiff_after = _stiff_after(stiff)
     rtol = check_rtol(rtol)
     c, default_atol, seed_state, s = _packed(params, law, rtol)
-    horizon = s.horizon if t_end is None else check_real("t_end", t_end, "a finite number > 0", lambda x: x > 0)
-    save_kind, times = _save(save)
-    settle = (t_end is None or save_kind == d.SAVE_SUMMARY) if stop_when_settled is None else bool(stop_when_settled)
+    horizon = s.horizon if t_end is None else check_t_end(t_end, s.contact_time)
+    save_kind, times = _save(save, horizon, t_end)
+    settle = ((t_end is None or save_kind == d.SAVE_SUMMARY) if stop_when_settled is None
+              else check_bool("stop_when_settled", stop_when_settled))
     stop_kind, stop_count = _stop_on(stop_on)
+    if not (isinstance(max_steps, numbers.Integral) and not isinstance(max_steps, bool) and max_steps >= 1):
+        raise ValueError(f"max_steps = {max_steps!r} is out of range; allowed: an integer >= 1")
     y0 = seed_state.copy() if initial is None else _initial(params, initial)
     rk4_step = 0.0
     if integrator == "rk4":
@@ -229,9 +281,16 @@ def simulate(params: Parameters, law: ContactLaw | str = "paper", t_end: float |
         if horizon / rk4_step > max_steps:
             raise ValueError(f"step = {rk4_step!r} needs {horizon / rk4_step:.3g} steps; allowed: at most "
                              f"max_steps = {max_steps}")
-    out = d.run(law.code, c, y0, horizon, rtol, default_atol if atol is None else _atol(params, rtol, atol),
-                s.max_step, settle, stop_kind, stop_count, save_kind, times, int(max_steps), MAX_EVENTS, rk4_step,
-                int(every), stiff_after)
+    if not _signals.installed:
+        _signals.install()
+    while True:
+        out = d.run(law.code, c, y0, horizon, rtol, default_atol if atol is None else _atol(params, rtol, atol),
+                    s.max_step, settle, stop_kind, stop_count, save_kind, times, int(max_steps), MAX_EVENTS,
+                    rk4_step, int(every), stiff_after)
+        woken = out[0][d.S_STATUS] == d.INTERRUPTED
+        if not (woken or _signals.deferred):
+            break
+        _signals.check(woken)  # raises for Ctrl-C or SIGTERM; after an old wake-up, runs again
     summary, event_log, samples, y_final = out
     status = d.STATUSES[int(summary[d.S_STATUS])]
     reason = d.STOP_REASONS[int(summary[d.S_REASON])]
@@ -268,9 +327,14 @@ class Batch:
 def pack_batch(params_seq, law: ContactLaw, t_end, rtol: float, initial=None) -> Batch:
     """Pack a sequence of :class:`Parameters` (one law) for :func:`run_batch`."""
     law = as_law(law)
+    if isinstance(params_seq, Parameters) or not hasattr(params_seq, "__iter__"):
+        raise TypeError(f"params_seq = {params_seq!r} has the wrong type ({type(params_seq).__name__}); allowed: a "
+                        "sequence of Parameters")
     params_seq = list(params_seq)
     if not params_seq:
-        raise ValueError("params: allowed: a non-empty sequence of Parameters")
+        raise ValueError("params_seq = [] is out of range; allowed: a non-empty sequence of Parameters")
+    for i, p in enumerate(params_seq):
+        check_params(p, f"params_seq[{i}]")
     n = len(params_seq)
     C = np.empty((n, 9))
     Y0 = np.empty((n, 5))
@@ -281,7 +345,7 @@ def pack_batch(params_seq, law: ContactLaw, t_end, rtol: float, initial=None) ->
         s = scales(p)
         C[i] = pack(p, law)
         Y0[i] = _initial(p, initial)
-        T[i] = s.horizon if t_end is None else t_end
+        T[i] = s.horizon if t_end is None else check_t_end(t_end, s.contact_time)
         A[i] = _atol(p, rtol, None)
         S[i] = s.max_step
     return Batch(law, C, Y0, T, A, S)
@@ -301,13 +365,20 @@ def run_batch(batch: Batch, *, rtol: float, settle: bool = True, stop_on=None, n
             stop_count, MAX_STEPS, MAX_EVENTS, 0.0, stiff_after)
     outputs = (summary, st[0], st[1], st[2], count)
     threads = max(1, min(int(n_threads), n))
-    if threads == 1:
-        d.run_block(*args, 0, n, *outputs)
-    else:  # blocks small enough to balance the load; the driver releases the GIL
-        size = max(1, min(256, -(-n // (8 * threads))))
-        with ThreadPoolExecutor(threads) as pool:
-            list(pool.map(lambda start: d.run_block(*args, start, min(start + size, n), *outputs),
-                          range(0, n, size)))
+    if not _signals.installed:
+        _signals.install()
+    while True:
+        if threads == 1:
+            d.run_block(*args, 0, n, *outputs)
+        else:  # blocks small enough to balance the load; the driver releases the GIL
+            size = max(1, min(256, -(-n // (8 * threads))))
+            with ThreadPoolExecutor(threads) as pool:
+                list(pool.map(lambda start, size=size: d.run_block(*args, start, min(start + size, n), *outputs),
+                              range(0, n, size)))
+        woken = bool(np.any(summary[:, d.S_STATUS] == d.INTERRUPTED))
+        if not (woken or _signals.deferred):
+            break
+        _signals.check(woken)  # raises for Ctrl-C or SIGTERM; after an old wake-up, runs again
     parts_t, parts_delta, parts_dwell = [], [], []
     for i in range(n):
         k = int(count[i])
@@ -317,9 +388,14 @@ def run_batch(batch: Batch, *, rtol: float, settle: bool = True, stop_on=None, n
             parts_dwell.append(st[2, i, :k])
             continue
         # more stick phases than the buffer holds (near kappa_c): rerun this one for all of them
-        out = d.run(batch.law.code, batch.C[i], batch.Y0[i], batch.t_end[i], rtol, batch.atol[i],
-                    batch.max_step[i], settle, stop_kind, stop_count, d.SAVE_SUMMARY, _NO_TIMES, MAX_STEPS,
-                    MAX_EVENTS, 0.0, 1, stiff_after)
+        while True:
+            out = d.run(batch.law.code, batch.C[i], batch.Y0[i], batch.t_end[i], rtol, batch.atol[i],
+                        batch.max_step[i], settle, stop_kind, stop_count, d.SAVE_SUMMARY, _NO_TIMES, MAX_STEPS,
+                        MAX_EVENTS, 0.0, 1, stiff_after)
+            woken = out[0][d.S_STATUS] == d.INTERRUPTED
+            if not (woken or _signals.deferred):
+                break
+            _signals.check(woken)
         full = np.empty((3, k))
         s = out[0]
         d.stick_points(out[1], s[d.S_T_STOP], s[d.S_OUTCOME] == d.PERMANENT_STICK, full[0], full[1], full[2])
@@ -345,8 +421,10 @@ def simulate_many(params_seq, law: ContactLaw | str = "paper", t_end: float | No
     rtol = check_rtol(rtol)
     if t_end is not None:
         t_end = check_real("t_end", t_end, "a finite number > 0", lambda x: x > 0)
-    if not (isinstance(n_threads, numbers.Integral) and n_threads >= 1):
+    if not (isinstance(n_threads, numbers.Integral) and not isinstance(n_threads, bool) and n_threads >= 1):
         raise ValueError(f"n_threads = {n_threads!r} is out of range; allowed: an integer >= 1")
     _stiff_after(stiff)
+    check_bool("stop_when_settled", stop_when_settled)
+    _stop_on(stop_on)
     batch = pack_batch(params_seq, law, t_end, rtol, initial)
     return run_batch(batch, rtol=rtol, settle=stop_when_settled, stop_on=stop_on, n_threads=n_threads, stiff=stiff)

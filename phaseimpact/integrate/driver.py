@@ -21,11 +21,13 @@ import math
 import numpy as np
 
 from .._jit import allocating, kernel
+from .._signals import interrupted
 from ..model.laws import PLAIN, STUCK
 from ..model.rhs import (
     FLIGHT,
     M2_,
     RIGID_,
+    SPRINGS_,
     V1,
     V2,
     WORK,
@@ -34,10 +36,13 @@ from ..model.rhs import (
     contact_side,
     damping_rate,
     energy,
+    onto_stuck_orbit,
+    relative_slip,
     rhs,
     rhs_integration,
     spring_force,
     stick_margin,
+    stuck_pair_energy,
 )
 from . import dop853, flight, radau5
 from .dop853 import N_STATE
@@ -56,6 +61,7 @@ from .events import (
     SILENT,
     SLIP,
     STICK,
+    STICK_BREAK,
     STOP_RUNAWAY,
     STOP_SETTLED,
     crossed,
@@ -69,8 +75,13 @@ from .events import (
 )
 
 # Run status (numerical health) and why the run stopped.
-SUCCESS, STEP_SIZE_COLLAPSE, TOO_MANY_STEPS, NON_FINITE = range(4)
-STATUSES = ("success", "step-size-collapse", "too-many-steps", "non-finite")
+SUCCESS, STEP_SIZE_COLLAPSE, TOO_MANY_STEPS, NON_FINITE, INTERRUPTED = range(5)
+STATUSES = ("success", "step-size-collapse", "too-many-steps", "non-finite", "interrupted")
+#: Steps between two looks for Ctrl-C or SIGTERM (``_signals.interrupted``, a system call):
+#: milliseconds of work, so a run stops well within a second at no measurable cost.
+POLL_STEPS = 4096
+#: Runs of a block between two looks (each long run also looks every POLL_STEPS steps).
+POLL_RUNS = 64
 HORIZON, SETTLED_STOP, RUNAWAY_STOP, ASKED_STOP, FAILED_STOP = range(5)
 STOP_REASONS = ("horizon", "settled", "runaway", "asked", "failed")
 # Outcome classes (docs/physics.md §5).
@@ -95,6 +106,12 @@ TIME = 5  # the physical time in the integration state u
 TIME_COLUMN = N_EVENTS  # a pseudo event column: the physical time minus a target
 #: Smallest step reduction after a rejection when the observed order is used (else MIN_FACTOR).
 OBSERVED_MIN_FACTOR = 0.01
+#: Absolute tolerance of ``deltadot`` in a slip, relative to that of the velocities (which is
+#: rtol times the impact speed). A slip's own speed near the critical damping is 1e-7 to 1e-12 of
+#: the impact speed, and its sign decides whether the slip re-sticks. 1e-3 is the largest power of
+#: ten that counts the seed case at v = 7 m/s, kappa = 4.16865e11 right (4 stick phases; 1e-2 gives
+#: 2); it costs a stiff creep far above kappa_c about five times the Radau steps (161 -> 777).
+SLIP_SPEED_SCALE = 1e-3
 _TINY = np.finfo(np.float64).tiny
 _EPS = np.finfo(np.float64).eps
 
@@ -156,26 +173,30 @@ def _regularised(side):
 
 
 @kernel
-def _physical_state(side, u, y):
+def _physical_state(code, mode, side, u, y):
     """Physical state ``y`` at the integration state ``u``."""
     y[X1] = u[X1] if not _regularised(side) else u[X2] + side * u[0] * u[0]
     for j in range(1, 5):
         y[j] = u[j]
+    if relative_slip(code, mode, side):
+        y[V1] = u[V1] + u[V2]
 
 
 @kernel
 def _physical(code, c, mode, side, u, y, f):
     """Physical state ``y`` and ``dy/dt`` (``f``) at the integration state ``u``; returns the force."""
-    _physical_state(side, u, y)
+    _physical_state(code, mode, side, u, y)
     return rhs(code, c, y, mode, f)
 
 
 @kernel
-def _integration_state(side, y, t, u):
+def _integration_state(code, mode, side, y, t, u):
     """The integration state of a phase on ``side`` (see :func:`~phaseimpact.model.rhs.rhs_integration`)."""
     u[X1] = y[X1] if not _regularised(side) else math.sqrt(abs(y[X1] - y[X2]))
     for j in range(1, 5):
         u[j] = y[j]
+    if relative_slip(code, mode, side):
+        u[V1] = y[V1] - y[V2]
     u[TIME] = t
 
 
@@ -190,8 +211,11 @@ def _dense(c, side, F, u0, s0, h, s, out):
 
 
 @kernel
-def _phase_tolerances(side, atol, out):
+def _phase_tolerances(code, mode, side, atol, out):
     """Absolute tolerances of the integration state: ``atol`` is (x1, x2, v1, v2, W, t, w).
+
+    A :func:`relative_slip` phase controls ``deltadot`` relative to itself: its absolute
+    tolerance is that of the velocities times :data:`SLIP_SPEED_SCALE`.
 
     The work ``W`` is a quadrature along the motion that feeds nothing back: it is left out of the
     step control (an infinite tolerance), as ODE codes do with quadratures. Controlled, it chose
@@ -201,6 +225,8 @@ def _phase_tolerances(side, atol, out):
     for j in range(1, 6):
         out[j] = atol[j]
     out[WORK] = math.inf
+    if relative_slip(code, mode, side):
+        out[V1] = atol[V1] * SLIP_SPEED_SCALE
 
 
 @kernel
@@ -209,6 +235,8 @@ def _events(code, c, mode, side, energy_limit, u, y, f, force, g):
     event_values(code, c, y, f, force, mode, energy_limit, g)
     if _regularised(side):
         g[DELTA] = side * u[0]  # delta = side w^2 keeps its sign through its root; w changes sign there
+    if relative_slip(code, mode, side):
+        g[DELTADOT] = u[V1]  # as integrated: x1dot - x2dot of the physical state has lost its digits
 
 
 @kernel
@@ -223,10 +251,12 @@ def _event_at(code, c, mode, side, energy_limit, target, column, F, u0, s0, h, s
         return us[TIME] - target
     if column == DELTA and _regularised(side):
         return side * us[0]  # delta = side w^2 keeps its sign through its root; w changes sign there
+    if column == DELTADOT and relative_slip(code, mode, side):
+        return us[V1]
     if column == FORCE_RATE:
         force = _physical(code, c, mode, side, us, ys, fs)
     else:
-        _physical_state(side, us, ys)
+        _physical_state(code, mode, side, us, ys)
         force = math.nan
     return event_value(code, c, ys, fs, force, mode, energy_limit, column)
 
@@ -482,6 +512,9 @@ def _advance(code, c, mode, side, s, t_end, u, fu, y, f, force, h_abs, rtol, ato
             for j in range(5):
                 y_new[j] = u_new[j]
                 f_new[j] = fu_new[j]
+            if relative_slip(code, mode, side):
+                y_new[V1] = u_new[V1] + u_new[V2]
+                f_new[V1] = fu_new[V1] + fu_new[V2]
         else:
             force_new = _physical(code, c, mode, side, u_new, y_new, f_new)
             evaluations += 1
@@ -660,6 +693,9 @@ def run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count,
             if nsteps >= max_steps:
                 status, reason = TOO_MANY_STEPS, FAILED_STOP
                 break
+            if nsteps % POLL_STEPS == 0 and nsteps > 0 and interrupted():
+                status, reason = INTERRUPTED, FAILED_STOP
+                break
             h = min(rk4_step, t_end - t)
             rhs(code, c, y, mode, k1)
             for j in range(5):
@@ -722,8 +758,8 @@ def run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count,
     # figure gets a sample every sixteenth of the target's period
     flight_step = math.inf if save_kind != SAVE_STEPS else max_step / 2
     side = contact_side(code, c, y, mode)
-    _integration_state(side, y, 0.0, u)
-    _phase_tolerances(side, atol, atol_u)
+    _integration_state(code, mode, side, y, 0.0, u)
+    _phase_tolerances(code, mode, side, atol, atol_u)
     s = 0.0
     rhs_integration(code, c, u, mode, side, fu)
     nfev += 1
@@ -736,11 +772,18 @@ def run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count,
         flight.coefficients(c, u, s, K6)  # kept in K6 for the whole flight (it has no stages)
 
     stats = np.empty(2)
+    next_poll = np.int64(POLL_STEPS)  # _advance returns there (_ADV_LIMIT); resuming it changes no bit
     stiff = radau5.workspace(stiff_after)
+    pair_energy = stuck_pair_energy(c, y)  # read while stuck only
     while u[TIME] < t_end:
         if nsteps >= max_steps or n_ev >= max_events:
             status, reason = TOO_MANY_STEPS, FAILED_STOP
             break
+        if nsteps >= next_poll:
+            next_poll = nsteps + POLL_STEPS
+            if interrupted():
+                status, reason = INTERRUPTED, FAILED_STOP
+                break
         if radau5.failed(stiff):
             break
         next_sample = u[TIME] if save_kind == SAVE_STEPS else (
@@ -748,8 +791,8 @@ def run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count,
         stats[0], stats[1] = max_force, max_indentation
         result, s, h, h_abs, h_next, force, force_new, d_steps, d_fev = _advance(
             code, c, mode, side, s, t_end, u, fu, y, f, force, h_abs, rtol, atol_u, max_step, flight_step, w_floor,
-            energy_limit, next_sample, max_steps - nsteps, g_old, g_new, fired, K6, u_new, fu_new, y_new, f_new, stats,
-            stiff)
+            energy_limit, next_sample, min(max_steps, next_poll) - nsteps, g_old, g_new, fired, K6, u_new, fu_new,
+            y_new, f_new, stats, stiff)
         max_force, max_indentation = stats[0], stats[1]
         nsteps += d_steps
         nfev += d_fev
@@ -759,6 +802,8 @@ def run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count,
             status, reason = STEP_SIZE_COLLAPSE, FAILED_STOP
             break
         if result == _ADV_LIMIT:
+            if nsteps < max_steps:
+                continue  # at next_poll
             status, reason = TOO_MANY_STEPS, FAILED_STOP
             break
         # a step to look at (an event fired in it, a sample or the horizon falls in it); not accepted yet
@@ -885,18 +930,22 @@ def run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count,
                 _copy(u, u_r)
             t = s_restart if not _regularised(side) else u_r[TIME]
             _physical(code, c, mode, side, u_r, y_r, f_r)
+            if restart_col == STICK_BREAK and c[SPRINGS_] > 0 and c[RIGID_] == 0:
+                onto_stuck_orbit(c, pair_energy, y_r)
             kind, mode, action = transition(code, c, restart_col, y_r, mode, settle)
+            if kind == STICK:
+                pair_energy = stuck_pair_energy(c, y_r)
             _copy(y_r, y)
             force = rhs(code, c, y, mode, f)
             new_side = contact_side(code, c, y, mode)
-            _integration_state(new_side, y, t, u)
+            _integration_state(code, mode, new_side, y, t, u)
             s = t if not _regularised(new_side) else 0.0
             rhs_integration(code, c, u, mode, new_side, fu)
             nfev += 2
             radau5.reset(stiff)  # a new phase starts explicit
+            _phase_tolerances(code, mode, new_side, atol, atol_u)
             if new_side != side:  # the independent variable changes: a fresh initial step
                 side = new_side
-                _phase_tolerances(side, atol, atol_u)
                 h_abs = _phase_step(code, c, mode, side, u, fu, rtol, atol_u, t_end, max_step, w_floor, tmp6, fu_new)
                 nfev += 1
             else:
@@ -1032,12 +1081,17 @@ def run_block(code, C, Y0, t_end, rtol, ATOL, max_step, settle, stop_kind, stop_
     """Runs ``start..stop-1`` of a batch, without the GIL (callers run blocks in threads; each run's
     numbers depend on nothing else). Fills ``summary`` (n, N_SUMMARY) and the first ``capacity``
     stick points of each run; ``st_count`` holds each run's full number of stick points. Threads
-    over blocks, not a compiled parallel loop: that would compile the driver a second time."""
+    over blocks, not a compiled parallel loop: that would compile the driver a second time. On
+    Ctrl-C or SIGTERM the rest of the block is left with the status ``interrupted``."""
     empty = np.empty(0)
     c = np.empty(C.shape[1])
     y0 = np.empty(Y0.shape[1])
     atol = np.empty(ATOL.shape[1])
     for i in range(start, stop):
+        if (i - start) % POLL_RUNS == POLL_RUNS - 1 and interrupted():
+            for j in range(i, stop):
+                summary[j, S_STATUS] = INTERRUPTED
+            break
         # the run reads its own copies: a row of the shared batch arrays would share their reference
         # count, which run (an allocating function) updates, between the threads (a contended cache line)
         _copy(C[i], c)
@@ -1049,5 +1103,9 @@ def run_block(code, C, Y0, t_end, rtol, ATOL, max_step, settle, stop_kind, stop_
         _copy(s, summary[i])
         permanent = s[S_OUTCOME] == PERMANENT_STICK
         st_count[i] = stick_points(out[1], s[S_T_STOP], permanent, st_t[i], st_delta[i], st_dwell[i])
+        if s[S_STATUS] == INTERRUPTED:
+            for j in range(i + 1, stop):
+                summary[j, S_STATUS] = INTERRUPTED
+            break
 
 

@@ -17,6 +17,9 @@ The argument types below are the ones the driver calls the kernels with:
 ``tests/test_precompile.py`` compiles from an empty cache and checks that no kernel is compiled
 twice and that this process compiles none of the helper's. ``PHASEIMPACT_COMPILE_PROCESSES=1``
 (the default on a single core) turns the helper off.
+
+The first compile says so on stderr, once per process and only on a cache miss (:func:`announce`);
+:func:`warmup` (``phaseimpact warmup``) compiles every entry the commands use ahead of time.
 """
 
 from __future__ import annotations
@@ -26,18 +29,20 @@ import os
 import subprocess
 import sys
 import tempfile
+import time
 import warnings
 from pathlib import Path
 
 from numba import typeof, types
 from numba.core import event
 
+from .._jit import PROCESSES_VARIABLE, cache_info, mark_complete, processes
 from . import dop853, driver, flight, radau5
 
-__all__ = ["HELPER_PART", "LOCAL_PART", "compile_part", "processes"]
+__all__ = ["HELPER_PART", "LOCAL_PART", "compile_part", "processes", "announce", "warmup", "PROCESSES_VARIABLE"]
 
-#: Environment variable: the number of processes of a first-ever compile (1 or 2).
-PROCESSES_VARIABLE = "PHASEIMPACT_COMPILE_PROCESSES"
+#: Set in the helper's environment: it compiles silently (its output is read only if it fails).
+_HELPER_VARIABLE = "PHASEIMPACT_COMPILE_HELPER"
 #: A helper that has not finished by then is abandoned (this process compiles what it needs itself).
 HELPER_TIMEOUT = 600.0
 
@@ -76,8 +81,8 @@ LOCAL_PART = (
     (driver._summarize, "I V V V I I I F F F IV I M I I"),
     (driver._events, "I V I I F V V V F V"),
     (driver._quiet_start, "I V I V"),
-    (driver._integration_state, "I V F V"),
-    (driver._phase_tolerances, "I V V"),
+    (driver._integration_state, "I I I V F V"),
+    (driver._phase_tolerances, "I I I V V"),
     (driver._push_event, "M I F I I V F"),
     (driver._push_sample, "M I F V I F"),
     (driver.stick_points, "M F B V V V"),
@@ -90,18 +95,6 @@ LOCAL_PART = (
 
 
 _HELPER = f"import {__name__} as part; part.compile_part(part.HELPER_PART)"
-
-
-def processes() -> int:
-    """How many processes a first-ever compile uses: ``PHASEIMPACT_COMPILE_PROCESSES`` (1 or 2),
-    by default 2 when this process may run on two cores."""
-    value = os.environ.get(PROCESSES_VARIABLE, "")
-    if value:
-        if value not in ("1", "2"):
-            raise ValueError(f"{PROCESSES_VARIABLE} = {value!r} is out of range; allowed: 1 or 2")
-        return int(value)
-    cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1
-    return 2 if cores >= 2 else 1
 
 
 def compile_part(part) -> None:
@@ -121,7 +114,7 @@ def _start_helper():
     """The helper process and the file its error output goes to (None if it cannot start)."""
     # the helper imports this very package, wherever this process found it
     root = str(Path(__file__).resolve().parents[2])
-    env = {**os.environ, PROCESSES_VARIABLE: "1",
+    env = {**os.environ, PROCESSES_VARIABLE: "1", _HELPER_VARIABLE: "1",
            "PYTHONPATH": os.pathsep.join(filter(None, (root, os.environ.get("PYTHONPATH"))))}
     errors = tempfile.TemporaryFile("w+")  # a file, not a pipe: nothing reads it while this process compiles
     try:
@@ -153,14 +146,38 @@ def _join(helper: subprocess.Popen, errors) -> None:
                           f"its part in this process:\n{tail}", RuntimeWarning, stacklevel=3)
 
 
+def announce() -> str:
+    """The line a first compile writes on stderr (it depends on where the cache is)."""
+    info = cache_info()
+    if info.path is None:
+        return (f"phaseimpact: compiling the engine for this process, ~20 s (nothing is cached: {info.reason}; "
+                "set NUMBA_CACHE_DIR to a writable directory to compile once)")
+    if not info.writable:
+        return f"phaseimpact: compiling part of the engine for this process (the cache {info.path} is read-only)"
+    return f"phaseimpact: compiling the engine once for this machine, ~20 s (cache: {info.path})"
+
+
+def _is_entry(dispatcher) -> bool:
+    """A run loop of the driver, called from Python: what compiles the engine on a cold cache (a
+    kernel called from Python, as the tests do, compiles in a second)."""
+    return (getattr(dispatcher.py_func, "__module__", "") == driver.__name__
+            and not dispatcher.targetoptions.get("no_cpython_wrapper", False))
+
+
 class _FirstCompile(event.Listener):
-    """Splits the first compile of an entry over two processes (once per process)."""
+    """Says that the engine compiles, and splits the first compile of an entry over two processes
+    (each once per process)."""
 
     def __init__(self):
         self.done = False
+        self.announced = bool(os.environ.get(_HELPER_VARIABLE))
 
     def on_start(self, ev):
-        if self.done or ev.data["dispatcher"] not in (driver.run, driver.run_block):
+        dispatcher = ev.data["dispatcher"]
+        if not self.announced and _is_entry(dispatcher):
+            self.announced = True
+            print(announce(), file=sys.stderr, flush=True)
+        if self.done or dispatcher not in (driver.run, driver.run_block):
             return
         self.done = True
         if processes() < 2:
@@ -177,3 +194,40 @@ class _FirstCompile(event.Listener):
 event.register("numba:compile", _FirstCompile())
 
 
+def _cache_files(path: Path | None) -> tuple[int, int]:
+    if path is None or not path.is_dir():
+        return 0, 0
+    files = [f for f in path.rglob("*") if f.suffix in (".nbi", ".nbc")]
+    return len(files), sum(f.stat().st_size for f in files)
+
+
+def warmup() -> dict:
+    """Compile (or load) every entry the commands use, each law, integrator and output, and mark
+    the cache complete, so that other users of a shared install read it.
+
+    Returns where the cache is (``cache``: a path or None, ``writable``, ``reason`` when there is
+    none), ``compiled`` (whether anything was compiled here), ``seconds``, and the cache's ``files``
+    and ``bytes``."""
+    from ..model import law_variants
+    from ..parameters import seed_parameters
+    from .api import simulate, simulate_many
+
+    info = cache_info()
+    start = time.perf_counter()
+    before = driver.run.stats.cache_misses.copy(), driver.run_block.stats.cache_misses.copy()
+    p = seed_parameters(v=1.0, kappa=3e9)
+    stiff = p.replace(kappa=1e14, v=5.0)  # the stiff (Radau) path
+    for law in law_variants():
+        simulate(p, law, 2e-3)
+        simulate_many([p, stiff], law, 2e-3)
+    simulate(p, "paper", None, stop_on="slip")
+    simulate(stiff, "paper", 2e-3)
+    simulate(p, "paper", 2e-4, integrator="rk4")
+    simulate(p, "hunt-crossley", 2e-3, save="steps")
+    simulate_many([p, p.replace(kappa=1e12)], "paper", n_threads=2)
+    compiled = (driver.run.stats.cache_misses, driver.run_block.stats.cache_misses) != before
+    mark_complete()
+    files, size = _cache_files(info.path)
+    return {"cache": None if info.path is None else str(info.path), "writable": info.writable,
+            "source": info.source, "reason": info.reason or None, "compiled": compiled,
+            "seconds": time.perf_counter() - start, "files": files, "bytes": size}

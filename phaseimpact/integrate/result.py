@@ -67,6 +67,8 @@ def run_message(status: str, reason: str, t_stop: float, outcome: str) -> str:
         return f"stopped at t = {t_stop:.6g} s: the step or event limit was reached"
     if status == "non-finite":
         return f"the state became non-finite after t = {t_stop:.6g} s"
+    if status == "interrupted":  # Ctrl-C or SIGTERM; simulate raises, this is for runs read directly
+        return f"interrupted at t = {t_stop:.6g} s (Ctrl-C or SIGTERM)"
     if reason == "runaway":
         return f"the energy doubled at t = {t_stop:.6g} s: the contact force feeds the motion ({outcome})"
     if reason == "settled":

@@ -9,8 +9,6 @@ from .rhs import (
     WORK,
     X1,
     X2,
-    contact_force_of_states,
-    energy_of_states,
     initial_state,
     jacobian,
     pack,
@@ -19,5 +17,5 @@ from .rhs import (
 __all__ = [
     "CONTACT_READINGS", "LAWS", "PLAIN", "REGISTRY", "STUCK", "ContactLaw", "LawEntry", "as_law",
     "law_variants", "hunt_crossley_restitution", "kappa_for_restitution", "V1", "V2", "WORK", "X1", "X2",
-    "contact_force_of_states", "energy_of_states", "initial_state", "jacobian", "pack",
+    "initial_state", "jacobian", "pack",
 ]

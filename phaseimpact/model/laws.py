@@ -65,6 +65,12 @@ def _sign(x):
     return 1.0 if x > 0 else (-1.0 if x < 0 else 0.0)
 
 
+@kernel(inline="always")
+def is_filippov(code):
+    """Whether the law's sign factor needs stick/slip modes (``paper``)."""
+    return code == PAPER_PRINTED or code == PAPER_UNILATERAL
+
+
 @kernel(python=True)
 def contact_force(code, delta, deltadot, mode, K, damping, alpha):
     """Contact force ``P`` (N, positive pushing the bodies apart) while slipping or free.

@@ -1,0 +1,52 @@
+"""Environment variables that phaseimpact reads, checked before anything else reads them.
+
+``SOURCE_DATE_EPOCH`` (reproducible builds: the ``created`` time of an archive) is also read by
+NumPy's f2py when SciPy imports it, and a value that is not an integer crashes that import with a
+traceback from inside NumPy. The package hides a bad value while it imports its dependencies
+(:func:`hide_bad_source_date_epoch`, :func:`restore_source_date_epoch`), so that phaseimpact's own
+check refuses it with a message: the command line at once, an archive when it is written.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+
+__all__ = ["EPOCH_MAX", "source_date_epoch", "hide_bad_source_date_epoch", "restore_source_date_epoch"]
+
+VARIABLE = "SOURCE_DATE_EPOCH"
+#: The last second a timestamp can hold (9999-12-31T23:59:59 UTC), s since 1970.
+EPOCH_MAX = 253_402_300_799
+
+
+def source_date_epoch() -> int | None:
+    """``SOURCE_DATE_EPOCH`` as seconds since 1970-01-01 UTC, or None when it is not set.
+
+    Raises
+    ------
+    ValueError
+        Naming the variable, its value and the allowed range (digits only, as ``date +%s`` prints).
+    """
+    text = os.environ.get(VARIABLE, "").strip()
+    if not text:
+        return None
+    if not re.fullmatch(r"[0-9]+", text) or int(text) > EPOCH_MAX:
+        raise ValueError(f"{VARIABLE} = {text!r} is out of range; allowed: an integer number of seconds since "
+                         f"1970-01-01 UTC, 0 <= {VARIABLE} <= {EPOCH_MAX} (the year 9999), as 'date +%s' prints "
+                         "it, or unset")
+    return int(text)
+
+
+def hide_bad_source_date_epoch() -> str | None:
+    """Remove a bad ``SOURCE_DATE_EPOCH`` from the environment and return it (None if fine)."""
+    try:
+        source_date_epoch()
+    except ValueError:
+        return os.environ.pop(VARIABLE)
+    return None
+
+
+def restore_source_date_epoch(value: str | None) -> None:
+    """Put back what :func:`hide_bad_source_date_epoch` removed."""
+    if value is not None:
+        os.environ[VARIABLE] = value

@@ -1,0 +1,127 @@
+"""Counts that check themselves: stick counts of ``paper`` near the critical damping, confirmed by
+two physical invariants and by a re-run at a tighter tolerance (docs/physics.md §5).
+
+Near ``kappa_c`` a slip's relative speed is 1e-7 to 1e-12 of the impact speed and a run makes
+thousands of stick phases, so a count is the most fragile number the tool reports. A count is
+reported as confirmed only when
+
+* the run keeps the invariants of eq. 8 (:func:`stick_sequence_violation`), and
+* a re-run at :func:`tighter` tolerance gives the same count, also within its invariants.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..integrate import simulate
+from ..integrate.events import EVENT_KINDS
+
+__all__ = ["CONFIRM_FACTOR", "ConfirmedCount", "confirmed_count", "stick_sequence_violation", "tighter"]
+
+_STICK, _SLIP, _REVERSAL = (EVENT_KINDS.index(k) for k in ("stick", "slip", "reversal"))
+_ESCAPES = ("ratchet-escape", "runaway", "rebound")
+#: A count is re-run at the tolerance divided by this (not below the smallest allowed, 1e-13).
+CONFIRM_FACTOR = 100.0
+_RTOL_FLOOR = 1e-13
+
+
+def tighter(rtol: float) -> float:
+    """The tolerance a count is confirmed at."""
+    return max(rtol / CONFIRM_FACTOR, _RTOL_FLOOR)
+
+
+def stick_sequence_violation(trajectory) -> str | None:
+    """Why the stick phases of a ``paper`` run cannot be the motion of eq. 8, or None.
+
+    Two invariants hold whatever the tolerance:
+
+    * a slip from one stick to the next (no reversal between) moves ``delta`` in the direction of
+      its mode: an outward slip (``deltadot > 0``) re-sticks deeper, an inward one shallower
+      (to the rounding of ``delta``);
+    * the break of the first stick is followed by a second stick: the first slip above
+      ``kappa_c`` goes deeper and is damped, so an escape right after it is a missed re-stick;
+    * a run that ends slipping has ``deltadot`` of its mode's sign (else its zero was stepped over).
+    """
+    kinds = trajectory.event_kind
+    y = trajectory.event_y
+    delta = y[:, 0] - y[:, 1]
+    rounding = 16 * np.finfo(float).eps * (np.abs(y[:, 0]) + np.abs(y[:, 1]))
+    stuck_at, slip_mode = None, 0
+    for i, kind in enumerate(kinds):
+        if kind == _STICK:
+            if stuck_at is not None and slip_mode != 0 and \
+                    (delta[i] - delta[stuck_at]) * slip_mode < -(rounding[i] + rounding[stuck_at]):
+                direction = "shallower" if slip_mode > 0 else "deeper"
+                return (f"the slip of mode {slip_mode:+d} that began at t = {trajectory.event_t[stuck_at]:.9g} s "
+                        f"re-stuck {direction} than it stuck (delta {delta[stuck_at]:.12g} -> {delta[i]:.12g} m), "
+                        "against its direction")
+            stuck_at, slip_mode = i, 0
+        elif kind == _SLIP:
+            slip_mode = int(trajectory.event_mode[i])
+        elif kind == _REVERSAL:
+            slip_mode = 0  # a slip that reverses may end on either side
+    if trajectory.n_stick == 1 and np.any(kinds == _SLIP) and trajectory.outcome in _ESCAPES:
+        return "the first stick broke and the run escaped without a second stick (a missed re-stick)"
+    mode, final = trajectory.final_mode, trajectory.final_state
+    deltadot = final[2] - final[3]
+    if mode in (1, -1) and deltadot * mode < -16 * np.finfo(float).eps * (abs(final[2]) + abs(final[3])):
+        return f"the run ended slipping in mode {mode:+d} with deltadot = {deltadot:.3g} m/s of the other sign"
+    return None
+
+
+@dataclass(frozen=True)
+class ConfirmedCount:
+    """A stick count at one ``kappa`` and how far it can be trusted.
+
+    Attributes
+    ----------
+    n_stick : int
+        Stick phases at the run's tolerance (a lower bound if :attr:`cut`).
+    t_run : float or None
+        Escape time, s.
+    cut : bool
+        The horizon ended the run first.
+    confirmed : bool
+        The invariants hold and the re-run at :func:`tighter` tolerance gives the same count.
+    reason : str
+        Why not confirmed ("" when confirmed).
+    n_stick_tight : int or None
+        The count at the tighter tolerance (None if that run was not made or broke an invariant).
+    """
+
+    n_stick: int
+    t_run: float | None
+    cut: bool
+    confirmed: bool
+    reason: str = ""
+    n_stick_tight: int | None = None
+
+    @property
+    def disagree(self) -> bool:
+        """Not confirmed only because the two tolerances count differently (no invariant broken)."""
+        return self.n_stick_tight is not None and self.n_stick_tight != self.n_stick
+
+
+def _count(params, law, rtol):
+    run = simulate(params, law, None, rtol=rtol)
+    if run.status != "success":
+        return run, f"the run at rtol {rtol:g} failed: {run.message}"
+    return run, stick_sequence_violation(run)
+
+
+def confirmed_count(params, law, rtol: float) -> ConfirmedCount:
+    """Count the stick phases of ``paper`` at ``params`` and confirm the count (module docstring)."""
+    run, violation = _count(params, law, rtol)
+    if violation is not None:
+        return ConfirmedCount(run.n_stick, run.t_run, run.cut, False, violation)
+    tight = tighter(rtol)
+    check, violation = _count(params, law, tight)
+    if violation is not None:
+        return ConfirmedCount(run.n_stick, run.t_run, run.cut, False, f"at rtol {tight:g}: {violation}")
+    if check.n_stick != run.n_stick or check.cut != run.cut:
+        return ConfirmedCount(run.n_stick, run.t_run, run.cut, False,
+                              f"{run.n_stick} stick phases at rtol {rtol:g}, {check.n_stick} at rtol {tight:g}",
+                              check.n_stick)
+    return ConfirmedCount(run.n_stick, run.t_run, run.cut, True, "", check.n_stick)

@@ -1,0 +1,195 @@
+"""Where the compiled engine is kept (phaseimpact/_jit.py): keyed on its sources, so an edit is
+never run stale; never a crash where nothing can be written; and the commands that integrate
+nothing never import numba."""
+
+from __future__ import annotations
+
+import json
+import os
+import re
+import shutil
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+
+import pytest
+
+from phaseimpact import _jit
+
+ROOT = Path(__file__).resolve().parents[1]
+
+# One Hunt-Crossley run through the driver's cached machine code (the stale path of issue 22:
+# numba checked only driver.py, while the force is compiled into the driver from model/laws.py).
+RUN = r"""
+import json, sys
+import phaseimpact
+from phaseimpact import seed_parameters, simulate
+from phaseimpact._jit import cache_info
+r = simulate(seed_parameters(v=1.0, kappa=3e9), "hunt-crossley", 2e-3)
+print(json.dumps({"file": phaseimpact.__file__, "cache": str(cache_info().path), "max_force": r.max_force}))
+"""
+
+
+def _copy_package(destination: Path) -> Path:
+    # copy2 keeps the times, and nothing compiled comes along
+    shutil.copytree(ROOT / "phaseimpact", destination / "phaseimpact", copy_function=shutil.copy2,
+                    ignore=shutil.ignore_patterns("__pycache__"))
+    return destination / "phaseimpact"
+
+
+def _run(code: str, pythonpath: Path, **env) -> subprocess.CompletedProcess:
+    environment = {**os.environ, "PYTHONPATH": str(pythonpath), **env}
+    environment.pop("NUMBA_DISABLE_JIT", None)
+    # run from the copy's parent: the checkout in the working directory must not shadow it
+    return subprocess.run([sys.executable, "-c", code], cwd=pythonpath, env=environment, capture_output=True,
+                          text=True, timeout=900)
+
+
+def test_the_digest_covers_every_engine_file_and_only_those(tmp_path):
+    package = _copy_package(tmp_path)
+    before = _jit.engine_digest(package)
+    assert before == _jit.engine_digest(ROOT / "phaseimpact")
+    (package / "cli.py").write_text((package / "cli.py").read_text() + "\n# not compiled\n")
+    assert _jit.engine_digest(package) == before
+    rhs = package / "model" / "rhs.py"
+    rhs.write_text(rhs.read_text() + "\n# an edit\n")
+    assert _jit.engine_digest(package) != before
+
+
+@pytest.mark.slow
+def test_editing_a_kernel_in_a_copy_changes_the_next_run(tmp_path):
+    """Copy the package, run, double the Hertz power in model/laws.py (a kernel the driver inlines),
+    run again in a fresh process on the same cache root: the new force, not the cached one."""
+    import numpy as np
+
+    from phaseimpact import seed_parameters, simulate
+
+    expected = simulate(seed_parameters(v=1.0, kappa=3e9), "hunt-crossley", 2e-3).max_force  # warms the cache
+    package = _copy_package(tmp_path / "copy")
+    root = tmp_path / "cache"
+    # the copy's sources are the checkout's: start from the checkout's warm cache (only the edit compiles)
+    shutil.copytree(_jit.cache_info().path, root / _jit.cache_info().path.name)
+    first = _run(RUN, package.parent, NUMBA_CACHE_DIR=str(root))
+    assert first.returncode == 0, first.stderr[-3000:]
+    first = json.loads(first.stdout.strip().splitlines()[-1])
+    assert first["file"] == str(package / "__init__.py")
+    assert first["max_force"] == expected
+
+    laws = package / "model" / "laws.py"
+    text = laws.read_text()
+    edited = re.sub(r"(def hertz_power\(ad, alpha\):\n(?:    .*\n)*?)(    )(if alpha == 1\.5:)",
+                    r"\1\2return 2.0 * ad**alpha\n\2\3", text, count=1)
+    assert edited != text, "hertz_power's body was not found: update this test's edit"
+    laws.write_text(edited)
+    second = _run(RUN, package.parent, NUMBA_CACHE_DIR=str(root))
+    assert second.returncode == 0, second.stderr[-3000:]
+    assert "compiling the engine once for this machine" in second.stderr
+    second = json.loads(second.stdout.strip().splitlines()[-1])
+    assert second["cache"] != first["cache"]
+    # a stiffer force: a larger peak (doubling K raises it by about 2^(2/5))
+    assert second["max_force"] > 1.2 * first["max_force"]
+    assert np.isfinite(second["max_force"])
+
+
+def _info(monkeypatch, roots):
+    monkeypatch.setattr(_jit, "_roots", lambda: roots)
+    return _jit._choose()
+
+
+def test_the_first_writable_root_holds_the_cache_and_old_directories_are_pruned(tmp_path, monkeypatch):
+    root = tmp_path / "root"
+    for i in range(_jit.KEEP + 2):  # older directories of ours, and one that is not ours
+        old = root / f"phaseimpact-0.1-{i:016d}"
+        old.mkdir(parents=True)
+        (old / _jit._MARKER).touch()
+        os.utime(old / _jit._MARKER, (1e9 + i, 1e9 + i))
+    (root / "someone-elses").mkdir()
+    info = _info(monkeypatch, [(root, "test")])
+    assert info.writable and info.path.parent == root
+    assert info.path.name == f"phaseimpact-{_jit._version()}-{_jit.engine_digest()}"
+    left = sorted(p.name for p in root.iterdir())
+    kept = [f"phaseimpact-0.1-{i:016d}" for i in range(2, _jit.KEEP + 2)]  # the KEEP most recent
+    assert left == sorted([*kept, "someone-elses", info.path.name])
+
+
+def test_an_unwritable_root_falls_back_then_reads_a_complete_cache_then_caches_nothing(tmp_path, monkeypatch):
+    if os.geteuid() == 0:
+        pytest.skip("root writes anywhere: the unwritable case is run in test_a_read_only_install_...")
+    locked = tmp_path / "locked"
+    locked.mkdir()
+    user = tmp_path / "user"
+    locked.chmod(0o555)
+    try:
+        info = _info(monkeypatch, [(locked, "install"), (user, "per user")])
+        assert info.writable and info.source == "per user"
+        info = _info(monkeypatch, [(locked, "install")])
+        assert info.path is None and "is writable" in info.reason
+    finally:
+        locked.chmod(0o755)
+
+
+def _without_root_privileges() -> list[str] | None:
+    """A command prefix running as root without the right to ignore file permissions (a stand-in
+    for another user: this one can still read the interpreter under /root)."""
+    if os.geteuid() != 0 or shutil.which("setpriv") is None:
+        return None
+    caps = "-dac_override,-dac_read_search"
+    prefix = ["setpriv", f"--bounding-set={caps}", f"--inh-caps={caps}"]
+    if subprocess.run([*prefix, "true"], capture_output=True).returncode != 0:
+        return None
+    return prefix
+
+
+def test_a_read_only_install_with_no_home_never_crashes(tmp_path):
+    """Issue 22: installed by root, run by a user who can write neither the install nor a HOME."""
+    prefix = _without_root_privileges()
+    if prefix is None:
+        pytest.skip("needs root and setpriv to drop the right to write anywhere")
+    base = Path(tempfile.mkdtemp(prefix="phaseimpact-readonly-"))
+    try:
+        package = _copy_package(base)
+        for path in [base, *base.rglob("*")]:
+            path.chmod(0o555 if path.is_dir() else 0o444)
+        env = {k: v for k, v in os.environ.items() if k not in ("NUMBA_CACHE_DIR", "NUMBA_DISABLE_JIT")}
+        env.update(HOME=str(base / "home"), PYTHONPATH=str(base), PYTHONDONTWRITEBYTECODE="1")
+        env.pop("XDG_CACHE_HOME", None)
+
+        def run(*argv):
+            return subprocess.run([*prefix, sys.executable, *argv], cwd=base, env=env, capture_output=True,
+                                  text=True, timeout=600)
+        cases = run("-m", "phaseimpact.cli", "cases")
+        assert cases.returncode == 0 and "seed" in cases.stdout and cases.stderr == "", cases.stderr
+        # every compiled module imports (before: "cannot cache function ...: no locator available"),
+        # and a kernel compiles, for this process only
+        kernel = run("-c", "import json, phaseimpact.integrate.api; from phaseimpact.model import laws; "
+                           "from phaseimpact._jit import cache_info; "
+                           "print(json.dumps([laws.__file__, str(cache_info().path), "
+                           "laws.contact_force(2, 1e-5, 0.1, 1, 1e10, 3e9, 1.5)]))")
+        assert kernel.returncode == 0, kernel.stderr[-3000:]
+        file, cache, force = json.loads(kernel.stdout)
+        assert file == str(package / "model" / "laws.py") and cache == "None" and force > 0
+    finally:
+        for path in [base, *base.rglob("*")]:
+            path.chmod(0o755)
+        shutil.rmtree(base)
+
+
+def test_a_complete_cache_is_read_where_it_cannot_be_written(tmp_path, monkeypatch):
+    locked = tmp_path / "locked"
+    name = f"phaseimpact-{_jit._version()}-{_jit.engine_digest()}"
+    (locked / name).mkdir(parents=True)
+    (locked / name / _jit.COMPLETE).touch()
+    monkeypatch.setattr(_jit, "_writable", lambda path: False)
+    info = _info(monkeypatch, [(locked, "install"), (tmp_path / "user", "per user")])
+    assert info.path == locked / name and not info.writable
+
+
+@pytest.mark.parametrize("argv", [["cases"], ["params"], ["--version"], ["--help"], ["cases", "--json"]])
+def test_commands_that_integrate_nothing_import_no_numba(argv):
+    code = ("import sys\nfrom phaseimpact.cli import main\ntry:\n    main(sys.argv[1:])\nexcept SystemExit:\n"
+            "    pass\nsys.stdout.flush()\nprint('NUMBA' if 'numba' in sys.modules else 'NO-NUMBA', "
+            "'SCIPY' if 'scipy' in sys.modules else 'NO-SCIPY', file=sys.stderr)")
+    out = subprocess.run([sys.executable, "-c", code, *argv], capture_output=True, text=True, timeout=120, cwd=ROOT)
+    assert out.returncode == 0, out.stderr
+    assert out.stderr.strip().splitlines()[-1] == "NO-NUMBA NO-SCIPY"

@@ -1,0 +1,268 @@
+"""Ctrl-C and SIGTERM: a compiled run stops at its next look at the wakeup pipe (every
+``driver.POLL_STEPS`` steps) without changing any result; the command line ends with one line,
+exit 130 (SIGINT) or 143 (SIGTERM), no traceback, no crash and no ``.lock`` left.
+
+The commands run in subprocesses whose stderr is a terminal (so that their progress notes say when
+the work has begun); each signal is sent seconds after that note, on a warm numba cache, so that it
+lands inside the compiled run, and each command would run far longer than it is given.
+"""
+
+from __future__ import annotations
+
+import os
+import pty
+import signal
+import subprocess
+import sys
+import threading
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from phaseimpact import _signals, archive, seed_parameters, simulate, simulate_many
+from phaseimpact.integrate import api
+from phaseimpact.integrate import driver as d
+from phaseimpact.model import as_law, pack
+
+ROOT = Path(__file__).resolve().parents[1]
+#: A run of about 1.4e5 steps (a stiff Hunt-Crossley contact held to 50 ms).
+LONG = (seed_parameters(v=1e4, kappa=1e18), "hunt-crossley", 0.05)
+
+
+def _run_args(params, law, t_end):
+    """The arguments simulate gives driver.run (summary, settle)."""
+    law = as_law(law)
+    s = api.scales(params)
+    return (law.code, pack(params, law), api._initial(params, None), t_end, 1e-10, api._atol(params, 1e-10, None),
+            s.max_step, True, -1, 0, d.SAVE_SUMMARY, np.empty(0), api.MAX_STEPS, api.MAX_EVENTS, 0.0, 1,
+            api._stiff_after(True))
+
+
+@pytest.fixture
+def pipe():
+    """The wakeup pipe of this process; emptied afterwards (a byte left would wake later runs)."""
+    assert _signals._open_pipe() or _signals._FD.value >= 0
+    yield _signals._WRITE_FD
+    _signals._drain()
+    _signals.deferred.clear()
+
+
+def test_a_byte_in_the_pipe_stops_a_compiled_run_at_its_next_look(pipe):
+    args = _run_args(*LONG)
+    full = d.run(*args)[0]
+    assert full[d.S_NSTEPS] > 10 * d.POLL_STEPS and d.STATUSES[int(full[d.S_STATUS])] == "success"
+    os.write(pipe, b"\x02")
+    stopped = d.run(*args)[0]
+    assert d.STATUSES[int(stopped[d.S_STATUS])] == "interrupted" and d.OUTCOMES[int(stopped[d.S_OUTCOME])] == "failed"
+    assert stopped[d.S_NSTEPS] == d.POLL_STEPS  # the first look
+    # the RK4 loop looks too
+    rk4 = list(_run_args(seed_parameters(v=1.0, kappa=3e9), "hunt-crossley", 2e-3))
+    rk4[14] = 1e-8  # rk4_step: 2e5 steps
+    stopped = d.run(*rk4)[0]
+    assert d.STATUSES[int(stopped[d.S_STATUS])] == "interrupted" and stopped[d.S_NSTEPS] == d.POLL_STEPS
+
+
+def test_looking_changes_no_bit_and_an_old_byte_only_repeats_the_run(pipe):
+    """simulate returns through the looks unchanged (its step count crosses many of them); a byte
+    left by a signal already acted on (nothing deferred) makes it clear the pipe and run again."""
+    params, law, t_end = LONG
+    reference = simulate(params, law, t_end, save="steps")
+    assert reference.summary[d.S_NSTEPS] > 10 * d.POLL_STEPS
+    os.write(pipe, b"\x02")
+    again = simulate(params, law, t_end, save="steps")
+    np.testing.assert_array_equal(again.summary, reference.summary)
+    np.testing.assert_array_equal(again.samples, reference.samples)
+    np.testing.assert_array_equal(again.event_log, reference.event_log)
+    with pytest.raises(BlockingIOError):
+        os.read(_signals._FD.value, 1)  # cleared
+
+
+def test_a_batch_left_by_an_old_byte_is_run_again_and_identical(pipe):
+    seq = [seed_parameters(v=v, kappa=k) for v in (0.5, 1.0) for k in np.geomspace(1e9, 1e14, 80)]
+    reference = simulate_many(seq, "paper", n_threads=2)
+    for threads in (1, 2):
+        os.write(pipe, b"\x02")
+        again = simulate_many(seq, "paper", n_threads=threads)
+        for name in ("status", "outcome", "max_force", "n_stick", "t_stop"):
+            np.testing.assert_array_equal(getattr(again, name), getattr(reference, name))
+
+
+def test_run_block_marks_the_rest_of_its_block_interrupted(pipe):
+    seq = [seed_parameters(v=1.0, kappa=k) for k in np.geomspace(1e9, 1e14, 3 * d.POLL_RUNS)]
+    batch = api.pack_batch(seq, as_law("paper"), None, 1e-10)
+    n = len(batch)
+    summary = np.zeros((n, d.N_SUMMARY))
+    st = np.empty((3, n, 32))
+    count = np.empty(n, np.int64)
+    os.write(pipe, b"\x02")
+    d.run_block(batch.law.code, batch.C, batch.Y0, batch.t_end, 1e-10, batch.atol, batch.max_step, True, -1, 0,
+                api.MAX_STEPS, api.MAX_EVENTS, 0.0, api._stiff_after(True), 0, n, summary, st[0], st[1], st[2], count)
+    status = summary[:, d.S_STATUS]
+    assert np.all(status[:d.POLL_RUNS - 1] == d.SUCCESS) and np.all(status[d.POLL_RUNS - 1:] == d.INTERRUPTED)
+
+
+@pytest.mark.parametrize(("signum", "raised"), [(signal.SIGINT, KeyboardInterrupt),
+                                                (signal.SIGTERM, _signals.Terminated)])
+def test_a_signal_deferred_inside_numba_is_raised_after_the_run(pipe, signum, raised):
+    _signals.deferred.append(signum)
+    with pytest.raises(raised):
+        simulate(seed_parameters(v=1.0, kappa=3e9), "hunt-crossley", 2e-3)
+    assert not _signals.deferred
+    assert simulate(seed_parameters(v=1.0, kappa=3e9), "hunt-crossley", 2e-3).ok  # nothing left behind
+
+
+# ------------------------------------------------------------------------------------------------
+# Real signals, in subprocesses
+# ------------------------------------------------------------------------------------------------
+
+LIBRARY_SCRIPT = """
+import sys, time
+from phaseimpact import seed_parameters, simulate
+p = seed_parameters(v=1e4, kappa=1e18)
+simulate(p, "hunt-crossley", 1e-4)  # loads the compiled engine
+print("running", flush=True)
+start = time.perf_counter()
+try:
+    simulate(p, "hunt-crossley", 50.0)  # minutes of compiled work
+except KeyboardInterrupt as stop:
+    print(type(stop).__name__, round(time.perf_counter() - start, 3), flush=True)
+"""
+
+
+@pytest.fixture(scope="module")
+def warm():
+    """Load (or compile) the engine in this process, so that the subprocesses start from the cache."""
+    simulate(seed_parameters(v=1.0, kappa=3e9), "hunt-crossley", 2e-3)
+    simulate_many([seed_parameters(v=1.0, kappa=3e9)], "paper")
+
+
+def test_library_ctrl_c_inside_a_compiled_run_raises_keyboard_interrupt_within_a_second(warm):
+    proc = subprocess.Popen([sys.executable, "-c", LIBRARY_SCRIPT], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                            text=True, cwd=ROOT)
+    try:
+        assert proc.stdout.readline().strip() == "running"
+        time.sleep(2.0)  # well inside the run (the arguments are checked in microseconds)
+        sent = time.monotonic()
+        proc.send_signal(signal.SIGINT)
+        out, err = proc.communicate(timeout=120)
+        waited = time.monotonic() - sent
+    finally:
+        proc.kill()
+    assert proc.returncode == 0, err
+    name, seconds = out.split()
+    assert name == "KeyboardInterrupt" and float(seconds) > 1.5, out  # raised by the run's return, not before it
+    assert waited < 5.0 and err == ""
+
+
+class Command:
+    """A command line in a subprocess whose stderr is a terminal; lines are timestamped."""
+
+    def __init__(self, argv, cwd):
+        master, slave = pty.openpty()
+        self.lines: list[tuple[float, str]] = []
+        self.proc = subprocess.Popen([sys.executable, "-m", "phaseimpact.cli", *map(str, argv)], cwd=cwd,
+                                     stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=slave)
+        os.close(slave)
+        self._reader = threading.Thread(target=self._read, args=(master,), daemon=True)
+        self._reader.start()
+
+    def _read(self, fd):
+        buffer = b""
+        while True:
+            try:
+                chunk = os.read(fd, 4096)
+            except OSError:  # the terminal closed: the process is gone
+                chunk = b""
+            if not chunk:
+                break
+            buffer += chunk
+            *complete, buffer = buffer.split(b"\n")
+            self.lines += [(time.monotonic(), line.decode(errors="replace").rstrip("\r")) for line in complete]
+        if buffer:
+            self.lines.append((time.monotonic(), buffer.decode(errors="replace")))
+        os.close(fd)
+
+    def wait_for(self, text, timeout=300):
+        deadline = time.monotonic() + timeout
+        while not any(text in line for _, line in self.lines):
+            assert self.proc.poll() is None, f"ended before {text!r}: {self.lines}"
+            assert time.monotonic() < deadline, f"no {text!r} within {timeout} s: {self.lines}"
+            time.sleep(0.05)
+
+    def signal_and_wait(self, signum, timeout=60):
+        """Send ``signum``; returns (exit code, seconds to exit, stderr lines after the signal)."""
+        sent = time.monotonic()
+        self.proc.send_signal(signum)
+        try:
+            self.proc.wait(timeout)
+        finally:
+            self.proc.kill()
+        took = time.monotonic() - sent
+        self._reader.join(10)
+        return self.proc.returncode, took, [line for t, line in self.lines if t >= sent and line.strip()]
+
+
+def _interrupted_once(cmd, signum, note, delay, expect_code, expect_line, longer_than):
+    """The command ends within seconds of ``signum`` with ``expect_code`` and one line only."""
+    started = time.monotonic()
+    cmd.wait_for(note)
+    time.sleep(delay)
+    code, took, after = cmd.signal_and_wait(signum)
+    everything = "\n".join(line for _, line in cmd.lines)
+    assert code == expect_code, everything
+    assert len(after) == 1 and expect_line in after[0], everything
+    assert "Traceback" not in everything and "Error" not in everything, everything
+    assert took < 10.0, took
+    # the work it was stopped in would have lasted longer than it was given (its run was cut)
+    assert time.monotonic() - started < longer_than
+    return after[0]
+
+
+@pytest.mark.parametrize("signum", [signal.SIGINT, signal.SIGTERM])
+def test_simulate_stops_inside_its_compiled_run(tmp_path, warm, signum):
+    cmd = Command(["simulate", "--law", "hunt-crossley", "--kappa", "1e18", "--v", "1e4", "--t-end", "50"], tmp_path)
+    code, word = (130, "phaseimpact: interrupted") if signum == signal.SIGINT else (143, "phaseimpact: terminated")
+    _interrupted_once(cmd, signum, "integrating", 4.0, code, word, longer_than=60)
+
+
+def test_critical_stops_inside_its_compiled_runs(tmp_path, warm):
+    cmd = Command(["critical", "--v", "1e4"], tmp_path)
+    _interrupted_once(cmd, signal.SIGINT, "locating kappa_c", 4.0, 130, "phaseimpact: interrupted", longer_than=60)
+
+
+def test_portrait_of_twelve_panels_stops_and_leaves_no_lock(tmp_path, warm):
+    kappas = ",".join(f"{k:g}" for k in np.geomspace(1e17, 1e18, 12))
+    out = tmp_path / "p.png"
+    cmd = Command(["portrait", "--law", "hunt-crossley", "--v", "1e4", "--kappa", kappas, "--t-end", "10",
+                   "--out", out], tmp_path)
+    _interrupted_once(cmd, signal.SIGINT, "integrating 12", 4.0, 130, "phaseimpact: interrupted", longer_than=60)
+    assert sorted(p.name for p in tmp_path.iterdir()) == []  # no figure, no lock, no temporary file
+
+
+ATLAS = ["atlas", "--law", "paper", "--axis", "kappa=1e10:1e14:200:log", "--axis", "v=0.5:13:300", "--jobs", "1",
+         "--no-progress"]
+
+
+@pytest.mark.parametrize(("signum", "code", "word"), [(signal.SIGINT, 130, "interrupted"),
+                                                     (signal.SIGTERM, 143, "terminated (SIGTERM)")])
+def test_atlas_stops_with_the_resume_command_and_no_lock(tmp_path, warm, signum, code, word):
+    out = tmp_path / "a.h5"
+    cmd = Command([*ATLAS, "--out", out], tmp_path)
+    deadline = time.monotonic() + 300
+    while not out.exists():  # the first checkpoint: the work is under way
+        assert cmd.proc.poll() is None and time.monotonic() < deadline, cmd.lines
+        time.sleep(0.05)
+    time.sleep(0.5)
+    returned, took, after = cmd.signal_and_wait(signum)
+    everything = "\n".join(line for _, line in cmd.lines)
+    assert returned == code and took < 10.0, everything
+    assert len(after) == 1 and after[0].startswith(f"phaseimpact: {word}; "), everything
+    assert "Traceback" not in everything
+    line = after[0]
+    assert " points are saved in " in line and line.endswith(" --resume")
+    assert not Path(str(out) + ".lock").exists()
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["a.h5"]  # no lock, no temporary file
+    done = archive.load(out).done
+    assert 0 < np.count_nonzero(done) < done.size
