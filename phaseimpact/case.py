@@ -422,6 +422,8 @@ def load_case(name_or_path) -> Case:
                              "(or give a path to a .toml file)")
         return _read_toml(shipped[text].read_text(encoding="utf-8"), f"{text}.toml")
     path = Path(name_or_path)
+    if path.exists() and not path.is_file():  # a FIFO would block the read forever
+        raise ValueError(f"{path}: not a regular file (a case file is a .toml file)")
     try:
         content = path.read_text(encoding="utf-8")
     except OSError as exc:

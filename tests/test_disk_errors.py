@@ -177,3 +177,11 @@ def test_a_fifo_or_a_device_is_refused_before_any_work(tmp_path, small_sweep, ar
     assert "not a regular file" in done.stderr
     assert sorted(p.name for p in tmp_path.iterdir()) == ["f.h5", "f.png", "s.h5"]  # no lock, no temporary file
     assert not Path("/dev/null.lock").exists()
+
+
+def test_a_case_file_that_is_a_fifo_is_refused(tmp_path):
+    fifo = tmp_path / "case.toml"
+    os.mkfifo(fifo)
+    done = _cli("params", "--case", str(fifo), cwd=tmp_path)  # reading a FIFO would wait: the timeout says it hung
+    assert done.returncode == 2, done.stderr
+    assert "not a regular file" in done.stderr and str(fifo) in done.stderr
