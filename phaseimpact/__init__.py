@@ -27,11 +27,13 @@ _EXPORTS = {
     "LAWS": "model", "ContactLaw": "model", "kappa_for_restitution": "model",
     "Geometry": "parameters", "Material": "parameters", "Parameters": "parameters",
     "derive_parameters": "parameters", "seed_parameters": "parameters",
+    "define_law": "model.userlaw", "check_law": "checks",
 }
 
 __all__ = [
     "Columns", "ContactLaw", "Event", "Geometry", "LAWS", "Material", "Parameters", "Trajectory",
-    "derive_parameters", "kappa_for_restitution", "scales", "seed_parameters", "simulate", "simulate_many",
+    "check_law", "define_law", "derive_parameters", "kappa_for_restitution", "scales", "seed_parameters",
+    "simulate", "simulate_many",
     "__version__",
 ]
 

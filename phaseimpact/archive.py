@@ -116,7 +116,6 @@ CHUNK_POINTS = 8192
 CHUNK_ROWS = 8192
 STOP_REASONS = _driver.STOP_REASONS
 _UNITS = {name: unit for name, _, _, unit in SUMMARY_COLUMNS}
-_DTYPES = {name: np.dtype(dtype) for name, _, dtype, _ in SUMMARY_COLUMNS}
 _CODES = {"status": STATUSES, "outcome": OUTCOMES, "stop_reason": STOP_REASONS}
 _LONG_NAMES = {
     "status": "numerical health of the run", "outcome": "outcome class (docs/physics.md section 5)",
@@ -240,16 +239,23 @@ def _udunits(text: str) -> str:
     return " ".join(words)
 
 
-def kappa_units(alpha: float) -> str:
-    """Units of the damping coefficient: ``N s m-(1+alpha)``, e.g. ``N s m-2.5`` for Hertz."""
+def kappa_units(alpha: float, law=None) -> str:
+    """Units of the damping coefficient set by ``kappa``, from the law's entry (e.g. ``N s m-2.5``
+    for ``(K + kappa deltadot) delta^alpha`` with Hertz, ``N s m-1.5`` for Kuwabara-Kono);
+    ``N s m-(1+alpha)`` without a law."""
+    if law is not None:
+        from .model.laws import as_law
+
+        return as_law(law).entry.damping_udunits(alpha)
     return f"N s m-{_g(1 + alpha)}"
 
 
-def axis_units(name: str, alpha: float) -> str:
-    """UDUNITS units of a grid axis or curve parameter (``alpha``: the base case's exponent)."""
+def axis_units(name: str, alpha: float, law=None) -> str:
+    """UDUNITS units of a grid axis or curve parameter (``alpha``: the base case's exponent;
+    ``law``: whose entry gives the damping's unit)."""
     from .case import SETTABLE
 
-    fixed = {"kappa": kappa_units(alpha), "K": f"N m-{_g(alpha)}", "v": "m s-1", "M1": "kg", "M2": "kg",
+    fixed = {"kappa": kappa_units(alpha, law), "K": f"N m-{_g(alpha)}", "v": "m s-1", "M1": "kg", "M2": "kg",
              "Kb": "N m-1", "Km": "N m-3", "alpha": "1", "R": "m"}
     if name in fixed:
         return fixed[name]
@@ -593,7 +599,7 @@ def _write_sweep(f, r: SweepResult, created: str, layout: _Layout, spare_rows: i
     for axis, dim in zip(grid.axes, dims, strict=True):
         d = f.create_dataset(dim, data=np.asarray(axis.values, dtype=float), **_CHECKED)
         d.make_scale(dim)
-        d.attrs["units"] = axis_units(axis.name, alpha)
+        d.attrs["units"] = axis_units(axis.name, alpha, r.law)
         d.attrs["long_name"] = axis.name
         d.attrs["parameter"] = axis.name
         d.attrs["log"] = np.int8(bool(axis.log))
@@ -657,13 +663,13 @@ def _write_curve(f, c: CriticalCurve, created: str) -> None:
     f.attrs["message"] = str(c.message)
     values = f.create_dataset(dim, data=np.asarray(c.values, dtype=float), **_CHECKED)
     values.make_scale(dim)
-    values.attrs["units"] = axis_units(c.param, alpha)
+    values.attrs["units"] = axis_units(c.param, alpha, c.law)
     values.attrs["long_name"] = c.param
     values.attrs["parameter"] = c.param
     for name in ("kappa", "closed_form", "predicted"):
         d = f.create_dataset(name, data=np.asarray(getattr(c, name), dtype=float), **_CHECKED)
         d.attrs["_FillValue"] = np.float64(np.nan)
-        d.attrs["units"] = kappa_units(alpha)
+        d.attrs["units"] = kappa_units(alpha, c.law)
         d.attrs["long_name"] = {"kappa": c.what, "closed_form": "closed-form kappa_c (docs/physics.md section 5)",
                                 "predicted": "the continuation's prediction"}[name]
         d.dims[0].attach_scale(values)

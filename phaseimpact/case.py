@@ -145,9 +145,9 @@ _CASES_PACKAGE = "phaseimpact.cases"
 def _laws() -> tuple:
     # Imported late: the engine (model) is not needed to describe a case, and importing it here
     # would tie case files to the engine's import time.
-    from .model import LAWS
+    from .model import REGISTRY  # the shipped laws and any defined before (--law-file, define_law)
 
-    return tuple(LAWS)
+    return tuple(REGISTRY)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -235,17 +235,18 @@ def _check_read_by_law(impact: dict) -> None:
 
     law, e, kappa = impact["law"], impact["restitution"], impact["kappa"]
     entry = REGISTRY[law]
-    if e is not None and entry.damping != "restitution" and law != "hunt-crossley":
+    if e is not None and entry.damping != "restitution" and not entry.inverse:
         raise ValueError(f"impact.restitution = {e!r} is not read by law {law!r}; allowed: restitution with "
-                         "hunt-crossley or a restitution law ("
+                         + ", ".join(n for n, x in REGISTRY.items() if x.inverse) + " or a restitution law ("
                          + ", ".join(n for n, x in REGISTRY.items() if x.damping == "restitution") + ")")
     if kappa != 0 and not (entry.damping == "kappa" and e is None):
         source = "its damping comes from impact.restitution" if e is not None or entry.damping else "it is undamped"
         raise ValueError(f"impact.kappa = {kappa!r} is not read by law {law!r} ({source}); allowed: no kappa "
-                         "with this law, or kappa with paper or hunt-crossley (without restitution)")
-    if impact["contact"] != "printed" and not entry.filippov:
+                         "with this law, or kappa with "
+                         + ", ".join(n for n, x in REGISTRY.items() if x.damping == "kappa") + " (without restitution)")
+    if impact["contact"] != "printed" and "contact" not in entry.options:
         raise ValueError(f"impact.contact = {impact['contact']!r} is not read by law {law!r}; allowed: contact "
-                         "with law paper")
+                         "with law " + ", ".join(n for n, x in REGISTRY.items() if "contact" in x.options))
 
 
 # ---------------------------------------------------------------------------------------------

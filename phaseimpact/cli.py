@@ -32,10 +32,11 @@ import numpy as np
 from . import __version__
 from ._atomic import check_target, exclusive
 from .case import QUANTITIES, SETTABLE, setting_name
-from .model import LAWS
 from .parameters import KAPPA_MAX, TARGETS, V_RANGE
 
 EXIT_OK, EXIT_FAILURE, EXIT_USAGE, EXIT_INTERRUPTED = 0, 1, 2, 130
+#: A reader that went away (``| head``): what a POSIX tool killed by SIGPIPE reports (128 + 13), not a failure.
+EXIT_BROKEN_PIPE = 141
 
 #: Relative width of kappa_c's bracket (critical, critical-curve), or of a transition's location.
 KAPPA_RTOL_RANGE = (1e-14, 1e-2)
@@ -52,7 +53,6 @@ DEFAULT_SAMPLES = 96
 MAX_PANELS = 12
 MAX_JOBS = 4 * (os.cpu_count() or 1)
 BACKENDS = ("threads", "loky", "dask")
-#: Seconds to wait for a Dask scheduler before giving up.
 #: Statuses of critical_damping that are answers (anything else is a failure: exit 1).
 CRITICAL_ANSWERS = ("success", "not-found", "unconfirmed")
 #: What a critical curve continues.
@@ -343,20 +343,27 @@ def _resolve_law(args, impact: dict):
     restitution_laws = [n for n, entry in REGISTRY.items() if entry.damping == "restitution"]
     settings = _setting_names(args)
     contact_given = _given(args, "contact") or "contact" in settings
-    if contact_given and name != "paper":
+    if name not in REGISTRY:
+        raise ValueError(f"law = {name!r} is not a registered law; allowed: {', '.join(REGISTRY)} (or a law of "
+                         "--law-file FILE.py)")
+    entry = REGISTRY[name]
+    readers = [n for n, x in REGISTRY.items() if "contact" in x.options]
+    if contact_given and "contact" not in entry.options:
         raise ValueError(f"contact = {impact['contact'] if 'contact' in settings else args.contact!r} is not read by "
-                         f"law {name!r}; allowed: --contact with law paper")
-    contact = args.contact if _given(args, "contact") else (impact["contact"] if name == "paper" else "printed")
+                         f"law {name!r}; allowed: --contact with law {', '.join(readers)}")
+    contact = args.contact if _given(args, "contact") else (impact["contact"] if "contact" in entry.options
+                                                            else "printed")
     # a value given by --set is the user's as much as an option's: refused where the law ignores it
     kappa_given = _given(args, "kappa") or "kappa" in settings
     restitution = getattr(args, "restitution", None)
     if restitution is None and "restitution" in settings:
         restitution = impact["restitution"]
-    if restitution is not None and name == "abrate":
-        raise ValueError(f"restitution = {restitution!r} is not read by law 'abrate' (undamped Hertz contact); "
-                         "allowed: --restitution with hunt-crossley or a restitution law")
+    inverse_laws = [n for n, x in REGISTRY.items() if x.inverse]
+    if restitution is not None and entry.damping != "restitution" and not entry.inverse:
+        raise ValueError(f"restitution = {restitution!r} is not read by law {name!r} ({entry.description}); "
+                         f"allowed: --restitution with {', '.join(inverse_laws)} or a restitution law")
     if restitution is None and impact["restitution"] is not None and not kappa_given and (
-            name in restitution_laws or name == "hunt-crossley"):
+            name in restitution_laws or entry.inverse):
         restitution = impact["restitution"]  # the case's: its law reads it
     if restitution is None and name in restitution_laws:
         lo, hi = RESTITUTION_RANGE
@@ -367,7 +374,7 @@ def _resolve_law(args, impact: dict):
         source = "its damping comes from the restitution" if law.damping_source == "restitution" else "it is undamped"
         raise ValueError(f"kappa = {impact['kappa']!r} is not read by law {law.label()!r} ({source}); allowed: "
                          + ("--kappa or --restitution, not both" if restitution is not None
-                            else "--kappa with paper or hunt-crossley"))
+                            else "--kappa with " + ", ".join(n for n, x in REGISTRY.items() if x.damping == "kappa")))
     check_attainable(law)
     return law
 
@@ -483,6 +490,29 @@ def cmd_cases(args) -> int:
     return EXIT_OK
 
 
+def cmd_check_law(args) -> int:
+    from .checks import check_law
+    from .model import REGISTRY, law_variants
+
+    if args.law.endswith(".py"):
+        from .model.userlaw import load_law_file
+
+        names = load_law_file(args.law)
+    elif args.law in REGISTRY:
+        names = [args.law]
+    else:
+        raise ValueError(f"law = {args.law!r} is neither a registered law nor a .py file; allowed: "
+                         f"{', '.join(REGISTRY)} or FILE.py")
+    reports = [check_law(law) for law in law_variants(names)]
+    if args.json:
+        _print_json([{"law": r.law, "passed": r.passed,
+                      "checks": [{"check": v.check, "passed": v.passed, "detail": v.detail} for v in r.verdicts]}
+                     for r in reports])
+    else:
+        print("\n".join(str(r) for r in reports))
+    return EXIT_OK if all(r.passed for r in reports) else EXIT_FAILURE
+
+
 def cmd_warmup(args) -> int:
     from .integrate.precompile import warmup
 
@@ -557,7 +587,8 @@ def cmd_simulate(args) -> int:
     trajectory = simulate(p, law, args.t_end, rtol=args.rtol)
     q = impact_quantities(trajectory)
     t_stick, delta_stick, dwell = trajectory.stick_points()
-    out = {**_law_fields(setup), "v": p.v, "kappa": law.kappa(p), "target": p.target,
+    out = {**_law_fields(setup), "v": p.v, "kappa": law.kappa(p), "kappa_unit": law.damping_unit(p.alpha),
+           "target": p.target,
            "status": trajectory.status, "stop_reason": trajectory.stop_reason, "message": trajectory.message,
            "t_end": trajectory.t_end, "t_stop": trajectory.t_stop, **q.as_dict(),
            **_contact_reading(trajectory, setup),
@@ -572,7 +603,7 @@ def cmd_simulate(args) -> int:
         _print_json(out)
     else:
         print(f"{law.label()} on a {p.target} target ({setup.case.name}), v = {p.v:g} m/s, "
-              f"kappa = {out['kappa']:.4g} {KAPPA_UNIT}")
+              f"{law.entry.damping_name} = {out['kappa']:.4g} {law.damping_unit(p.alpha)}")
         print(f"  status: {trajectory.status} ({trajectory.message})")
         units = {"max_force": "N", "max_indentation": "m", "contact_duration": "s", "restitution": "",
                  "time_equal_displacement": "s", "dissipated_energy": "J", "loop_area": "J",
@@ -604,7 +635,8 @@ def cmd_fixed_points(args) -> int:
     setup = _setup(args)
     law, p = setup.law, setup.params
     found = fixed_points(p, law)
-    out = {**_law_fields(setup), "v": p.v, "kappa": law.kappa(p), "target": p.target,
+    out = {**_law_fields(setup), "v": p.v, "kappa": law.kappa(p), "kappa_unit": law.damping_unit(p.alpha),
+           "target": p.target,
            "equilibria": [e.as_dict() for e in found], "case": setup.case.as_dict()}
     if args.json:
         _print_json(out)
@@ -651,10 +683,11 @@ def cmd_critical(args) -> int:
     if args.json:
         _print_json(out)
     else:
-        kc = "not found" if result.kappa_c is None else f"{result.kappa_c:.10g} {KAPPA_UNIT}"
+        unit = law.damping_unit(params.alpha)
+        kc = "not found" if result.kappa_c is None else f"{result.kappa_c:.10g} {unit}"
         print(f"critical damping of {law.label()} ({setup.case.name}) at v = {params.v:g} m/s: {kc}")
-        print(f"  closed form {_fmt(result.closed_form, KAPPA_UNIT)}; kappa_2 (N = 2 from here on) "
-              f"{_fmt(result.kappa_2, KAPPA_UNIT, '.10g')}; classification {result.classification or 'none'}")
+        print(f"  closed form {_fmt(result.closed_form, unit)}; kappa_2 (N = 2 from here on) "
+              f"{_fmt(result.kappa_2, unit, '.10g')}; classification {result.classification or 'none'}")
         if result.n_staircase:
             steps = [("?" if s["n_stick"] is None else f"{s['n_stick']}") + ("+" if s["cut"] else "")
                      for s in result.n_staircase]
@@ -708,7 +741,7 @@ def cmd_transitions(args) -> int:
         _print_json(out)
     else:
         print(f"transitions of {law.label()} ({setup.case.name}) at v = {params.v:g} m/s, kappa in "
-              f"[{args.kappa_min:g}, {args.kappa_max:g}] {KAPPA_UNIT} (counts: {count})")
+              f"[{args.kappa_min:g}, {args.kappa_max:g}] {law.damping_unit(params.alpha)} (counts: {count})")
         for t in found:
             above = "unbounded" if t.count_above is None else str(t.count_above)
             print(f"  {t.kind:<15} kappa = {t.kappa:.10g}   {t.count_below} -> {above}")
@@ -1226,11 +1259,16 @@ def build_parser() -> argparse.ArgumentParser:
                             f"{_settable_help()} (default: none)")
 
     def law_options(p, *, restitution=True, contact=True):
-        p.add_argument("--law", choices=LAWS, default=None,
+        from .model import REGISTRY  # the shipped laws and those of --law-file (loaded before parsing)
+
+        p.add_argument("--law", choices=tuple(REGISTRY), default=None,
                        help="contact law (default: the case's, else paper)")
+        p.add_argument("--law-file", default=None, metavar="FILE.py",
+                       help="a Python file that defines laws with phaseimpact.define_law (then --law NAME); see "
+                            "'phaseimpact check-law FILE.py' (default: none)")
         if contact:
             p.add_argument("--contact", choices=("printed", "unilateral"), default=None,
-                           help="law 'paper' only: read |delta|^alpha as printed (also in tension) or "
+                           help="Filippov laws (paper) only: read |delta|^alpha as printed (also in tension) or "
                                 "unilaterally (P = 0 for delta <= 0) (default: the case's, else printed)")
         if restitution:
             lo, hi = RESTITUTION_RANGE
@@ -1243,10 +1281,18 @@ def build_parser() -> argparse.ArgumentParser:
         p.add_argument("--v", type=_V, default=None, metavar="V",
                        help=f"impact speed, m/s, {v_lo:g} <= V <= {v_hi:g} (default: the case's, 1 for seed)")
 
-    def damping(p, read_by="read by paper and hunt-crossley only"):
+    def damping(p, read_by=None):
+        from .model import REGISTRY
+
+        readers = [n for n, x in REGISTRY.items() if x.damping == "kappa"]
+        units = {}
+        for n in readers:
+            units.setdefault(REGISTRY[n].damping_unit(1.5), []).append(n)
+        unit = "; ".join(f"{u} for {', '.join(names)}" for u, names in units.items())
+        read_by = read_by or f"read by {', '.join(readers)} only"
         p.add_argument("--kappa", type=_KAPPA, default=None,
-                       help=f"damping coefficient, {KAPPA_UNIT}, 0 <= KAPPA <= {KAPPA_MAX:g}; {read_by} "
-                            "(default: the case's, else 0)")
+                       help=f"damping coefficient in the law's unit (alpha = 3/2: {unit}), 0 <= KAPPA <= "
+                            f"{KAPPA_MAX:g}; {read_by} (default: the case's, else 0)")
 
     def target(p):
         p.add_argument("--target", choices=TARGETS, default=None,
@@ -1331,6 +1377,15 @@ def build_parser() -> argparse.ArgumentParser:
                                    "and cluster workers. On a warm cache it only loads.")
     json_option(p)
     p.set_defaults(func=cmd_warmup)
+
+    p = sub.add_parser("check-law", help="run the law conformance suite on a law or a law file",
+                       description="The checks every shipped law passes (force, partials against finite "
+                                   "differences, energy ledger, momentum, scipy and the test oracle), on a registered "
+                                   "law with each of its options, or on the laws a Python file defines with "
+                                   "phaseimpact.define_law. Exit code 1 when a check fails.")
+    p.add_argument("law", metavar="LAW|FILE.py", help="a registered law's name, or a Python file defining laws")
+    json_option(p)
+    p.set_defaults(func=cmd_check_law)
 
     p = add("params", "a case's derived parameters, Hertz scales and validity",
             "The derived parameters (seed eq. 3-5) of a case, its Hertz scales (contact time, plate period, "
@@ -1519,13 +1574,37 @@ def _stopped(stop: KeyboardInterrupt) -> str:
     return "terminated (SIGTERM)" if isinstance(stop, _signals.Terminated) else "interrupted"
 
 
+def _load_law_files(argv) -> list:
+    """Run the files of ``--law-file FILE.py`` (they register laws with phaseimpact.define_law);
+    return ``argv`` without them, so that every command takes them (``plot`` and ``info`` of an
+    archive of a user law too)."""
+    rest, i = [], 0
+    while i < len(argv):
+        arg = argv[i]
+        if arg == "--":
+            rest.extend(argv[i:])
+            break
+        path = arg.split("=", 1)[1] if arg.startswith("--law-file=") else (
+            argv[i + 1] if arg == "--law-file" and i + 1 < len(argv) else None)
+        if path is None:
+            rest.append(arg)
+            i += 1
+            continue
+        from .model.userlaw import load_law_file
+
+        load_law_file(path)
+        i += 1 if arg.startswith("--law-file=") else 2
+    return rest
+
+
 def main(argv=None) -> int:
     # Ctrl-C and SIGTERM, wherever they arrive (compiled runs included): one line, exit 130 or 143
     previous_term = signal.getsignal(signal.SIGTERM)
     try:
         argv = list(sys.argv[1:] if argv is None else argv)
+        parsed = _load_law_files(argv)  # before the parser: its --law choices include the file's laws
         parser = build_parser()
-        args = parser.parse_args(argv)
+        args = parser.parse_args(parsed)
         args.argv = argv
         if args.command not in _INTEGRATE_NOTHING:  # _signals imports numba (0.2 s): only where runs are stopped
             from . import _signals
@@ -1546,7 +1625,7 @@ def main(argv=None) -> int:
             os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         except (OSError, ValueError, AttributeError):
             pass
-        return EXIT_FAILURE
+        return EXIT_BROKEN_PIPE
     except OSError as error:  # the disk, not the input: full, gone, permissions changed under us
         print(f"phaseimpact: error: {error}", file=sys.stderr)
         return EXIT_FAILURE

@@ -23,7 +23,7 @@ import numpy as np  # noqa: E402
 
 from ._atomic import atomic_path  # noqa: E402
 
-__all__ = ["STYLE", "style", "figure", "plot_displacements", "plot_force", "plot_phase", "plot_hysteresis",
+__all__ = ["STYLE", "style", "figure", "plot_displacements", "plot_force", "plot_hysteresis",
            "mark_points", "save", "save_h5", "figure_format", "FIGURE_FORMATS", "UM", "MS", "OUTCOME_COLOURS",
            "axis_label", "plot_atlas", "plot_sweep", "plot_curve", "plot_portraits"]
 
@@ -92,23 +92,6 @@ def mark_points(ax, points, *, label="stick point", color="k", marker="o", scale
     if len(points):
         ax.plot(points[:, 0] * scale[0], points[:, 1] * scale[1], ls="none", marker=marker, mfc="none",
                 mec=color, ms=6, mew=1.2, label=f"{label} ({len(points)})")
-
-
-def plot_phase(ax, trajectory, plane=("delta", "deltadot"), *, mark_events=True, label=None, **kwargs):
-    """Phase path in ``plane`` (lengths in µm, velocities in m/s); stick points marked."""
-    from .analysis import find_asymptotic_points, plane_coordinates
-
-    a, b = plane_coordinates(trajectory.y, plane)
-    ax.plot(np.asarray(a) * UM, b, label=label, **kwargs)
-    names = {"delta": r"$\delta = x_1 - x_2$ (µm)", "deltadot": r"$\dot\delta$ (m/s)",
-             "x1": "$x_1$ (µm)", "x2": "$x_2$ (µm)", "x1dot": r"$\dot x_1$ (m/s)", "x2dot": r"$\dot x_2$ (m/s)"}
-    ax.set_xlabel(names.get(plane[0], plane[0]))
-    ax.set_ylabel(names.get(plane[1], plane[1]))
-    points = None
-    if mark_events and tuple(plane) == ("delta", "deltadot"):
-        points = find_asymptotic_points(trajectory, plane)
-        mark_points(ax, points.points, color=kwargs.get("color", "k"))
-    return points
 
 
 #: The formats :func:`save` writes, each with the metadata that keeps its bytes the same from run to
@@ -188,10 +171,21 @@ _UNITS = {"kappa": "N s/m$^{2.5}$", "v": "m/s", "M1": "kg", "M2": "kg", "K": "N/
 _SYMBOLS = {"kappa": r"$\kappa$", "v": "impact speed $v$", "alpha": r"$\alpha$"}
 
 
-def axis_label(name: str) -> str:
-    """``name (unit)`` for a parameter of an axis or a curve (SI units)."""
+def _damping_unit(law, base) -> str:
+    """The damping coefficient's unit from the law's entry, in mathtext (``N s/m$^{1.5}$``)."""
+    unit = law.damping_unit(getattr(base, "alpha", None) or getattr(getattr(base, "params", None), "alpha", 1.5))
+    head, _, power = unit.partition("^")
+    return f"{head}$^{{{power}}}$" if power else unit
+
+
+def axis_label(name: str, law=None, base=None) -> str:
+    """``name (unit)`` for a parameter of an axis or a curve (SI units); ``kappa`` is named and
+    united by ``law``'s entry when given (``base``: the case, for its exponent alpha)."""
     from .case import SETTABLE
 
+    if name == "kappa" and law is not None:
+        symbol = law.entry.damping_name
+        return f"{_SYMBOLS.get(symbol, '$' + chr(92) + symbol + '$')} ({_damping_unit(law, base)})"
     unit = _UNITS.get(name, SETTABLE.get(name, ("",))[0])
     unit = "" if unit in ("", "-", "1") else unit.replace("^3", "$^3$")
     text = _SYMBOLS.get(name, name)
@@ -260,8 +254,8 @@ def plot_atlas(result, *, contours: str | None = None, curves=()):
             ax.set_xscale("log")
         if ax1.log:
             ax.set_yscale("log")
-        ax.set_xlabel(axis_label(ax0.name))
-        ax.set_ylabel(axis_label(ax1.name))
+        ax.set_xlabel(axis_label(ax0.name, result.grid.law, result.grid.base))
+        ax.set_ylabel(axis_label(ax1.name, result.grid.law, result.grid.base))
         ax.grid(False)
         present = {names[i] for i in np.unique(codes)}
         if contours:
@@ -334,7 +328,7 @@ def plot_sweep(result):
             bottom.set_yscale("log")
         top.set_ylabel("stick phases $N$" if count_name == "n_stick" else "contacts")
         bottom.set_ylabel("max contact force (N)")
-        bottom.set_xlabel(axis_label(axis.name))
+        bottom.set_xlabel(axis_label(axis.name, result.grid.law, result.grid.base))
         present = set(outcomes[computed]) | ({"not computed"} if not computed.all() else set())
         extra = []
         if np.any(cut):
@@ -380,8 +374,8 @@ def plot_curve(curve):
         ax.set_yscale("log")
         if _geometric(x):
             ax.set_xscale("log")
-        ax.set_xlabel(axis_label(curve.param))
-        ax.set_ylabel(f"{what} (N s/m$^{{2.5}}$)")
+        ax.set_xlabel(axis_label(curve.param, curve.law, curve.base))
+        ax.set_ylabel(f"{what} ({_damping_unit(curve.law, curve.base)})")
         ax.legend()
         title = f"{curve.law.label()}, case {_case_name(curve.base)}"
         ax.set_title(title + (f"\n{curve.message}" if curve.message else ""))

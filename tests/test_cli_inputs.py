@@ -437,3 +437,22 @@ def test_coarse_transition_sampling_is_warned_about():
     assert code == 0 and "phaseimpact: warning: 8 samples" in err and "per decade" in err
     assert any("per decade" in w for w in json.loads(out)["warnings"])
 
+
+
+def test_a_reader_that_went_away_ends_quietly_like_a_posix_tool():
+    """``phaseimpact params --json | head -1``: the pipe closes under the writer; exit 141
+    (128 + SIGPIPE) with nothing on stderr, never 1 (a numerical failure)."""
+    read_end, write_end = os.pipe()
+    os.close(read_end)
+    try:
+        done = subprocess.run([sys.executable, "-m", "phaseimpact", "params", "--json"], stdout=write_end,
+                              stderr=subprocess.PIPE, text=True, timeout=120)
+    finally:
+        os.close(write_end)
+    assert done.returncode == 141 and done.stderr == ""
+
+
+def test_python_dash_m_runs_the_command_line():
+    done = subprocess.run([sys.executable, "-m", "phaseimpact", "--version"], capture_output=True, text=True,
+                          timeout=120)
+    assert done.returncode == 0 and done.stdout.split()[-1] == __import__("phaseimpact").__version__

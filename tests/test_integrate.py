@@ -235,8 +235,10 @@ STIFF_CREEP = seed_parameters(v=6.35, kappa=1.6e14)  # the inward slip creeps, d
 
 def test_a_stiff_creep_goes_on_with_radau_and_matches_the_oracle():
     """Far above kappa_c the inward slip is a creep held by the damper: DOP853 sits at its
-    stability limit there, Radau IIA takes over. Both agree with scipy's Radau at rtol 1e-13."""
-    ref = oracle(STIFF_CREEP, "paper", rtol=1e-13, method="Radau")
+    stability limit there, Radau IIA takes over. Both agree with the oracle (scipy's DOP853 at rtol
+    1e-13; scipy's Radau agrees with it to 1e-10 at rtol 1e-11 to 3e-13, but at 1e-13, its floor,
+    its escape time moves by 2e-7 and its second stick depth by 2e-11)."""
+    ref = oracle(STIFF_CREEP, "paper", rtol=1e-13)
     stiff = simulate(STIFF_CREEP, "paper")
     explicit = simulate(STIFF_CREEP, "paper", stiff=False)
     assert stiff.integrator.startswith("exact[DOP853+Radau5") and explicit.integrator.startswith("exact[DOP853,")
@@ -256,7 +258,7 @@ def test_radau_converges_with_the_tolerance():
     """The second stick depth (the end of the creep, integrated by Radau) approaches the oracle's
     as rtol falls: the internal tolerance 0.01 rtol^(2/3) delivers rtol. (Not monotone at loose
     tolerances: at 1e-7 the creep's deltadot, controlled relative to itself, lands at 5e-11.)"""
-    ref = [s[0] - s[1] for _, s in oracle(STIFF_CREEP, "paper", rtol=1e-13, method="Radau").of("stick")][1]
+    ref = [s[0] - s[1] for _, s in oracle(STIFF_CREEP, "paper", rtol=1e-13).of("stick")][1]
     rtols = (1e-7, 1e-9, 1e-11)
     errors = [abs(simulate(STIFF_CREEP, "paper", rtol=r).stick_points()[1][1] / ref - 1) for r in rtols]
     assert all(error < rtol for error, rtol in zip(errors, rtols, strict=True))
@@ -326,7 +328,8 @@ def test_engine_kernels_are_compiled_without_reference_counting():
                 assert "_nrt" in obj.targetoptions, f"{module.__name__}.{name} is not declared through _jit"
                 if obj.targetoptions["_nrt"]:
                     counted.add(name)
-    assert counted == {"run", "run_block", "_grow", "_push_event", "_push_sample", "_summarize", "workspace"}
+    assert counted == {"run", "run_block", "_run_rk4", "_open_logs", "_grow", "_push_event", "_push_sample",
+                       "_summarize", "workspace"}
 
 
 def _python_calls_of_compiled_functions():

@@ -98,7 +98,8 @@ def critical_curve(base: Parameters | Case, law: ContactLaw | str, param: str, v
     if what not in CURVE_QUANTITIES:
         raise ValueError(f"what = {what!r} is out of range; allowed: one of {', '.join(CURVE_QUANTITIES)}")
     if what in ("kappa_c", "kappa_2") and not law.is_filippov:
-        raise ValueError(f"what = {what!r} needs law 'paper'; unilateral laws continue 'grazing'")
+        raise ValueError(f"what = {what!r} needs a Filippov law (a stick to lose); law {law.name!r} is not: unilateral "
+                         "laws continue 'grazing'")
     if what == "grazing" and law.is_filippov and law.contact == "printed":
         raise ValueError("what = 'grazing' needs a unilateral law")
     if param == "kappa":

@@ -14,7 +14,7 @@ import numpy as np
 
 from .. import _signals
 from ..model.laws import ContactLaw, as_law
-from ..model.rhs import initial_state, pack
+from ..model.rhs import N_COEF, initial_state, pack
 from ..parameters import Parameters, is_number
 from . import driver as d
 from . import (
@@ -97,7 +97,8 @@ class Scales:
     horizon : float
         Default cap on a run that goes until its outcome settles, s.
     max_step : float
-        Largest step the driver takes (an eighth of the fastest oscillation), s.
+        Largest step the driver takes: an eighth of the target's small-amplitude period
+        (:attr:`plate_period`), inf without springs, s.
     """
 
     indentation: float
@@ -211,7 +212,7 @@ def _save(save, horizon: float, t_end):
     return d.SAVE_TIMES, times
 
 
-_STIFF_ON, _STIFF_OFF = np.int64(radau5.STIFF_STEPS), np.int64(0)
+_STIFF_ON = np.int64(radau5.STIFF_STEPS)
 
 
 def _stiff_after(stiff) -> np.int64:
@@ -310,7 +311,7 @@ def _integrator_name(rk4_step: float, rtol: float, stiff: bool) -> str:
 
 @dataclass(frozen=True)
 class Batch:
-    """Packed inputs of many runs of one law: coefficients (n, 9), initial states (n, 5),
+    """Packed inputs of many runs of one law: coefficients (n, N_COEF), initial states (n, 5),
     horizons, absolute tolerances (n, 7, see :func:`state_tolerances`) and step caps (n,)."""
 
     law: ContactLaw
@@ -336,7 +337,7 @@ def pack_batch(params_seq, law: ContactLaw, t_end, rtol: float, initial=None) ->
     for i, p in enumerate(params_seq):
         check_params(p, f"params_seq[{i}]")
     n = len(params_seq)
-    C = np.empty((n, 9))
+    C = np.empty((n, N_COEF))
     Y0 = np.empty((n, 5))
     T = np.empty(n)
     A = np.empty((n, 7))

@@ -17,6 +17,8 @@ from ..model.rhs import rhs_integration
 from ._dop853_stages import dense_coefficients, error_norm, step  # noqa: F401  (the step's API)
 
 N_STATE = 6  # the integration state (see model.rhs.rhs_integration)
+N_STAGES = 16  # rows of the stages array K: the step's 13 and the interpolant's 3 more
+N_DENSE = 7  # rows of the interpolant F (dense_eval)
 ORDER = 8
 ERROR_EXPONENT = -1.0 / 8.0  # error estimator of order 7
 SAFETY, MIN_FACTOR, MAX_FACTOR = 0.9, 0.2, 10.0
@@ -28,9 +30,9 @@ def dense_eval(F, y, t_old, h, t, out):
     x = (t - t_old) / h if h != 0 else 0.0
     for j in range(N_STATE):
         acc = 0.0
-        for i in range(6, -1, -1):
+        for i in range(N_DENSE - 1, -1, -1):
             acc += F[i, j]
-            acc *= x if (6 - i) % 2 == 0 else 1.0 - x
+            acc *= x if (N_DENSE - 1 - i) % 2 == 0 else 1.0 - x
         out[j] = y[j] + acc
 
 

@@ -3,12 +3,16 @@
 Between events the right-hand side of the current mode is smooth and a stepper advances it:
 adaptive DOP853 (:mod:`.dop853`), Radau IIA for the rest of a phase whose DOP853 steps stay at
 their stability limit (:mod:`.radau5`), or the seed's fixed-step RK4 (``rk4_step > 0``; eq. 8
-read literally, no events resolved, so its chattering across ``deltadot = 0`` stays visible).
-After each step the event table (:mod:`.events`) is checked for crossings; each crossing is
-located by Brent's method on the step's dense output (Radau's roots then polished on steps);
-recorded events are logged, and at the first event that changes the phase the state is taken
-from a fresh step that ends exactly at the root, the transition is applied and the run restarts
-there in the new mode.
+read literally, no events resolved, so its chattering across ``deltadot = 0`` stays visible:
+:func:`_run_rk4`, a run of its own).
+After each step the event table (:mod:`.events`) is checked for crossings (:func:`_advance`
+steps while none fires); each crossing is located by Brent's method on the step's dense output
+(Radau's roots then polished on steps: :func:`_locate_events`); recorded events are logged
+(:func:`_record`), and at the first event that changes the phase the state is taken from a
+fresh step that ends exactly at the root, the transition is applied and the run restarts there
+in the new mode (:func:`_restart`). :func:`run` holds the loop and the run's logs.
+
+Scratch vectors are rows of a few arrays with named rows (``Y_*``, ``G_*``, ``U_*``, ``RK_*``).
 
 Everything here is scalars and small arrays (numba's subset); strings, objects and messages are
 made outside (:mod:`.api`). The same source runs uncompiled with ``NUMBA_DISABLE_JIT=1``.
@@ -45,12 +49,13 @@ from ..model.rhs import (
     stuck_pair_energy,
 )
 from . import dop853, flight, radau5
-from .dop853 import N_STATE
+from .dop853 import N_DENSE, N_STAGES, N_STATE
 from .events import (
     CONTACT,
     DELTA,
     DELTADOT,
     ENERGY,
+    EVENT_KINDS,
     FORCE_PEAK,
     FORCE_RATE,
     N_EVENTS,
@@ -103,6 +108,30 @@ N_SMP_COLUMNS = 8
 N_SUMMARY = 19
 
 TIME = 5  # the physical time in the integration state u
+
+# Named rows of a run's scratch arrays (an allocation costs about 30 ns, a row of one array nothing).
+# Physical states (5 numbers): the rate at the state, a step's end state and rate, the state and rate
+# at a root, and at a trial point of the root finders.
+Y_F, Y_NEW, Y_F_NEW, Y_ROOT, Y_F_ROOT, Y_TRIAL, Y_F_TRIAL = range(7)
+N_Y_ROWS = 7
+# Event values (N_EVENTS numbers): at a trial point, before and after the step, the roots.
+G_TRIAL, G_OLD, G_NEW, G_ROOTS = range(4)
+N_G_ROWS = 4
+# Integration states (N_STATE numbers): the state and its rate, a step's end, the state at a root,
+# at a trial point, scratch, the phase's absolute tolerances; then DOP853's stages (a flight's
+# invariants) and the step's interpolant.
+U_U, U_FU, U_NEW, U_FU_NEW, U_ROOT, U_FU_ROOT, U_TRIAL, U_TMP, U_ATOL = range(9)
+U_STAGES = 9
+U_DENSE = U_STAGES + N_STAGES
+N_U_ROWS = U_DENSE + N_DENSE
+# RK4 (5 numbers): the rate at the state, a stage's argument, the step's end and its rate, the stages.
+RK_F, RK_TMP, RK_Y_NEW, RK_F_NEW, RK_K = range(5)
+N_RK_ROWS = RK_K + 4
+# The running extremes of a run (``stats``), kept up to date by the kernels that take steps.
+STAT_MAX_FORCE, STAT_MAX_INDENTATION = 0, 1
+N_STATS = 2
+#: Event kinds (``events.EVENT_KINDS``): the length of a run's counts.
+N_KINDS = len(EVENT_KINDS)
 TIME_COLUMN = N_EVENTS  # a pseudo event column: the physical time minus a target
 #: Smallest step reduction after a rejection when the observed order is used (else MIN_FACTOR).
 OBSERVED_MIN_FACTOR = 0.01
@@ -135,12 +164,9 @@ def _grow(a, n):
     return b
 
 
-@allocating
-def _push_event(ev, n, t, kind, mode, y, force):
-    """Append an event to the log ``ev`` (columns ``EV_*``, grown by doubling); returns the log
-    and its new length."""
-    if n == ev.shape[0]:
-        ev = _grow(ev, n)
+@kernel
+def _write_event(ev, n, t, kind, mode, y, force):
+    """Write an event into row ``n`` of the log ``ev`` (columns ``EV_*``)."""
     row = ev[n]
     row[EV_T] = t
     row[EV_KIND] = kind
@@ -148,6 +174,15 @@ def _push_event(ev, n, t, kind, mode, y, force):
     for j in range(5):
         row[EV_Y + j] = y[j]
     row[EV_FORCE] = force
+
+
+@allocating
+def _push_event(ev, n, t, kind, mode, y, force):
+    """Append an event to the log ``ev`` (columns ``EV_*``, grown by doubling); returns the log
+    and its new length."""
+    if n == ev.shape[0]:
+        ev = _grow(ev, n)
+    _write_event(ev, n, t, kind, mode, y, force)
     return ev, n + 1
 
 
@@ -240,7 +275,7 @@ def _events(code, c, mode, side, energy_limit, u, y, f, force, g):
 
 
 @kernel
-def _event_at(code, c, mode, side, energy_limit, target, column, F, u0, s0, h, s, us, ys, fs, gs):
+def _event_at(code, c, mode, side, energy_limit, target, column, F, u0, s0, h, s, us, ys, fs):
     """Event function ``column`` at ``s`` on the dense output of the step; the pseudo column
     ``TIME_COLUMN`` is the physical time minus ``target`` (horizon and output times of a
     regularised phase, where ``t`` is a component of the state). The physical state is left in
@@ -262,7 +297,7 @@ def _event_at(code, c, mode, side, energy_limit, target, column, F, u0, s0, h, s
 
 
 @kernel
-def _brent(code, c, mode, side, energy_limit, target, column, F, u0, s0, h, xa, xb, fa, fb, us, ys, fs, gs):
+def _brent(code, c, mode, side, energy_limit, target, column, F, u0, s0, h, xa, xb, fa, fb, us, ys, fs):
     """Zero of event ``column`` in ``[xa, xb]`` (signs of ``fa``, ``fb`` differ): scipy's brentq."""
     xpre, xcur, fpre, fcur = xa, xb, fa, fb
     xblk = fblk = spre = scur = 0.0
@@ -293,7 +328,7 @@ def _brent(code, c, mode, side, energy_limit, target, column, F, u0, s0, h, xa, 
             spre = scur = sbis
         xpre, fpre = xcur, fcur
         xcur += scur if abs(scur) > tol else (tol if sbis > 0 else -tol)
-        fcur = _event_at(code, c, mode, side, energy_limit, target, column, F, u0, s0, h, xcur, us, ys, fs, gs)
+        fcur = _event_at(code, c, mode, side, energy_limit, target, column, F, u0, s0, h, xcur, us, ys, fs)
     return xcur
 
 
@@ -311,7 +346,7 @@ def _flight_rate(c, column, y):
 
 
 @kernel
-def _flight_root(code, c, mode, side, energy_limit, column, F, u0, s0, h, a, b, fa, fb, us, ys, fs, gs):
+def _flight_root(code, c, mode, side, energy_limit, column, F, u0, s0, h, a, b, fa, fb, us, ys, fs):
     """Zero of event ``column`` in ``[a, b]`` (signs of ``fa``, ``fb`` differ) of a flight: Newton's
     method on the closed form with the event's exact rate, kept inside the bracket (bisection
     where it would leave it). Three or four evaluations where Brent's method on the same bracket
@@ -322,7 +357,7 @@ def _flight_root(code, c, mode, side, energy_limit, column, F, u0, s0, h, a, b, 
     tol = 1e-14 * (b - a) + 4.0 * _EPS * abs(b)
     x = a - fa * (b - a) / (fb - fa)
     for _ in range(100):
-        g = _event_at(code, c, mode, side, energy_limit, 0.0, column, F, u0, s0, h, x, us, ys, fs, gs)
+        g = _event_at(code, c, mode, side, energy_limit, 0.0, column, F, u0, s0, h, x, us, ys, fs)
         if g == 0:
             return x
         left = (g < 0) == (fa < 0)
@@ -342,7 +377,7 @@ def _flight_root(code, c, mode, side, energy_limit, column, F, u0, s0, h, a, b, 
 
 
 @kernel
-def _locate(code, c, mode, side, energy_limit, column, F, u0, s0, h, s1, g_start, g_end, us, ys, fs, gs):
+def _locate(code, c, mode, side, energy_limit, column, F, u0, s0, h, s1, g_start, g_end, us, ys, fs):
     """The first zero of event ``column`` in ``[s0, s1]`` on the dense output.
 
     A run that restarts on this event's zero (``g_start`` a signed tiny number) may leave it
@@ -352,17 +387,17 @@ def _locate(code, c, mode, side, energy_limit, column, F, u0, s0, h, s1, g_start
     """
     expected = 1.0 if g_start > 0 else -1.0
     a, ga, b, gb = s0, g_start, s1, g_end
-    g0 = _event_at(code, c, mode, side, energy_limit, 0.0, column, F, u0, s0, h, s0, us, ys, fs, gs)
+    g0 = _event_at(code, c, mode, side, energy_limit, 0.0, column, F, u0, s0, h, s0, us, ys, fs)
     if g0 * expected <= 0 and side == FLIGHT and column == DELTA:
         # a flight step holds at most one extremum of delta (flight.py): if delta left zero and
         # came back, it was away at that extremum, the zero of deltadot
-        d0 = _event_at(code, c, mode, side, energy_limit, 0.0, np.int64(DELTADOT), F, u0, s0, h, s0, us, ys, fs, gs)
-        d1 = _event_at(code, c, mode, side, energy_limit, 0.0, np.int64(DELTADOT), F, u0, s0, h, s1, us, ys, fs, gs)
+        d0 = _event_at(code, c, mode, side, energy_limit, 0.0, np.int64(DELTADOT), F, u0, s0, h, s0, us, ys, fs)
+        d1 = _event_at(code, c, mode, side, energy_limit, 0.0, np.int64(DELTADOT), F, u0, s0, h, s1, us, ys, fs)
         if not d0 * d1 < 0:
             return -math.inf
         a = _flight_root(code, c, mode, side, energy_limit, np.int64(DELTADOT), F, u0, s0, h, s0, s1, d0, d1, us, ys,
-                         fs, gs)
-        ga = _event_at(code, c, mode, side, energy_limit, 0.0, column, F, u0, s0, h, a, us, ys, fs, gs)
+                         fs)
+        ga = _event_at(code, c, mode, side, energy_limit, 0.0, column, F, u0, s0, h, a, us, ys, fs)
         if ga * expected <= 0:
             return -math.inf
     elif g0 * expected <= 0:
@@ -370,14 +405,14 @@ def _locate(code, c, mode, side, energy_limit, column, F, u0, s0, h, s1, g_start
         prev = s0
         for i in range(1, 33):
             s = s0 + (s1 - s0) * i / 32.0
-            gv = _event_at(code, c, mode, side, energy_limit, 0.0, column, F, u0, s0, h, s, us, ys, fs, gs)
+            gv = _event_at(code, c, mode, side, energy_limit, 0.0, column, F, u0, s0, h, s, us, ys, fs)
             if not found_away:
                 if gv * expected > 0:
                     found_away = True
                     a, ga = s, gv
             elif gv * expected <= 0:
                 a, b, gb = prev, s, gv
-                ga = _event_at(code, c, mode, side, energy_limit, 0.0, column, F, u0, s0, h, a, us, ys, fs, gs)
+                ga = _event_at(code, c, mode, side, energy_limit, 0.0, column, F, u0, s0, h, a, us, ys, fs)
                 break
             prev = s
         if not found_away:
@@ -385,12 +420,12 @@ def _locate(code, c, mode, side, energy_limit, column, F, u0, s0, h, s1, g_start
     if gb == 0 or ga * gb > 0:
         return b
     if side == FLIGHT and not math.isnan(_flight_rate(c, column, ys)):
-        return _flight_root(code, c, mode, side, energy_limit, column, F, u0, s0, h, a, b, ga, gb, us, ys, fs, gs)
-    return _brent(code, c, mode, side, energy_limit, 0.0, column, F, u0, s0, h, a, b, ga, gb, us, ys, fs, gs)
+        return _flight_root(code, c, mode, side, energy_limit, column, F, u0, s0, h, a, b, ga, gb, us, ys, fs)
+    return _brent(code, c, mode, side, energy_limit, 0.0, column, F, u0, s0, h, a, b, ga, gb, us, ys, fs)
 
 
 @kernel
-def _s_at_time(code, c, mode, side, F, u0, s0, h, time, us, ys, fs, gs):
+def _s_at_time(code, c, mode, side, F, u0, s0, h, time, us, ys, fs):
     """Where on the step the physical time is ``time`` (it lies within the step): ``s`` itself in
     a plain phase, a root of ``t(s)`` on the dense output in a regularised one."""
     if not _regularised(side):
@@ -399,10 +434,10 @@ def _s_at_time(code, c, mode, side, F, u0, s0, h, time, us, ys, fs, gs):
     fa = u0[TIME] - time
     if fa >= 0:
         return s0
-    fb = _event_at(code, c, mode, side, 0.0, time, np.int64(TIME_COLUMN), F, u0, s0, h, s1, us, ys, fs, gs)
+    fb = _event_at(code, c, mode, side, 0.0, time, np.int64(TIME_COLUMN), F, u0, s0, h, s1, us, ys, fs)
     if fb <= 0:
         return s1
-    return _brent(code, c, mode, side, 0.0, time, np.int64(TIME_COLUMN), F, u0, s0, h, s0, s1, fa, fb, us, ys, fs, gs)
+    return _brent(code, c, mode, side, 0.0, time, np.int64(TIME_COLUMN), F, u0, s0, h, s0, s1, fa, fb, us, ys, fs)
 
 
 _ADV_END, _ADV_STEP, _ADV_COLLAPSE, _ADV_LIMIT = range(4)
@@ -535,8 +570,8 @@ def _advance(code, c, mode, side, s, t_end, u, fu, y, f, force, h_abs, rtol, ato
         _copy(g_new, g_old)
         force = force_new
         h_abs = h_next
-        stats[0] = max(stats[0], force)
-        stats[1] = max(stats[1], y[X1] - y[X2])
+        stats[STAT_MAX_FORCE] = max(stats[STAT_MAX_FORCE], force)
+        stats[STAT_MAX_INDENTATION] = max(stats[STAT_MAX_INDENTATION], y[X1] - y[X2])
     return _ADV_END, s, h, h_abs, h_next, force, force_new, steps, evaluations
 
 
@@ -627,37 +662,145 @@ def _phase_step(code, c, mode, side, u, fu, rtol, atol, t_end, max_step, w_floor
                                max_step if not _regularised(side) else max_step / max(abs(u[0]), w_floor), tmp, f1)
 
 
-@allocating(python=True)
-def run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count, save_kind, times,
-        max_steps, max_events, rk4_step, rk4_every, stiff_after):
-    """Integrate one trajectory. See :func:`phaseimpact.integrate.simulate` for the meaning.
+@kernel
+def _locate_events(code, c, mode, side, settle, energy_limit, s, h, s_horizon, u, fu, g_old, g_new, fired, roots, K,
+                   F, u_r, fu_r, stiff, us, ys, fs, gs):
+    """Locate the events that fired in the step ``[s, s + h]`` on its interpolant ``F``: their roots
+    into ``roots`` (``fired`` cleared where the crossing did not happen or falls after the horizon
+    ``s_horizon``), and the first root that restarts the run (polished on steps when the step was
+    Radau's). Returns ``(unresolved, restart_col, s_restart, evaluations)``: ``unresolved`` when an
+    event left and re-crossed zero inside the step (the caller retries a smaller step);
+    ``restart_col`` -1 when no event restarts the run."""
+    s_new = s + h
+    evaluations = 0
+    restart_col = np.int64(-1)
+    s_restart = math.inf
+    unresolved = False
+    for col in range(N_EVENTS):
+        if fired[col]:
+            roots[col] = _locate(code, c, mode, side, energy_limit, col, F, u, s, h, s_new, g_old[col], g_new[col],
+                                 us, ys, fs)
+            if roots[col] == -math.inf:
+                if h > 1e3 * (np.nextafter(s, np.inf) - s):
+                    unresolved = True
+                else:  # nothing smaller to try: the excursion did not happen
+                    fired[col] = False
+            elif roots[col] > s_horizon:
+                fired[col] = False  # after the horizon
+    if unresolved:
+        return True, restart_col, s_restart, evaluations
+    if fired[DELTADOT] and not fired[DELTA]:
+        # an extreme of delta inside the step on the other side of zero: a contact (or
+        # separation) and its return both fell inside the step
+        d_ext = _event_at(code, c, mode, side, energy_limit, 0.0, np.int64(DELTA), F, u, s, h, roots[DELTADOT], us, ys,
+                          fs)
+        if d_ext * g_old[DELTA] < 0:
+            fired[DELTA] = True
+            roots[DELTA] = _brent(code, c, mode, side, energy_limit, 0.0, np.int64(DELTA), F, u, s, h, s,
+                                  roots[DELTADOT], g_old[DELTA], d_ext, us, ys, fs)
+    for col in range(N_EVENTS):
+        if fired[col] and (restarts(code, col, mode, settle) or col == ENERGY) and roots[col] < s_restart:
+            restart_col, s_restart = col, roots[col]
+    if restart_col >= 0 and radau5.active(stiff):
+        s_restart, spent = _polish_root(code, c, mode, side, energy_limit, restart_col, s, u, fu, s_new,
+                                        g_old[restart_col], g_new[restart_col], s_restart, K, u_r, fu_r, stiff, ys,
+                                        fs, gs)
+        evaluations += spent
+    return False, restart_col, s_restart, evaluations
 
-    Returns ``(summary, events, samples, y_final)``: the event log (columns ``EV_*``) and the
-    samples (columns ``SMP_*``) trimmed to their lengths.
-    """
-    y = y0.copy()
-    t = 0.0
-    mode = PLAIN if rk4_step > 0 else initial_mode(code, c, y)
-    # scratch vectors as rows of three arrays: an allocation costs about 30 ns, a row nothing
-    rows5 = np.empty((12, 5))
-    rows7 = np.empty((4, N_EVENTS))
-    f = rows5[0]
+
+@kernel
+def _record(code, c, mode, side, settle, stop_kind, stop_count, s, h, s_restart, fired, roots, u, fu, F, K, us, fu_r,
+            stiff, ys, fs, ev, n_ev, counts, stats):
+    """Log the recorded events (force peaks, reversals, reach) that fired in the step up to
+    ``s_restart``, in time order, into ``ev`` (which has a free row for each event column); the
+    running extremes ``stats`` follow them. Returns ``(n_ev, stop_record, evaluations)``:
+    ``stop_record`` is the root of the event the run was asked to stop at (-1 if none)."""
+    evaluations = 0
+    stop_record = -1.0
+    while True:
+        best = np.int64(-1)
+        for col in range(N_EVENTS):
+            if fired[col] and not (restarts(code, col, mode, settle) or col == ENERGY) \
+                    and roots[col] <= s_restart and (best < 0 or roots[col] < roots[best]):
+                best = col
+        if best < 0:
+            break
+        fired[best] = False
+        if radau5.active(stiff):  # the state from a step to the root: the polynomial is of order 3
+            evaluations += _fresh_step(code, c, mode, side, s, u, fu, roots[best] - s, K, us, fu_r, stiff)
+        else:
+            _dense(c, side, F, u, s, h, roots[best], us)
+        f_ev = _physical(code, c, mode, side, us, ys, fs)
+        kind = FORCE_PEAK if best == FORCE_RATE else REVERSAL
+        if best == REACH:
+            kind = SETTLED  # recorded only: the run goes on
+        t_ev = us[TIME] if _regularised(side) else roots[best]
+        _write_event(ev, n_ev, t_ev, kind, mode, ys, f_ev)
+        n_ev += 1
+        counts[kind] += 1
+        stats[STAT_MAX_FORCE] = max(stats[STAT_MAX_FORCE], f_ev)
+        stats[STAT_MAX_INDENTATION] = max(stats[STAT_MAX_INDENTATION], ys[X1] - ys[X2])
+        if kind == stop_kind and counts[kind] >= stop_count:
+            stop_record = roots[best]
+            break
+    return n_ev, stop_record, evaluations
+
+
+@kernel
+def _restart(code, c, settle, column, mode, side, s, s_restart, h_next, u, fu, u_r, fu_r, y_r, f_r, y, f, K, stiff,
+             rtol, atol, atol_u, t_end, max_step, w_floor, tmp, f_tmp, pair_energy):
+    """Restart the run at the root ``s_restart`` of event ``column``: the state there from a fresh
+    step that ends there (the stages beyond the root belong to the continuation, not to the
+    motion), the transition, and the new phase in ``u``, ``fu``, ``y``, ``f``, ``atol_u`` (``K``: a
+    flight's invariants). Returns ``(kind, mode, action, side, s, t, h_abs, force, pair_energy,
+    evaluations)``."""
+    evaluations = 0
+    h_r = s_restart - s
+    if h_r > 0:
+        evaluations += _fresh_step(code, c, mode, side, s, u, fu, h_r, K, u_r, fu_r, stiff)
+    else:
+        _copy(u, u_r)
+    t = s_restart if not _regularised(side) else u_r[TIME]
+    _physical(code, c, mode, side, u_r, y_r, f_r)
+    if column == STICK_BREAK and c[SPRINGS_] > 0 and c[RIGID_] == 0:
+        onto_stuck_orbit(c, pair_energy, y_r)
+    kind, mode, action = transition(code, c, column, y_r, mode, settle)
+    if kind == STICK:
+        pair_energy = stuck_pair_energy(c, y_r)
+    _copy(y_r, y)
     force = rhs(code, c, y, mode, f)
-    nfev = 1
-    nsteps = 0
-    energy_limit = energy_limit_of(code, c, y0)
+    new_side = contact_side(code, c, y, mode)
+    _integration_state(code, mode, new_side, y, t, u)
+    s = t if not _regularised(new_side) else 0.0
+    rhs_integration(code, c, u, mode, new_side, fu)
+    evaluations += 2
+    radau5.reset(stiff)  # a new phase starts explicit
+    _phase_tolerances(code, mode, new_side, atol, atol_u)
+    if new_side != side:  # the independent variable changes: a fresh initial step
+        side = new_side
+        h_abs = _phase_step(code, c, mode, side, u, fu, rtol, atol_u, t_end, max_step, w_floor, tmp, f_tmp)
+        evaluations += 1
+    else:
+        h_abs = max(h_next, h_r)
+    if side == FLIGHT:
+        flight.coefficients(c, u, s, K)
+    return kind, mode, action, side, s, t, h_abs, force, pair_energy, evaluations
 
+
+@allocating
+def _open_logs(y, mode, force, save_kind, times):
+    """The event log and the samples of a run from ``y`` at t = 0 (its contact when it starts on one,
+    its first samples). Returns ``(ev, n_ev, smp, n_s, counts, i_time)``: ``counts`` per event kind,
+    ``i_time`` the next output time (``SAVE_TIMES``)."""
     # Integer constants passed to compiled callees go as np.int64: a literal argument would compile
     # a second copy of the callee (and of everything it calls) specialised on that value.
     ev = np.empty((64, N_EV_COLUMNS))
     n_ev = np.int64(0)
     smp = np.empty((256 if save_kind != SAVE_SUMMARY else 1, N_SMP_COLUMNS))
     n_s = np.int64(0)
-    counts = np.zeros(9, np.int64)
-    max_force = force
-    max_indentation = y[X1] - y[X2]
-    i_time = 0  # next output time (save_kind == SAVE_TIMES)
-
+    counts = np.zeros(N_KINDS, np.int64)
+    i_time = 0
     if y[X1] == y[X2] and y[V1] > y[V2]:
         ev, n_ev = _push_event(ev, n_ev, 0.0, np.int64(CONTACT), mode, y, force)
         counts[CONTACT] += 1
@@ -667,92 +810,140 @@ def run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count,
         while i_time < times.shape[0] and times[i_time] <= 0.0:
             smp, n_s = _push_sample(smp, n_s, times[i_time], y, mode, force)
             i_time += 1
+    return ev, n_ev, smp, n_s, counts, i_time
 
+
+@allocating
+def _run_rk4(code, c, y0, t_end, save_kind, times, max_steps, rk4_step, rk4_every):
+    """The seed's classic RK4 (:func:`run` with ``rk4_step > 0``): eq. 8's plain right-hand side,
+    fixed steps, nothing resolved (a contact or separation is logged where ``delta`` changed sign,
+    its time interpolated linearly). Returns what :func:`run` does."""
+    y = y0.copy()
+    t = 0.0
+    mode = np.int64(PLAIN)
+    rows = np.empty((N_RK_ROWS, 5))
+    tmp = rows[RK_TMP]
+    y_new = rows[RK_Y_NEW]
+    f_new = rows[RK_F_NEW]
+    k1 = rows[RK_K]
+    k2 = rows[RK_K + 1]
+    k3 = rows[RK_K + 2]
+    k4 = rows[RK_K + 3]
+    force = rhs(code, c, y, mode, rows[RK_F])
+    nfev = 1
+    nsteps = 0
+    energy_limit = energy_limit_of(code, c, y0)
+    ev, n_ev, smp, n_s, counts, _ = _open_logs(y, mode, force, save_kind, times)
+    max_force = force
+    max_indentation = y[X1] - y[X2]
     status = SUCCESS
     reason = HORIZON
-    tmp = rows5[1]
-    y_new = rows5[2]
-    f_new = rows5[3]
-    y_r = rows5[4]
-    f_r = rows5[5]
-    ys = rows5[6]
-    fs = rows5[7]
-    gs = rows7[0]
-    g_old = rows7[1]
-    g_new = rows7[2]
-    roots = rows7[3]
+    while t < t_end:
+        if nsteps >= max_steps:
+            status, reason = TOO_MANY_STEPS, FAILED_STOP
+            break
+        if nsteps % POLL_STEPS == 0 and nsteps > 0 and interrupted():
+            status, reason = INTERRUPTED, FAILED_STOP
+            break
+        h = min(rk4_step, t_end - t)
+        rhs(code, c, y, mode, k1)
+        for j in range(5):
+            tmp[j] = y[j] + 0.5 * h * k1[j]
+        rhs(code, c, tmp, mode, k2)
+        for j in range(5):
+            tmp[j] = y[j] + 0.5 * h * k2[j]
+        rhs(code, c, tmp, mode, k3)
+        for j in range(5):
+            tmp[j] = y[j] + h * k3[j]
+        rhs(code, c, tmp, mode, k4)
+        finite = True
+        for j in range(5):
+            y_new[j] = y[j] + h / 6.0 * (k1[j] + 2.0 * k2[j] + 2.0 * k3[j] + k4[j])
+            finite = finite and math.isfinite(y_new[j])
+        nfev += 4
+        nsteps += 1
+        if not finite:
+            status, reason = NON_FINITE, FAILED_STOP
+            break
+        force_new = rhs(code, c, y_new, mode, f_new)
+        d_old = y[X1] - y[X2]
+        d_new = y_new[X1] - y_new[X2]
+        if (d_old <= 0 < d_new) or (d_old > 0 >= d_new):
+            kind = CONTACT if d_new > 0 else SEPARATION
+            t_cross = t + h * d_old / (d_old - d_new)  # linear: RK4 resolves no event
+            ev, n_ev = _push_event(ev, n_ev, t_cross, kind, mode, y_new, force_new)
+            counts[kind] += 1
+        t += h
+        for j in range(5):
+            y[j] = y_new[j]
+        max_force = max(max_force, force_new)
+        max_indentation = max(max_indentation, d_new)
+        if save_kind == SAVE_STEPS and (nsteps % rk4_every == 0 or t >= t_end):
+            smp, n_s = _push_sample(smp, n_s, t, y, mode, force_new)
+        if energy(code, c, y) > energy_limit:
+            reason = RUNAWAY_STOP
+            break
+    summary = _summarize(code, c, y0, y, mode, status, reason, t, max_force, max_indentation, counts,
+                         n_ev, ev, nsteps, nfev)
+    return summary, ev[:n_ev], smp[:n_s], y
+
+
+@allocating(python=True)
+def run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count, save_kind, times,
+        max_steps, max_events, rk4_step, rk4_every, stiff_after):
+    """Integrate one trajectory. See :func:`phaseimpact.integrate.simulate` for the meaning.
+
+    Returns ``(summary, events, samples, y_final)``: the event log (columns ``EV_*``) and the
+    samples (columns ``SMP_*``) trimmed to their lengths. ``rk4_step > 0``: :func:`_run_rk4`.
+    Otherwise adaptive DOP853 (Radau IIA where a phase turns stiff) with events: steps while
+    nothing happens (:func:`_advance`), then on the step where something did, the events located
+    (:func:`_locate_events`), the recorded ones logged (:func:`_record`) and the run restarted at
+    the first that changes the phase (:func:`_restart`).
+    """
+    if rk4_step > 0:
+        return _run_rk4(code, c, y0, t_end, save_kind, times, max_steps, rk4_step, rk4_every)
+    y = y0.copy()
+    t = 0.0
+    mode = initial_mode(code, c, y)
+    # scratch vectors as rows of three arrays (layouts Y_*, G_*, U_*)
+    rows5 = np.empty((N_Y_ROWS, 5))
+    f = rows5[Y_F]
+    y_new = rows5[Y_NEW]
+    f_new = rows5[Y_F_NEW]
+    y_r = rows5[Y_ROOT]
+    f_r = rows5[Y_F_ROOT]
+    ys = rows5[Y_TRIAL]
+    fs = rows5[Y_F_TRIAL]
+    force = rhs(code, c, y, mode, f)
+    nfev = 1
+    nsteps = 0
+    energy_limit = energy_limit_of(code, c, y0)
+    ev, n_ev, smp, n_s, counts, i_time = _open_logs(y, mode, force, save_kind, times)
+    max_force = force
+    max_indentation = y[X1] - y[X2]
+    status = SUCCESS
+    reason = HORIZON
+    rows7 = np.empty((N_G_ROWS, N_EVENTS))
+    gs = rows7[G_TRIAL]
+    g_old = rows7[G_OLD]
+    g_new = rows7[G_NEW]
+    roots = rows7[G_ROOTS]
     fired = np.zeros(N_EVENTS, np.bool_)
 
-    if rk4_step > 0:
-        # ---- the seed's classic RK4: plain right-hand side, fixed step, nothing resolved ----
-        k1 = rows5[8]
-        k2 = rows5[9]
-        k3 = rows5[10]
-        k4 = rows5[11]
-        while t < t_end:
-            if nsteps >= max_steps:
-                status, reason = TOO_MANY_STEPS, FAILED_STOP
-                break
-            if nsteps % POLL_STEPS == 0 and nsteps > 0 and interrupted():
-                status, reason = INTERRUPTED, FAILED_STOP
-                break
-            h = min(rk4_step, t_end - t)
-            rhs(code, c, y, mode, k1)
-            for j in range(5):
-                tmp[j] = y[j] + 0.5 * h * k1[j]
-            rhs(code, c, tmp, mode, k2)
-            for j in range(5):
-                tmp[j] = y[j] + 0.5 * h * k2[j]
-            rhs(code, c, tmp, mode, k3)
-            for j in range(5):
-                tmp[j] = y[j] + h * k3[j]
-            rhs(code, c, tmp, mode, k4)
-            finite = True
-            for j in range(5):
-                y_new[j] = y[j] + h / 6.0 * (k1[j] + 2.0 * k2[j] + 2.0 * k3[j] + k4[j])
-                finite = finite and math.isfinite(y_new[j])
-            nfev += 4
-            nsteps += 1
-            if not finite:
-                status, reason = NON_FINITE, FAILED_STOP
-                break
-            force_new = rhs(code, c, y_new, mode, f_new)
-            d_old = y[X1] - y[X2]
-            d_new = y_new[X1] - y_new[X2]
-            if (d_old <= 0 < d_new) or (d_old > 0 >= d_new):
-                kind = CONTACT if d_new > 0 else SEPARATION
-                t_cross = t + h * d_old / (d_old - d_new)  # linear: RK4 resolves no event
-                ev, n_ev = _push_event(ev, n_ev, t_cross, kind, mode, y_new, force_new)
-                counts[kind] += 1
-            t += h
-            for j in range(5):
-                y[j] = y_new[j]
-            max_force = max(max_force, force_new)
-            max_indentation = max(max_indentation, d_new)
-            if save_kind == SAVE_STEPS and (nsteps % rk4_every == 0 or t >= t_end):
-                smp, n_s = _push_sample(smp, n_s, t, y, mode, force_new)
-            if energy(code, c, y) > energy_limit:
-                reason = RUNAWAY_STOP
-                break
-        summary = _summarize(code, c, y0, y, mode, status, reason, t, max_force, max_indentation, counts,
-                             n_ev, ev, nsteps, nfev)
-        return summary, ev[:n_ev], smp[:n_s], y
-
-    # ---- adaptive DOP853 with events ----
     # Plain phases integrate u = (x1, x2, v1, v2, W, t) in s = t; regularised contact phases
     # (side = +-1) integrate u = (w, x2, v1, v2, W, t) in s with dt = w ds (model.rhs.rhs_integration).
-    rows6 = np.empty((9 + 16 + 7, N_STATE))
-    u = rows6[0]
-    fu = rows6[1]
-    u_new = rows6[2]
-    fu_new = rows6[3]
-    u_r = rows6[4]
-    fu_r = rows6[5]
-    us = rows6[6]
-    tmp6 = rows6[7]
-    atol_u = rows6[8]
-    K6 = rows6[9:25]  # DOP853's stages
-    F6 = rows6[25:]  # the step's interpolant
+    rows6 = np.empty((N_U_ROWS, N_STATE))
+    u = rows6[U_U]
+    fu = rows6[U_FU]
+    u_new = rows6[U_NEW]
+    fu_new = rows6[U_FU_NEW]
+    u_r = rows6[U_ROOT]
+    fu_r = rows6[U_FU_ROOT]
+    us = rows6[U_TRIAL]
+    tmp6 = rows6[U_TMP]
+    atol_u = rows6[U_ATOL]
+    K6 = rows6[U_STAGES:U_DENSE]  # DOP853's stages (a flight's invariants)
+    F6 = rows6[U_DENSE:]  # the step's interpolant
     w_floor = atol[6] / rtol  # the scale of w = sqrt(|delta|)
     # a flight's steps only bracket events, between the target's passes through its centre; a
     # figure gets a sample every sixteenth of the target's period
@@ -771,7 +962,7 @@ def run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count,
     if side == FLIGHT:
         flight.coefficients(c, u, s, K6)  # kept in K6 for the whole flight (it has no stages)
 
-    stats = np.empty(2)
+    stats = np.empty(N_STATS)  # the running extremes (STAT_*) inside the kernels
     next_poll = np.int64(POLL_STEPS)  # _advance returns there (_ADV_LIMIT); resuming it changes no bit
     stiff = radau5.workspace(stiff_after)
     pair_energy = stuck_pair_energy(c, y)  # read while stuck only
@@ -788,12 +979,12 @@ def run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count,
             break
         next_sample = u[TIME] if save_kind == SAVE_STEPS else (
             times[i_time] if save_kind == SAVE_TIMES and i_time < times.shape[0] else math.inf)
-        stats[0], stats[1] = max_force, max_indentation
+        stats[STAT_MAX_FORCE], stats[STAT_MAX_INDENTATION] = max_force, max_indentation
         result, s, h, h_abs, h_next, force, force_new, d_steps, d_fev = _advance(
             code, c, mode, side, s, t_end, u, fu, y, f, force, h_abs, rtol, atol_u, max_step, flight_step, w_floor,
             energy_limit, next_sample, min(max_steps, next_poll) - nsteps, g_old, g_new, fired, K6, u_new, fu_new,
             y_new, f_new, stats, stiff)
-        max_force, max_indentation = stats[0], stats[1]
+        max_force, max_indentation = stats[STAT_MAX_FORCE], stats[STAT_MAX_INDENTATION]
         nsteps += d_steps
         nfev += d_fev
         if result == _ADV_END:
@@ -819,69 +1010,26 @@ def run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count,
         if _regularised(side) and u_new[TIME] >= t_end:
             nfev += _interpolant(code, c, mode, side, u, fu, u_new, fu_new, h, K6, F6, tmp6, stiff)
             have_dense = True
-            s_horizon = _s_at_time(code, c, mode, side, F6, u, s, h, t_end, us, ys, fs, gs)
+            s_horizon = _s_at_time(code, c, mode, side, F6, u, s, h, t_end, us, ys, fs)
         if any_fired:
             if not have_dense:
                 nfev += _interpolant(code, c, mode, side, u, fu, u_new, fu_new, h, K6, F6, tmp6, stiff)
                 have_dense = True
-            unresolved = False
-            for col in range(N_EVENTS):
-                if fired[col]:
-                    roots[col] = _locate(code, c, mode, side, energy_limit, col, F6, u, s, h, s_new, g_old[col],
-                                         g_new[col], us, ys, fs, gs)
-                    if roots[col] == -math.inf:
-                        if h > 1e3 * (np.nextafter(s, np.inf) - s):
-                            unresolved = True
-                        else:  # nothing smaller to try: the excursion did not happen
-                            fired[col] = False
-                    elif roots[col] > s_horizon:
-                        fired[col] = False  # after the horizon
+            unresolved, restart_col, s_restart, spent = _locate_events(
+                code, c, mode, side, settle, energy_limit, s, h, s_horizon, u, fu, g_old, g_new, fired, roots, K6, F6,
+                u_r, fu_r, stiff, us, ys, fs, gs)
+            nfev += spent
             if unresolved:
                 h_abs = h / 32.0  # an event left and re-crossed zero inside the step: resolve it
                 continue
-            if fired[DELTADOT] and not fired[DELTA]:
-                # an extreme of delta inside the step on the other side of zero: a contact (or
-                # separation) and its return both fell inside the step
-                d_ext = _event_at(code, c, mode, side, energy_limit, 0.0, np.int64(DELTA), F6, u, s, h,
-                                  roots[DELTADOT], us, ys, fs, gs)
-                if d_ext * g_old[DELTA] < 0:
-                    fired[DELTA] = True
-                    roots[DELTA] = _brent(code, c, mode, side, energy_limit, 0.0, np.int64(DELTA), F6, u, s, h, s,
-                                          roots[DELTADOT], g_old[DELTA], d_ext, us, ys, fs, gs)
-            for col in range(N_EVENTS):
-                if fired[col] and (restarts(code, col, mode, settle) or col == ENERGY) and roots[col] < s_restart:
-                    restart_col, s_restart = col, roots[col]
-            if restart_col >= 0 and radau5.active(stiff):
-                s_restart, spent = _polish_root(code, c, mode, side, energy_limit, restart_col, s, u, fu, s_new,
-                                                g_old[restart_col], g_new[restart_col], s_restart, K6, u_r, fu_r,
-                                                stiff, ys, fs, gs)
-                nfev += spent
-            # recorded events before the restart, in time order
-            while True:
-                best = np.int64(-1)
-                for col in range(N_EVENTS):
-                    if fired[col] and not (restarts(code, col, mode, settle) or col == ENERGY) \
-                            and roots[col] <= s_restart and (best < 0 or roots[col] < roots[best]):
-                        best = col
-                if best < 0:
-                    break
-                fired[best] = False
-                if radau5.active(stiff):  # the state from a step to the root: the polynomial is of order 3
-                    nfev += _fresh_step(code, c, mode, side, s, u, fu, roots[best] - s, K6, us, fu_r, stiff)
-                else:
-                    _dense(c, side, F6, u, s, h, roots[best], us)
-                f_ev = _physical(code, c, mode, side, us, ys, fs)
-                kind = FORCE_PEAK if best == FORCE_RATE else REVERSAL
-                if best == REACH:
-                    kind = SETTLED  # recorded only: the run goes on
-                t_ev = us[TIME] if _regularised(side) else roots[best]
-                ev, n_ev = _push_event(ev, n_ev, t_ev, kind, mode, ys, f_ev)
-                counts[kind] += 1
-                max_force = max(max_force, f_ev)
-                max_indentation = max(max_indentation, ys[X1] - ys[X2])
-                if kind == stop_kind and counts[kind] >= stop_count:
-                    stop_record = roots[best]
-                    break
+            if n_ev + N_EVENTS > ev.shape[0]:
+                ev = _grow(ev, n_ev)  # a free row for each event _record may log
+            stats[STAT_MAX_FORCE], stats[STAT_MAX_INDENTATION] = max_force, max_indentation
+            n_ev, stop_record, spent = _record(code, c, mode, side, settle, stop_kind, stop_count, s, h, s_restart,
+                                               fired, roots, u, fu, F6, K6, us, fu_r, stiff, ys, fs, ev, n_ev, counts,
+                                               stats)
+            max_force, max_indentation = stats[STAT_MAX_FORCE], stats[STAT_MAX_INDENTATION]
+            nfev += spent
         if stop_record >= 0:
             # stopped at a recorded event: the state there from a fresh step that ends at it
             if stop_record > s:
@@ -904,8 +1052,8 @@ def run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count,
                 if not have_dense:
                     nfev += _interpolant(code, c, mode, side, u, fu, u_new, fu_new, h, K6, F6, tmp6, stiff)
                     have_dense = True
-                _dense(c, side, F6, u, s, h, _s_at_time(code, c, mode, side, F6, u, s, h, times[i_time], us, ys, fs,
-                                                        gs), us)
+                s_i = _s_at_time(code, c, mode, side, F6, u, s, h, times[i_time], us, ys, fs)
+                _dense(c, side, F6, u, s, h, s_i, us)
                 f_i = _physical(code, c, mode, side, us, ys, fs)
                 smp, n_s = _push_sample(smp, n_s, times[i_time], ys, mode, f_i)
                 i_time += 1
@@ -921,37 +1069,10 @@ def run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count,
                 smp, n_s = _push_sample(smp, n_s, t_end, y, mode, force)
             break
         if restart_col >= 0:
-            # the state at the root from a fresh step that ends there (the stages beyond the root
-            # belong to the continuation, not to the motion)
-            h_r = s_restart - s
-            if h_r > 0:
-                nfev += _fresh_step(code, c, mode, side, s, u, fu, h_r, K6, u_r, fu_r, stiff)
-            else:
-                _copy(u, u_r)
-            t = s_restart if not _regularised(side) else u_r[TIME]
-            _physical(code, c, mode, side, u_r, y_r, f_r)
-            if restart_col == STICK_BREAK and c[SPRINGS_] > 0 and c[RIGID_] == 0:
-                onto_stuck_orbit(c, pair_energy, y_r)
-            kind, mode, action = transition(code, c, restart_col, y_r, mode, settle)
-            if kind == STICK:
-                pair_energy = stuck_pair_energy(c, y_r)
-            _copy(y_r, y)
-            force = rhs(code, c, y, mode, f)
-            new_side = contact_side(code, c, y, mode)
-            _integration_state(code, mode, new_side, y, t, u)
-            s = t if not _regularised(new_side) else 0.0
-            rhs_integration(code, c, u, mode, new_side, fu)
-            nfev += 2
-            radau5.reset(stiff)  # a new phase starts explicit
-            _phase_tolerances(code, mode, new_side, atol, atol_u)
-            if new_side != side:  # the independent variable changes: a fresh initial step
-                side = new_side
-                h_abs = _phase_step(code, c, mode, side, u, fu, rtol, atol_u, t_end, max_step, w_floor, tmp6, fu_new)
-                nfev += 1
-            else:
-                h_abs = max(h_next, h_r)
-            if side == FLIGHT:
-                flight.coefficients(c, u, s, K6)
+            kind, mode, action, side, s, t, h_abs, force, pair_energy, spent = _restart(
+                code, c, settle, restart_col, mode, side, s, s_restart, h_next, u, fu, u_r, fu_r, y_r, f_r, y, f, K6,
+                stiff, rtol, atol, atol_u, t_end, max_step, w_floor, tmp6, fu_new, pair_energy)
+            nfev += spent
             if kind == SILENT:  # a restart only (the pair at its centre): nothing to log
                 quiet = restart_col
                 _events(code, c, mode, side, energy_limit, u, y, f, force, g_old)
@@ -1097,12 +1218,11 @@ def run_block(code, C, Y0, t_end, rtol, ATOL, max_step, settle, stop_kind, stop_
         _copy(C[i], c)
         _copy(Y0[i], y0)
         _copy(ATOL[i], atol)
-        out = run(code, c, y0, t_end[i], rtol, atol, max_step[i], settle, stop_kind, stop_count,
-                  np.int64(SAVE_SUMMARY), empty, max_steps, max_events, rk4_step, np.int64(1), stiff_after)
-        s = out[0]
+        s, events, _, _ = run(code, c, y0, t_end[i], rtol, atol, max_step[i], settle, stop_kind, stop_count,
+                              np.int64(SAVE_SUMMARY), empty, max_steps, max_events, rk4_step, np.int64(1), stiff_after)
         _copy(s, summary[i])
         permanent = s[S_OUTCOME] == PERMANENT_STICK
-        st_count[i] = stick_points(out[1], s[S_T_STOP], permanent, st_t[i], st_delta[i], st_dwell[i])
+        st_count[i] = stick_points(events, s[S_T_STOP], permanent, st_t[i], st_delta[i], st_dwell[i])
         if s[S_STATUS] == INTERRUPTED:
             for j in range(i + 1, stop):
                 summary[j, S_STATUS] = INTERRUPTED

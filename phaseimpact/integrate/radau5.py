@@ -9,13 +9,15 @@ Hairer & Wanner's RADAU5 (Solving ODEs II, IV.8) as scipy's ``Radau`` implements
 Newton on the transformed collocation system, Gustafsson's step predictor, the error estimate
 filtered by the real factor), with RADAU5's own mapping of the user's tolerance onto the
 method's internal one (:func:`enter`): its embedded estimate is of order 3, so it is asked for
-``0.1 rtol^(2/3)`` and delivers about ``rtol``.
+``INNER_SCALE rtol^(2/3)`` (Hairer's factor 0.1 lowered to :data:`INNER_SCALE`) and delivers about
+``rtol``.
 
 The Jacobian is a forward difference over the four components that feed back (the work ``W`` and
 the time ``t`` are quadratures); the collocation polynomial gives the dense output, written into
 the driver's interpolant array so that events are located on it like on DOP853's.
 
-All state travels in one tuple ``stiff`` made by :func:`workspace`.
+All state travels in one tuple ``stiff`` made by :func:`workspace`, read by the positions ``WS`` ...
+``F_START`` (constants: numba indexes the tuple's differently typed members statically).
 """
 
 from __future__ import annotations
@@ -73,13 +75,19 @@ WS_ROWS = 24
 # Controller state ctl.
 (ON, COUNT, SWITCH_AFTER, RTOL, H_OLD, ERR_OLD, JAC_CURRENT, LU_H, Q_BASE, Q_S, Q_H, HAVE_Q, FAILED) = range(13)
 N_CTL = 13
+# Members of the ``stiff`` tuple (:func:`workspace`).
+(WS, LU_REAL, LU_COMPLEX, ZC, PIV, CTL, TMP, FTMP, START, F_START) = range(10)
+# Rows of the pivots ``stiff[PIV]``: those of the real and of the complex factors.
+PIV_REAL, PIV_COMPLEX = 0, 1
 
 
 @allocating(python=True)
 def workspace(switch_after):
-    """A fresh ``stiff`` tuple for one run: ``(ws, real LU, complex LU, complex vector, pivots, ctl,
-    state, derivative, start, start derivative)``; the last four are scratch states for the
-    right-hand side and :func:`fixed_step` (the kernels allocate nothing)."""
+    """A fresh ``stiff`` tuple for one run, members at ``WS`` (the float rows ``J_`` ... ``ATOL_``),
+    ``LU_REAL``, ``LU_COMPLEX`` (the factors), ``ZC`` (a complex vector), ``PIV`` (pivots), ``CTL``
+    (the controller, indices ``ON`` ... ``FAILED``), then four scratch states: ``TMP``, ``FTMP`` for
+    the right-hand side and ``START``, ``F_START`` for :func:`fixed_step` (the kernels allocate
+    nothing)."""
     ctl = np.zeros(N_CTL)
     ctl[SWITCH_AFTER] = switch_after  # 0: never (DOP853 throughout)
     return (np.zeros((WS_ROWS, N_STATE)), np.zeros((N_FEEDBACK, N_FEEDBACK)),
@@ -91,40 +99,40 @@ def workspace(switch_after):
 @kernel
 def reset(stiff):
     """A new phase starts explicit."""
-    ctl = stiff[5]
+    ctl = stiff[CTL]
     ctl[ON] = 0.0
     ctl[COUNT] = 0.0
 
 
 @kernel
 def active(stiff):
-    return stiff[5][ON] != 0.0
+    return stiff[CTL][ON] != 0.0
 
 
 @kernel(python=True)
 def failed(stiff):
     """True once a step to a root could not be taken (the run must end with a failure status)."""
-    return stiff[5][FAILED] != 0.0
+    return stiff[CTL][FAILED] != 0.0
 
 
 @kernel
 def watch(stiff, h_lambda):
     """Count accepted explicit steps with a large ``h lambda``."""
-    ctl = stiff[5]
+    ctl = stiff[CTL]
     ctl[COUNT] = ctl[COUNT] + 1.0 if h_lambda > STIFF_H_LAMBDA else 0.0
 
 
 @kernel
 def due(stiff):
     """True when the phase has turned stiff and the next step should be Radau's."""
-    ctl = stiff[5]
+    ctl = stiff[CTL]
     return ctl[ON] == 0.0 and ctl[SWITCH_AFTER] > 0.0 and ctl[COUNT] >= ctl[SWITCH_AFTER]
 
 
 @kernel(python=True)
 def enter(code, c, mode, side, u, fu, rtol, atol, stiff):
     """Switch the phase to Radau at ``(u, fu)``; returns the evaluations spent (the Jacobian)."""
-    ws, ctl = stiff[0], stiff[5]
+    ws, ctl = stiff[WS], stiff[CTL]
     inner = INNER_SCALE * rtol ** (2.0 / 3.0)
     ctl[ON] = 1.0
     ctl[RTOL] = inner
@@ -141,7 +149,7 @@ def enter(code, c, mode, side, u, fu, rtol, atol, stiff):
 @kernel
 def jacobian(code, c, mode, side, u, fu, stiff):
     """Forward-difference Jacobian columns of the feedback components into ``ws[J_]``."""
-    ws, ctl, tmp, ftmp = stiff[0], stiff[5], stiff[6], stiff[7]
+    ws, ctl, tmp, ftmp = stiff[WS], stiff[CTL], stiff[TMP], stiff[FTMP]
     rtol = ctl[RTOL]
     for j in range(N_FEEDBACK):
         for i in range(N_STATE):
@@ -206,14 +214,14 @@ def _solve(A, piv, b):
 @kernel(inline="always")
 def _factorize(h, stiff):
     """LU of the feedback blocks of ``MU_REAL/h I - J`` and ``MU_COMPLEX/h I - J``; False when singular."""
-    ws, lu_real, lu_complex, piv = stiff[0], stiff[1], stiff[2], stiff[4]
+    ws, lu_real, lu_complex, piv = stiff[WS], stiff[LU_REAL], stiff[LU_COMPLEX], stiff[PIV]
     for i in range(N_FEEDBACK):
         for j in range(N_FEEDBACK):
             lu_real[i, j] = -ws[J_ + i, j]
             lu_complex[i, j] = -ws[J_ + i, j]
         lu_real[i, i] += MU_REAL / h
         lu_complex[i, i] += complex(MU_RE / h, MU_IM / h)
-    return _lu(lu_real, piv[0]) and _lu(lu_complex, piv[1])
+    return _lu(lu_real, piv[PIV_REAL]) and _lu(lu_complex, piv[PIV_COMPLEX])
 
 
 @kernel(inline="always")
@@ -242,7 +250,8 @@ def _norm(ws, row, n_rows, scale_row):
 def _collocation(code, c, mode, side, u, h, newton_tol, stiff):
     """Simplified Newton on the collocation system from the guess in ``ws[Z_]``; returns
     ``(converged, iterations, rate, evaluations)`` with the solution in ``ws[Z_]``."""
-    ws, lu_real, lu_complex, zc, piv, ctl, tmp, ftmp = stiff[:8]
+    ws, lu_real, lu_complex, zc, piv = stiff[WS], stiff[LU_REAL], stiff[LU_COMPLEX], stiff[ZC], stiff[PIV]
+    ctl, tmp, ftmp = stiff[CTL], stiff[TMP], stiff[FTMP]
     rtol = ctl[RTOL]
     mu_real = MU_REAL / h
     mu_complex = complex(MU_RE / h, MU_IM / h)
@@ -273,8 +282,8 @@ def _collocation(code, c, mode, side, u, h, newton_tol, stiff):
             ws[DW_, j] = TI[0, 0] * f0 + TI[0, 1] * f1 + TI[0, 2] * f2 - mu_real * w0
             zc[j] = complex(TI[1, 0] * f0 + TI[1, 1] * f1 + TI[1, 2] * f2,
                             TI[2, 0] * f0 + TI[2, 1] * f1 + TI[2, 2] * f2) - mu_complex * complex(w1, w2)
-        _solve_system(lu_real, piv[0], ws, h_over_mu_real, ws[DW_])
-        _solve_system(lu_complex, piv[1], ws, h_over_mu_complex, zc)
+        _solve_system(lu_real, piv[PIV_REAL], ws, h_over_mu_real, ws[DW_])
+        _solve_system(lu_complex, piv[PIV_COMPLEX], ws, h_over_mu_complex, zc)
         for j in range(N_STATE):
             ws[DW_ + 1, j] = zc[j].real
             ws[DW_ + 2, j] = zc[j].imag
@@ -298,7 +307,7 @@ def _collocation(code, c, mode, side, u, h, newton_tol, stiff):
 def _guess(s, h, stiff):
     """Starting stages from the last collocation polynomial when this step starts on it (at its
     end: the next step; at its start: a fresh step to a root inside it); zero otherwise."""
-    ws, ctl = stiff[0], stiff[5]
+    ws, ctl = stiff[WS], stiff[CTL]
     x0 = 1.0 if s == ctl[Q_S] else (0.0 if s == ctl[Q_BASE] else -1.0)
     if ctl[HAVE_Q] == 0.0 or x0 < 0.0:
         for i in range(3):
@@ -325,7 +334,7 @@ def _predict(h_abs, h_old, err, err_old):
 def _solve_stages(code, c, mode, side, s, u, fu, h, stiff):
     """Converge the collocation system for a step ``h`` (new factors, a fresh Jacobian once if the
     old one fails); returns ``(converged, iterations, rate, evaluations)``."""
-    ctl = stiff[5]
+    ctl = stiff[CTL]
     newton_tol = max(10.0 * _EPS / ctl[RTOL], min(0.03, math.sqrt(ctl[RTOL])))
     evaluations = 0
     _guess(s, h, stiff)
@@ -350,7 +359,7 @@ def _solve_stages(code, c, mode, side, s, u, fu, h, stiff):
 def _finish(code, c, mode, side, s, s_end, h, u, u_new, fu_new, stiff):
     """``u_new``, ``fu_new`` from the converged stages; the polynomial kept for the next guess.
     Returns the contact force at ``u_new``."""
-    ws, ctl = stiff[0], stiff[5]
+    ws, ctl = stiff[WS], stiff[CTL]
     for j in range(N_STATE):
         u_new[j] = u[j] + ws[Z_ + 2, j]
         for k in range(3):
@@ -369,7 +378,7 @@ def attempt(code, c, mode, side, s, s_bound, u, fu, h_abs, stiff, u_new, fu_new)
     Returns ``(ok, s_new, h_next, force_new, evaluations)``; ``ok`` False when the step size
     collapsed. The step's stages stay in the workspace for :func:`dense_coefficients`.
     """
-    ws, ctl = stiff[0], stiff[5]
+    ws, ctl = stiff[WS], stiff[CTL]
     rtol = ctl[RTOL]
     evaluations = 0
     rejected = False
@@ -392,18 +401,18 @@ def attempt(code, c, mode, side, s, s_bound, u, fu, h_abs, stiff, u_new, fu_new)
             z3 = ws[Z_ + 2, j]
             ws[SCALE_, j] = ws[ATOL_, j] + max(abs(u[j]), abs(u[j] + z3)) * rtol  # the error's scale
             ws[ERR_, j] = fu[j] + (E1 * ws[Z_, j] + E2 * ws[Z_ + 1, j] + E3 * z3) / h
-        _solve_system(stiff[1], stiff[4][0], ws, h / MU_REAL, ws[ERR_])
+        _solve_system(stiff[LU_REAL], stiff[PIV][PIV_REAL], ws, h / MU_REAL, ws[ERR_])
         err = _norm(ws, ERR_, 1, SCALE_)
         if rejected and err > 1.0:
             # the estimate after a rejection, filtered once more (Hairer's rule for stiff components)
-            tmp, ftmp = stiff[6], stiff[7]
+            tmp, ftmp = stiff[TMP], stiff[FTMP]
             for j in range(N_STATE):
                 tmp[j] = u[j] + ws[ERR_, j]
             rhs_integration(code, c, tmp, mode, side, ftmp)
             evaluations += 1
             for j in range(N_STATE):
                 ws[ERR_, j] = ftmp[j] + (E1 * ws[Z_, j] + E2 * ws[Z_ + 1, j] + E3 * ws[Z_ + 2, j]) / h
-            _solve_system(stiff[1], stiff[4][0], ws, h / MU_REAL, ws[ERR_])
+            _solve_system(stiff[LU_REAL], stiff[PIV][PIV_REAL], ws, h / MU_REAL, ws[ERR_])
             err = _norm(ws, ERR_, 1, SCALE_)
         if err <= 1.0:
             break
@@ -431,7 +440,7 @@ def fixed_step(code, c, mode, side, s, u, fu, h, stiff, u_new, fu_new):
     """A step of exactly ``h`` (to an event's root) without error control, split into equal
     sub-steps until Newton converges. Returns the evaluations spent."""
     evaluations = 0
-    start, f_start = stiff[8], stiff[9]
+    start, f_start = stiff[START], stiff[F_START]
     for pieces in (1, 2, 4, 8, 16, 32, 64):
         part = h / pieces
         for j in range(N_STATE):
@@ -452,7 +461,7 @@ def fixed_step(code, c, mode, side, s, u, fu, h, stiff, u_new, fu_new):
             return evaluations
     # Newton never converged, even on 64 pieces: no state at the root; the driver ends the run
     # with a failure status (radau5.failed)
-    stiff[5][FAILED] = 1.0
+    stiff[CTL][FAILED] = 1.0
     for j in range(N_STATE):
         u_new[j] = u[j]
         fu_new[j] = fu[j]
@@ -463,7 +472,7 @@ def fixed_step(code, c, mode, side, s, u, fu, h, stiff, u_new, fu_new):
 def dense_coefficients(stiff, F):
     """The step's collocation polynomial in the driver's interpolant form (:func:`.dop853.dense_eval`:
     ``F0 x + F1 x(1-x) + F2 x^2(1-x)`` with the higher rows zero)."""
-    ws = stiff[0]
+    ws = stiff[WS]
     for j in range(N_STATE):
         q1, q2, q3 = ws[Q_, j], ws[Q_ + 1, j], ws[Q_ + 2, j]
         F[0, j] = q1 + q2 + q3

@@ -361,10 +361,3 @@ class Columns(ColumnAccess):
         return cls(summary[:, d.S_STATUS].astype(np.int8), summary[:, d.S_OUTCOME].astype(np.int8),
                    summary[:, d.S_REASON].astype(np.int8), values, np.asarray(stick_count, dtype=np.int64),
                    stick_t, stick_delta, stick_dwell)
-
-    @classmethod
-    def concatenate(cls, parts: list[Columns]) -> Columns:
-        values = {name: np.concatenate([p.values[name] for p in parts]) for name, *_ in SUMMARY_COLUMNS}
-        return cls(*(np.concatenate([getattr(p, a) for p in parts]) for a in ("status", "outcome", "stop_reason")),
-                   values, *(np.concatenate([getattr(p, a) for p in parts])
-                             for a in ("stick_count", "stick_t", "stick_delta", "stick_dwell")))

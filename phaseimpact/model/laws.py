@@ -1,7 +1,11 @@
 r"""Contact laws, each defined once (seed eq. 2 and 8; docs/physics.md §3).
 
-A law is one :class:`LawEntry` in :data:`REGISTRY`: its kernel code, its flags and the
-parameters it reads. The kernels below (compiled with numba, callable from Python too) give
+A law is one :class:`LawEntry` in :data:`REGISTRY`: its kernel form, its flags (unilateral,
+Filippov, runaway guard), its options, and the name, unit and exponent of its damping parameter.
+Nothing outside this module names a law: the kernels read the law's flags from its kernel code
+(:attr:`ContactLaw.code`, bits :data:`FILIPPOV`, :data:`UNILATERAL`, :data:`CLAMP`) and its
+runaway guard from the packed coefficients; the command line, archives and plots take names and
+units from the entry. The kernels below (compiled with numba, callable from Python too) give
 the contact force ``P(delta, deltadot)``, its partial derivatives and the contact potential;
 the right-hand side, the Jacobian, the event functions and the energy ledger
 (:mod:`phaseimpact.model.rhs`) are composed from them, so a law's physics lives here only.
@@ -14,6 +18,9 @@ the right-hand side, the Jacobian, the event functions and the energy ledger
 ``hunt-crossley-approx``,   Hunt-Crossley form with ``kappa = chi(e) K / v`` from a
 ``lankarani-nikravesh``,    coefficient of restitution ``e`` (the damping's only source)
 ``flores``, ``gonthier``
+``kuwabara-kono``           ``K delta^alpha + gamma delta^(alpha-1) deltadot`` for ``delta > 0``
+                            (viscoelastic spheres, Kuwabara & Kono 1987; ``gamma`` set by
+                            ``kappa``, N s/m^alpha); ``clamp=True`` keeps ``P >= 0``
 ``paper``                   ``(K + kappa deltadot) |delta|^alpha sgn(deltadot)`` (eq. 8):
                             a Filippov system. ``contact="printed"`` (default) reads
                             ``|delta|`` literally, so the law also acts in tension;
@@ -24,16 +31,40 @@ Modes (``paper``): ``+1``/``-1`` while slipping with that sign of ``deltadot``, 
 while ``deltadot = 0`` holds, ``PLAIN`` (2) reads ``sgn(deltadot)`` literally (what a fixed-step
 method sees). Every other law runs in mode ``+1``.
 
-Adding a law: write its kernel branch in :func:`contact_force`, :func:`force_partials` and
-:func:`contact_potential` under a new code, and register a :class:`LawEntry`; the conformance
-tests (``tests/test_laws.py``) pick it up from :func:`law_variants`.
+Adding a law
+------------
+A law of your own needs no edit of the package: :func:`phaseimpact.define_law` takes plain
+Python functions and compiles them (:mod:`phaseimpact.model.userlaw`). To ship a law with the
+package, in this module only:
+
+1. Give its force a kernel form: a new constant next to :data:`ELASTIC` ... :data:`KUWABARA_KONO`
+   (below :data:`NATIVE`), or reuse a form whose force it shares (the restitution laws reuse
+   :data:`HUNT_CROSSLEY`).
+2. Write the form's branch in :func:`contact_force`, :func:`force_partials` (exact partial
+   derivatives, zero where ``P`` is 0) and, if its elastic term has a potential,
+   :func:`contact_potential` (a Filippov law has none). A branch reads the flags from ``code``:
+   :data:`UNILATERAL` (the kernels already return 0 for ``delta <= 0``), :data:`CLAMP`
+   (``P >= 0``), and the sign factor of a :data:`FILIPPOV` law from ``mode``. (A Filippov law
+   sticks while the required force stays within ``K |delta|^alpha``, ``paper``'s elastic term:
+   ``_stick_bound`` in :mod:`phaseimpact.integrate.events`; a Filippov law with another elastic
+   term needs its bound there as well.)
+3. :func:`register` a :class:`LawEntry`: name, form, damping source (``"kappa"``,
+   ``"restitution"`` or None), the flags, the options it allows (``"clamp"``, ``"bilateral"``,
+   ``"contact"``), the damping's exponent ``damping_power(alpha)`` (its unit is
+   ``N s/m^damping_power``) and a description.
+4. Run ``phaseimpact check-law NAME`` and ``pytest tests/test_laws.py``: the conformance suite
+   (:func:`phaseimpact.checks.check_law`; partials against finite differences, the energy
+   ledger, momentum, agreement with the scipy oracle) picks it up from :func:`law_variants`.
+
+The engine's compiled cache is keyed on a digest of these sources: the next run recompiles.
 """
 
 from __future__ import annotations
 
 import functools
 import math
-from dataclasses import dataclass
+import types as _types
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -41,15 +72,34 @@ from .._jit import kernel
 from ..parameters import Parameters, require, require_choice
 
 __all__ = [
-    "LawEntry", "REGISTRY", "LAWS", "CONTACT_READINGS", "ContactLaw", "as_law", "law_variants",
-    "contact_force", "force_partials", "contact_potential", "hertz_power",
-    "STUCK", "PLAIN",
+    "LawEntry", "REGISTRY", "LAWS", "CONTACT_READINGS", "ContactLaw", "as_law", "law_variants", "register",
+    "contact_force", "force_partials", "contact_potential", "hertz_power", "is_filippov", "is_unilateral",
+    "STUCK", "PLAIN", "RUNAWAY_ENERGY_FACTOR", "GUARD_ENERGY_FACTOR",
 ]
 
-# Kernel codes (integers: the compiled loop dispatches on them, no strings inside it).
-ABRATE, ABRATE_BILATERAL, HUNT_CROSSLEY, HUNT_CROSSLEY_CLAMPED, PAPER_PRINTED, PAPER_UNILATERAL = range(6)
+# A kernel code is an integer (the compiled loop reads no strings): its low bits are the law's
+# flags, the next bits its form (which branch of the kernels computes the force) and, for a user
+# law, the bits above FORM the address of its compiled function (phaseimpact.model.userlaw).
+FILIPPOV, UNILATERAL, CLAMP = 1, 2, 4
+FORM_SHIFT, FORM_MASK, ADDRESS_SHIFT = 3, 7, 6
+ELASTIC, HUNT_CROSSLEY, PAPER, KUWABARA_KONO, NATIVE = 0, 1, 2, 3, 7
+# What a user law's compiled function returns (its first argument).
+FORCE, D_DELTA, D_RATE, POTENTIAL = 0, 1, 2, 3
 STUCK, PLAIN = 0, 2
 CONTACT_READINGS = ("printed", "unilateral")
+OPTIONS = ("bilateral", "clamp", "contact")
+
+#: Energy growth, relative to the run's initial energy, that ends a run as a runaway: eq. 8 as
+#: printed feeds the motion without bound once the projectile is in tension. Every other law can
+#: only gain energy in an anti-damped slip that ends at the separation (the unilateral reading) or
+#: through numerical trouble, so it gets a wide guard instead: the run reaches its rebound.
+RUNAWAY_ENERGY_FACTOR = 2.0
+GUARD_ENERGY_FACTOR = 100.0
+
+
+def make_code(form: int, flags: int, address: int = 0) -> int:
+    """The kernel code of a law of ``form`` with ``flags`` (and a user law's function ``address``)."""
+    return (address << ADDRESS_SHIFT) | (form << FORM_SHIFT) | flags
 
 
 @kernel(python=True, inline="always")
@@ -60,17 +110,80 @@ def hertz_power(ad, alpha):
     return ad**alpha
 
 
+@kernel(inline="always")
+def _root(ad, alpha):
+    """``ad**(alpha - 1)`` for ``ad >= 0``; ``sqrt(ad)`` for Hertz's 3/2."""
+    if alpha == 1.5:
+        return math.sqrt(ad)
+    return ad ** (alpha - 1.0)
+
+
 @kernel
 def _sign(x):
     return 1.0 if x > 0 else (-1.0 if x < 0 else 0.0)
 
 
-@kernel(inline="always")
+@kernel(python=True, inline="always")
 def is_filippov(code):
-    """Whether the law's sign factor needs stick/slip modes (``paper``)."""
-    return code == PAPER_PRINTED or code == PAPER_UNILATERAL
+    """Whether the law's sign factor needs stick/slip modes (flag :data:`FILIPPOV`)."""
+    return (code & FILIPPOV) != 0
 
 
+@kernel(python=True, inline="always")
+def is_unilateral(code):
+    """Whether the law acts only while ``delta > 0`` (flag :data:`UNILATERAL`)."""
+    return (code & UNILATERAL) != 0
+
+
+class _NativeGlobals(dict):
+    """Globals of :func:`_native`: its one outside name, the call of a user law's compiled
+    function, is imported when numba first compiles it (it needs numba; the commands that
+    integrate nothing never import numba)."""
+
+    def __missing__(self, key):
+        if key != "call_native":
+            raise KeyError(key)
+        from .native import call_native_compiled
+
+        self[key] = call_native_compiled
+        return call_native_compiled
+
+
+def _native_py(address, which, delta, deltadot, mode, K, damping, alpha):
+    return call_native(address, which, delta, deltadot, mode, K, damping, alpha)  # noqa: F821 (_NativeGlobals)
+
+
+#: A user law's compiled function at ``address``: ``which`` of FORCE, D_DELTA, D_RATE, POTENTIAL.
+#: (Callers pass ``np.int64`` constants: a bare constant is typed as a literal, one more compile each.)
+_native = kernel(_types.FunctionType(
+    _native_py.__code__, _NativeGlobals(__name__=__name__, __builtins__=__builtins__), "_native"))
+
+
+@kernel
+def _kuwabara_kono_force(code, delta, deltadot, K, damping, alpha):
+    force = (K * delta + damping * deltadot) * _root(delta, alpha)
+    return max(force, 0.0) if (code & CLAMP) != 0 else force
+
+
+@kernel
+def _kuwabara_kono_partials(code, delta, deltadot, K, damping, alpha, stiffness):
+    ad = abs(delta)
+    root = _root(ad, alpha)
+    if (code & CLAMP) != 0 and K * ad + damping * deltadot <= 0:
+        return 0.0, 0.0
+    return K * stiffness + damping * deltadot * (alpha - 1.0) * root / ad, damping * root
+
+
+@kernel
+def _native_partials(code, delta, deltadot, mode, K, damping, alpha):
+    address = code >> ADDRESS_SHIFT
+    return (_native(address, np.int64(D_DELTA), delta, deltadot, mode, K, damping, alpha),
+            _native(address, np.int64(D_RATE), delta, deltadot, mode, K, damping, alpha))
+
+
+# The branches of the laws added after the first ones call out-of-line kernels: the body of
+# contact_force and force_partials stays small enough for LLVM to inline them into the steppers'
+# stages (a Hunt-Crossley step evaluates the force 12 times).
 @kernel(python=True)
 def contact_force(code, delta, deltadot, mode, K, damping, alpha):
     """Contact force ``P`` (N, positive pushing the bodies apart) while slipping or free.
@@ -78,18 +191,22 @@ def contact_force(code, delta, deltadot, mode, K, damping, alpha):
     ``mode`` is ignored except by ``paper`` (sign factor); the stuck force of ``paper`` is not a
     function of ``(delta, deltadot)`` and comes from :func:`phaseimpact.model.rhs.stick_force`.
     """
-    if code == ABRATE:
-        return K * hertz_power(delta, alpha) if delta > 0 else 0.0
-    if code == ABRATE_BILATERAL:
-        return K * hertz_power(abs(delta), alpha) * _sign(delta)
-    if code == HUNT_CROSSLEY or code == HUNT_CROSSLEY_CLAMPED:
-        if delta <= 0:
-            return 0.0
-        force = (K + damping * deltadot) * hertz_power(delta, alpha)
-        return max(force, 0.0) if code == HUNT_CROSSLEY_CLAMPED else force
-    # paper (eq. 8)
-    if code == PAPER_UNILATERAL and delta <= 0:
+    unilateral = (code & UNILATERAL) != 0
+    if unilateral and delta <= 0:
         return 0.0
+    form = (code >> FORM_SHIFT) & FORM_MASK
+    if form == ELASTIC:
+        if unilateral:
+            return K * hertz_power(delta, alpha)
+        return K * hertz_power(abs(delta), alpha) * _sign(delta)
+    if form == HUNT_CROSSLEY:
+        force = (K + damping * deltadot) * hertz_power(delta, alpha)
+        return max(force, 0.0) if (code & CLAMP) != 0 else force
+    if form == KUWABARA_KONO:
+        return _kuwabara_kono_force(code, delta, deltadot, K, damping, alpha)
+    if form == NATIVE:
+        return _native(code >> ADDRESS_SHIFT, np.int64(FORCE), delta, deltadot, mode, K, damping, alpha)
+    # paper (eq. 8)
     sign = _sign(deltadot) if mode == PLAIN else float(mode)
     return (K + damping * deltadot) * hertz_power(abs(delta), alpha) * sign
 
@@ -103,18 +220,19 @@ def force_partials(code, delta, deltadot, mode, K, damping, alpha):
     """
     ad = abs(delta)
     stiffness = alpha * hertz_power(ad, alpha) / ad if ad > 0 else 0.0  # d|delta|^alpha / d|delta|
-    if code == ABRATE:
-        return (K * stiffness, 0.0) if delta > 0 else (0.0, 0.0)
-    if code == ABRATE_BILATERAL:
+    if (code & UNILATERAL) != 0 and delta <= 0:
+        return 0.0, 0.0
+    form = (code >> FORM_SHIFT) & FORM_MASK
+    if form == ELASTIC:
         return K * stiffness, 0.0
-    if code == HUNT_CROSSLEY or code == HUNT_CROSSLEY_CLAMPED:
-        if delta <= 0:
-            return 0.0, 0.0
-        if code == HUNT_CROSSLEY_CLAMPED and K + damping * deltadot <= 0:
+    if form == HUNT_CROSSLEY:
+        if (code & CLAMP) != 0 and K + damping * deltadot <= 0:
             return 0.0, 0.0
         return (K + damping * deltadot) * stiffness, damping * hertz_power(ad, alpha)
-    if code == PAPER_UNILATERAL and delta <= 0:
-        return 0.0, 0.0
+    if form == KUWABARA_KONO:
+        return _kuwabara_kono_partials(code, delta, deltadot, K, damping, alpha, stiffness)
+    if form == NATIVE:
+        return _native_partials(code, delta, deltadot, mode, K, damping, alpha)
     sign = _sign(deltadot) if mode == PLAIN else float(mode)
     return sign * (K + damping * deltadot) * stiffness * _sign(delta), sign * damping * hertz_power(ad, alpha)
 
@@ -122,24 +240,32 @@ def force_partials(code, delta, deltadot, mode, K, damping, alpha):
 @kernel(python=True)
 def contact_potential(code, delta, K, alpha):
     """Potential of the elastic term, ``K |delta|^(alpha+1)/(alpha+1)`` (J), for the laws whose
-    elastic term is conservative; 0 for ``paper``, whose elastic term acts like friction."""
-    if code == PAPER_PRINTED or code == PAPER_UNILATERAL:
+    elastic term is conservative; 0 for a Filippov law (``paper``), whose elastic term acts like
+    friction; a user law's own potential (0 if it gives none)."""
+    if (code & FILIPPOV) != 0:
         return 0.0
-    if delta <= 0 and code != ABRATE_BILATERAL:
+    if (code & UNILATERAL) != 0 and delta <= 0:
         return 0.0
+    if (code >> FORM_SHIFT) & FORM_MASK == NATIVE:
+        return _native(code >> ADDRESS_SHIFT, np.int64(POTENTIAL), delta, 0.0, np.int64(1), K, 0.0, alpha)
     ad = abs(delta)
     return K * ad * hertz_power(ad, alpha) / (alpha + 1.0)
 
 
+def _number_text(x: float) -> str:
+    return f"{x:g}"
+
+
 @dataclass(frozen=True)
 class LawEntry:
-    """A registered contact law.
+    """A registered contact law: everything the package knows about it.
 
     Attributes
     ----------
     name : str
-    code : int
-        Kernel code (options may select a variant, see :attr:`ContactLaw.code`).
+    form : int
+        Kernel form (:data:`ELASTIC`, :data:`HUNT_CROSSLEY`, :data:`PAPER`,
+        :data:`KUWABARA_KONO`, or :data:`NATIVE` for a user law).
     damping : {None, "kappa", "restitution"}
         The law's one source of damping: the parameter ``kappa``, a coefficient of
         restitution, or none.
@@ -152,31 +278,78 @@ class LawEntry:
     chi : callable or None
         Damping factor ``chi(e)`` of a restitution law, ``kappa = chi(e) K / v``.
     description : str
+    options : tuple of str
+        Options of :class:`ContactLaw` the law allows: ``"bilateral"`` (a unilateral law that can
+        also pull), ``"clamp"`` (``P >= 0``), ``"contact"`` (a Filippov law's reading of
+        ``|delta|``).
+    damping_name : str
+        The damping coefficient's symbol in messages (set with ``kappa`` whatever its name).
+    damping_power : callable
+        ``alpha -> p``: the damping coefficient is in N s/m^p (``1 + alpha`` for
+        ``(K + kappa deltadot) delta^alpha``).
+    inverse : bool
+        ``restitution=e`` may replace ``kappa`` through the exact inverse
+        (:func:`phaseimpact.model.restitution.kappa_for_restitution`; ``hunt-crossley``).
+    runaway_factor : float
+        Energy growth that ends a run of the law's bilateral reading as a runaway
+        (:data:`RUNAWAY_ENERGY_FACTOR` for eq. 8 as printed; unilateral readings get
+        :data:`GUARD_ENERGY_FACTOR`).
+    native : object
+        A user law's compiled functions (:mod:`phaseimpact.model.userlaw`); None when shipped.
+    unit : str or None
+        A user law's own unit text for its damping coefficient (default from ``damping_power``).
     """
 
     name: str
-    code: int
+    form: int
     damping: str | None
     filippov: bool
     unilateral: bool
     conservative: bool
     chi: object = None
     description: str = ""
+    options: tuple = ()
+    damping_name: str = "kappa"
+    damping_power: object = field(default=lambda alpha: 1.0 + alpha)
+    inverse: bool = False
+    runaway_factor: float = GUARD_ENERGY_FACTOR
+    native: object = None
+    unit: str | None = None
+
+    @property
+    def shipped(self) -> bool:
+        return self.native is None
+
+    def damping_unit(self, alpha: float) -> str:
+        """The damping coefficient's unit, e.g. ``N s/m^2.5`` (a user law's own, if it gave one)."""
+        if self.unit is not None:
+            return self.unit
+        return f"N s/m^{_number_text(self.damping_power(alpha))}"
+
+    def damping_udunits(self, alpha: float) -> str:
+        """The same in UDUNITS (archives), e.g. ``N s m-2.5``."""
+        if self.unit is not None:
+            return self.unit
+        return f"N s m-{_number_text(self.damping_power(alpha))}"
 
 
 REGISTRY: dict[str, LawEntry] = {}
 
 
 def register(entry: LawEntry) -> LawEntry:
+    """Add ``entry`` to :data:`REGISTRY` (replacing a user law of the same name)."""
     REGISTRY[entry.name] = entry
+    if "_named_law" in globals():
+        _named_law.cache_clear()
     return entry
 
 
-register(LawEntry("abrate", ABRATE, None, False, True, True,
+register(LawEntry("abrate", ELASTIC, None, False, True, True, options=("bilateral",),
                   description="Hertz contact, no damping (seed eq. 2)"))
-register(LawEntry("paper", PAPER_PRINTED, "kappa", True, False, False,
+register(LawEntry("paper", PAPER, "kappa", True, False, False, options=("contact",),
+                  runaway_factor=RUNAWAY_ENERGY_FACTOR,
                   description="eq. 8: (K + kappa deltadot) |delta|^alpha sgn(deltadot)"))
-register(LawEntry("hunt-crossley", HUNT_CROSSLEY, "kappa", False, True, True,
+register(LawEntry("hunt-crossley", HUNT_CROSSLEY, "kappa", False, True, True, options=("clamp",), inverse=True,
                   description="(K + kappa deltadot) delta^alpha for delta > 0"))
 for _name, _chi, _text in (
     ("hunt-crossley-approx", lambda e: 1.5 * (1 - e), "chi = 3(1-e)/2"),
@@ -184,9 +357,13 @@ for _name, _chi, _text in (
     ("flores", lambda e: 1.6 * (1 - e) / e, "chi = 8(1-e)/(5e)"),
     ("gonthier", lambda e: (1 - e * e) / e, "chi = (1-e^2)/e"),
 ):
-    register(LawEntry(_name, HUNT_CROSSLEY, "restitution", False, True, True, chi=_chi,
+    register(LawEntry(_name, HUNT_CROSSLEY, "restitution", False, True, True, chi=_chi, options=("clamp",),
                       description=f"K delta^alpha (1 + chi deltadot / v), {_text}"))
+register(LawEntry("kuwabara-kono", KUWABARA_KONO, "kappa", False, True, True, options=("clamp",),
+                  damping_name="gamma", damping_power=lambda alpha: alpha,
+                  description="K delta^alpha + gamma delta^(alpha-1) deltadot for delta > 0 (viscoelastic spheres)"))
 
+#: The shipped laws (user laws join :data:`REGISTRY` only).
 LAWS = tuple(REGISTRY)
 
 
@@ -197,18 +374,21 @@ class ContactLaw:
     Attributes
     ----------
     name : str
-        One of :data:`LAWS`.
+        One of :data:`LAWS`, or a user law's name (:func:`phaseimpact.define_law`).
     restitution : float or None
         Coefficient of restitution ``e`` in (0, 1]: required by the restitution laws (their
-        only damping); for ``hunt-crossley`` it *replaces* ``kappa`` through the exact inverse
-        (:func:`phaseimpact.model.restitution.kappa_for_restitution`), and ``kappa`` is then not
-        read. Not allowed for ``abrate`` or ``paper``.
+        only damping); for a law with an exact inverse (``hunt-crossley``) it *replaces*
+        ``kappa`` (:func:`phaseimpact.model.restitution.kappa_for_restitution`), and ``kappa`` is
+        then not read. Not allowed for other laws.
     bilateral : bool
-        ``abrate`` only: the contact also pulls (``K |delta|^alpha sgn(delta)``).
+        Laws with the ``bilateral`` option (``abrate``): the contact also pulls
+        (``K |delta|^alpha sgn(delta)``).
     clamp : bool
-        Hunt-Crossley family only: ``P >= 0`` (no adhesion at the end of contact).
+        Laws with the ``clamp`` option (Hunt-Crossley family, Kuwabara-Kono): ``P >= 0`` (no
+        adhesion at the end of contact).
     contact : {"printed", "unilateral"}
-        ``paper`` only: the reading of ``|delta|^alpha`` (docs/physics.md §3).
+        Laws with the ``contact`` option (``paper``): the reading of ``|delta|^alpha``
+        (docs/physics.md §3).
     """
 
     name: str = "paper"
@@ -218,7 +398,7 @@ class ContactLaw:
     contact: str = "printed"
 
     def __post_init__(self):
-        require_choice("law", self.name, LAWS)
+        require_choice("law", self.name, tuple(REGISTRY))
         require_choice("contact", self.contact, CONTACT_READINGS)
         entry = self.entry
         if self.restitution is not None:
@@ -227,34 +407,51 @@ class ContactLaw:
                     isinstance(e, (int, float, np.floating, np.integer)) and not isinstance(e, bool)
                     and math.isfinite(e) and 1e-6 <= e <= 1)
             object.__setattr__(self, "restitution", float(e))
-            if entry.damping != "restitution" and self.name != "hunt-crossley":
-                raise ValueError(f"restitution = {e!r} is not read by law {self.name!r}; allowed with the "
-                                 "restitution laws and hunt-crossley")
+            if entry.damping != "restitution" and not entry.inverse:
+                allowed = [n for n, x in REGISTRY.items() if x.damping == "restitution" or x.inverse]
+                raise ValueError(f"restitution = {e!r} is not read by law {self.name!r}; allowed with "
+                                 + ", ".join(allowed))
         elif entry.damping == "restitution":
             raise ValueError(f"law {self.name!r} needs a restitution coefficient (restitution in [1e-6, 1])")
-        if self.bilateral and self.name != "abrate":
-            raise ValueError(f"bilateral = True is only allowed for law 'abrate', not {self.name!r}")
-        if self.clamp and entry.code != HUNT_CROSSLEY:
-            raise ValueError(f"clamp = True is only allowed for the Hunt-Crossley laws, not {self.name!r}")
-        if self.contact != "printed" and not entry.filippov:
-            raise ValueError(f"contact = {self.contact!r} is only allowed for law 'paper' "
-                             f"(law {self.name!r} is unilateral already)")
+        for option, given in (("bilateral", self.bilateral), ("clamp", self.clamp),
+                              ("contact", self.contact != "printed")):
+            if given and option not in entry.options:
+                allowed = [n for n, x in REGISTRY.items() if option in x.options]
+                value = f"contact = {self.contact!r}" if option == "contact" else f"{option} = True"
+                raise ValueError(f"{value} is only allowed for law{'s' if len(allowed) > 1 else ''} "
+                                 f"{', '.join(repr(n) for n in allowed)}, not {self.name!r}")
 
     @property
     def entry(self) -> LawEntry:
         return REGISTRY[self.name]
 
     @property
-    def code(self) -> int:
-        """Kernel code of this law with its options."""
-        code = self.entry.code
-        if self.bilateral:
-            return ABRATE_BILATERAL
+    def flags(self) -> int:
+        """The kernel flags of this law with its options."""
+        entry = self.entry
+        flags = FILIPPOV if entry.filippov else 0
+        if (entry.unilateral and not self.bilateral) or (entry.filippov and self.contact == "unilateral"):
+            flags |= UNILATERAL
         if self.clamp:
-            return HUNT_CROSSLEY_CLAMPED
-        if code == PAPER_PRINTED and self.contact == "unilateral":
-            return PAPER_UNILATERAL
+            flags |= CLAMP
+        return flags
+
+    @property
+    def code(self) -> int:
+        """Kernel code of this law with its options (flags, form, a user law's function); kept
+        until the law's entry is replaced (a user law defined again)."""
+        entry = REGISTRY[self.name]
+        cached = self.__dict__.get("_code")
+        if cached is not None and cached[0] is entry:
+            return cached[1]
+        code = make_code(entry.form, self.flags, 0 if entry.native is None else entry.native.address)
+        object.__setattr__(self, "_code", (entry, code))
         return code
+
+    def __getstate__(self):
+        state = dict(self.__dict__)
+        state.pop("_code", None)  # holds the entry (functions, a user law's compiled code): not pickled
+        return state
 
     @property
     def is_filippov(self) -> bool:
@@ -262,11 +459,16 @@ class ContactLaw:
 
     @property
     def is_unilateral(self) -> bool:
-        return self.code in (ABRATE, HUNT_CROSSLEY, HUNT_CROSSLEY_CLAMPED, PAPER_UNILATERAL)
+        return bool(self.flags & UNILATERAL)
 
     @property
     def is_conservative(self) -> bool:
         return self.entry.conservative
+
+    @property
+    def runaway_factor(self) -> float:
+        """Energy growth (relative to the start) that ends a run as a runaway."""
+        return GUARD_ENERGY_FACTOR if self.is_unilateral else self.entry.runaway_factor
 
     @property
     def damping_source(self) -> str | None:
@@ -274,6 +476,10 @@ class ContactLaw:
         if self.restitution is not None:
             return "restitution"
         return self.entry.damping
+
+    def damping_unit(self, alpha: float) -> str:
+        """Unit of the damping coefficient set by ``kappa`` (e.g. ``N s/m^2.5``)."""
+        return self.entry.damping_unit(alpha)
 
     def reads(self, name: str) -> bool:
         """Whether a parameter named ``name`` changes this law's results (``kappa`` is read only
@@ -285,7 +491,7 @@ class ContactLaw:
         return True
 
     def kappa(self, params: Parameters) -> float:
-        """Effective damping coefficient (N s/m^(1+alpha)) of this law for ``params``."""
+        """Effective damping coefficient (N s/m^damping_power) of this law for ``params``."""
         source = self.damping_source
         if source is None:
             return 0.0
@@ -299,7 +505,7 @@ class ContactLaw:
     def label(self) -> str:
         """Short description with options, for results and archives."""
         parts = [self.name]
-        if self.entry.filippov:
+        if "contact" in self.entry.options:
             parts.append(f"contact={self.contact}")
         if self.bilateral:
             parts.append("bilateral")
@@ -328,16 +534,19 @@ def _named_law(name: str) -> ContactLaw:
     return ContactLaw(name)
 
 
-def law_variants() -> list[ContactLaw]:
-    """Every registered law with every option it allows (for conformance tests)."""
+def law_variants(names=None) -> list[ContactLaw]:
+    """Every registered law (or those of ``names``) with every option it allows (for conformance
+    tests)."""
     variants = []
     for entry in REGISTRY.values():
+        if names is not None and entry.name not in names:
+            continue
         e = 0.6 if entry.damping == "restitution" else None
         variants.append(ContactLaw(entry.name, restitution=e))
-        if entry.name == "abrate":
-            variants.append(ContactLaw("abrate", bilateral=True))
-        if entry.code == HUNT_CROSSLEY:
+        if "bilateral" in entry.options:
+            variants.append(ContactLaw(entry.name, bilateral=True))
+        if "clamp" in entry.options:
             variants.append(ContactLaw(entry.name, restitution=e, clamp=True))
-        if entry.filippov:
+        if "contact" in entry.options:
             variants.append(ContactLaw(entry.name, contact="unilateral"))
     return variants

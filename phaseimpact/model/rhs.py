@@ -34,7 +34,7 @@ from .laws import (
 )
 
 __all__ = [
-    "X1", "X2", "V1", "V2", "WORK", "pack", "N_COEF",
+    "X1", "X2", "V1", "V2", "WORK", "pack", "N_COEF", "GUARD_",
     "rhs", "rhs_integration", "rhs_values", "contact_side", "damping_rate", "PLAIN_PHASE", "FLIGHT", "energy",
     "relative_slip",
     "stick_force", "stick_orbit", "stick_margin", "stick_break_distance",
@@ -42,9 +42,9 @@ __all__ = [
 ]
 
 X1, X2, V1, V2, WORK = range(5)
-# Packed coefficients.
-M1_, M2_, K_, KB_, KM_, DAMP_, ALPHA_, SPRINGS_, RIGID_ = range(9)
-N_COEF = 9
+# Packed coefficients; GUARD_: the law's runaway factor (its entry, :attr:`ContactLaw.runaway_factor`).
+M1_, M2_, K_, KB_, KM_, DAMP_, ALPHA_, SPRINGS_, RIGID_, GUARD_ = range(10)
+N_COEF = 10
 
 
 def pack(params: Parameters, law: ContactLaw) -> np.ndarray:
@@ -52,7 +52,7 @@ def pack(params: Parameters, law: ContactLaw) -> np.ndarray:
     springs = params.target == "plate"
     return np.array([params.M1, params.M2, params.K, params.Kb if springs else 0.0,
                      params.Km if springs else 0.0, law.kappa(params), params.alpha,
-                     1.0 if springs else 0.0, 1.0 if params.target == "rigid" else 0.0])
+                     1.0 if springs else 0.0, 1.0 if params.target == "rigid" else 0.0, law.runaway_factor])
 
 
 @kernel

@@ -1,0 +1,278 @@
+"""The conformance suite of a contact law: :func:`check_law` (``phaseimpact check-law``).
+
+The shipped laws pass it (``tests/test_laws.py`` runs the same checks with pytest); a user law
+(:func:`phaseimpact.define_law`) is held to it before it is trusted. Each check gives a verdict:
+
+==================  ==========================================================================
+``force``           the force is finite in contact; a unilateral law's is 0 at ``delta <= 0``
+``partials``        ``force_partials`` against central differences of the force, in contact
+``energy ledger``   the mechanical energy lost equals the contact work less the change of the
+                    contact potential (docs/physics.md §4), and the engine's own energy agrees
+``momentum``        a free target: total momentum conserved through the impact
+``oracle``          against scipy ``solve_ivp`` (DOP853, rtol 1e-12) on a rigid target: the
+                    largest force and the rebound speed; and ``tests/oracle.py`` where a
+                    checkout provides it (plate target, event times)
+==================  ==========================================================================
+"""
+
+from __future__ import annotations
+
+import math
+import sys
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+__all__ = ["check_law", "Verdict", "LawReport", "damping_number", "with_damping_number"]
+
+
+@dataclass(frozen=True)
+class Verdict:
+    check: str
+    passed: bool | None  # None: skipped
+    detail: str
+
+    def line(self) -> str:
+        mark = "PASS" if self.passed else ("skip" if self.passed is None else "FAIL")
+        return f"  {mark}  {self.check:<14} {self.detail}"
+
+
+@dataclass
+class LawReport:
+    law: str
+    verdicts: list = field(default_factory=list)
+
+    @property
+    def passed(self) -> bool:
+        return all(v.passed is not False for v in self.verdicts)
+
+    def __str__(self) -> str:
+        head = f"check-law {self.law}: {'passed' if self.passed else 'FAILED'}"
+        return "\n".join([head] + [v.line() for v in self.verdicts])
+
+
+def damping_number(params, law) -> float:
+    """The law's dimensionless damping at ``params``: its damping force over its elastic force at
+    the impact speed and the undamped Hertz indentation on a rigid target (``kappa v / K`` for
+    ``(K + kappa deltadot) delta^alpha``). None-damped laws: 0."""
+    from .model.laws import as_law, contact_force
+    from .model.rhs import pack
+
+    law = as_law(law)
+    if not law.reads("kappa"):
+        return 0.0
+    c = pack(params.replace(kappa=1.0), law)
+    K, alpha, v = c[2], c[6], float(params.v)
+    depth = (0.5 * (alpha + 1.0) * params.M1 * v * v / K) ** (1.0 / (alpha + 1.0))
+    term = contact_force(law.code, depth, v, 1, K, 1.0, alpha) - contact_force(law.code, depth, 0.0, 1, K, 1.0, alpha)
+    elastic = contact_force(law.code, depth, 0.0, 1, K, 0.0, alpha)
+    return float(params.kappa) * term / elastic if elastic > 0 else 0.0
+
+
+def with_damping_number(params, law, a: float):
+    """``params`` with ``kappa`` set so that ``law``'s :func:`damping_number` is ``a`` (unchanged
+    for a law whose damping does not come from ``kappa``)."""
+    unit = damping_number(params.replace(kappa=1.0), law)
+    if unit <= 0 or not math.isfinite(unit):
+        return params
+    return params.replace(kappa=a / unit)
+
+
+def _case(params, law):
+    """The check's case: ``params`` with a moderate damping for the law (damping force 5 % of the
+    elastic one at the impact speed and the Hertz indentation)."""
+    return with_damping_number(params, law, 0.05)
+
+
+def _check(name, function):
+    try:
+        passed, detail = function()
+    except Exception as exc:  # noqa: BLE001 (a verdict, whatever went wrong)
+        return Verdict(name, False, f"{type(exc).__name__}: {exc}")
+    return Verdict(name, passed, detail)
+
+
+def _force(law, params):
+    from .model.laws import contact_force
+    from .model.rhs import pack
+
+    c = pack(params, law)
+    K, damping, alpha = c[2], c[5], c[6]
+    modes = (1, -1) if law.is_filippov else (1,)
+    for delta in (1e-7, 1e-6, 1e-5, 4e-5):
+        for deltadot in (-0.5, 0.0, 0.5):
+            for mode in modes:
+                f = contact_force(law.code, delta, deltadot, mode, K, damping, alpha)
+                if not math.isfinite(f):
+                    return False, f"P({delta:g}, {deltadot:g}) = {f!r}: not finite"
+    if law.is_unilateral:
+        native = law.entry.native
+        for delta in (0.0, -1e-6):
+            f = (contact_force(law.code, delta, -0.5, 1, K, damping, alpha) if native is None
+                 else float(native.functions["force"](delta, -0.5, K, damping, alpha)) if delta == 0.0 else 0.0)
+            if f != 0.0:
+                return False, f"P({delta:g}, -0.5) = {f!r}: a unilateral law's force must be 0 at the separation"
+        return True, "finite in contact, 0 at delta <= 0"
+    return True, "finite in contact and in tension"
+
+
+def _partials(law, params):
+    from .model.laws import contact_force, force_partials
+    from .model.rhs import pack
+
+    c = pack(params, law)
+    K, damping, alpha = c[2], c[5], c[6]
+    worst = 0.0
+    for delta, deltadot in ((3e-5, 0.4), (2e-5, -0.3), (1e-5, 0.05)):
+        for mode in (1, -1) if law.is_filippov else (1,):
+            if law.is_filippov and np.sign(deltadot) != mode:
+                continue
+            exact = force_partials(law.code, delta, deltadot, mode, K, damping, alpha)
+            hd, hr = 1e-6 * abs(delta), 1e-6 * abs(deltadot)
+            fd = ((contact_force(law.code, delta + hd, deltadot, mode, K, damping, alpha)
+                   - contact_force(law.code, delta - hd, deltadot, mode, K, damping, alpha)) / (2 * hd),
+                  (contact_force(law.code, delta, deltadot + hr, mode, K, damping, alpha)
+                   - contact_force(law.code, delta, deltadot - hr, mode, K, damping, alpha)) / (2 * hr))
+            scale = K * abs(delta) ** alpha / abs(delta) + 1.0
+            for a, b, what in ((exact[0], fd[0], "dP/ddelta"), (exact[1], fd[1], "dP/ddeltadot")):
+                err = abs(a - b) / (abs(b) + 1e-3 * scale)
+                worst = max(worst, err)
+                if err > 1e-5:
+                    return False, (f"{what} at ({delta:g}, {deltadot:g}) = {a:.6g}, central differences "
+                                   f"{b:.6g} (relative error {err:.2g} > 1e-5)")
+    return True, f"largest relative error {worst:.2g} (<= 1e-5)"
+
+
+def _energy(law, params):
+    from .integrate import simulate
+    from .model.laws import contact_potential
+    from .model.rhs import energy, pack
+
+    tr = simulate(params, law, 4e-3, rtol=1e-12)
+    if tr.status != "success":
+        return False, f"the run failed: {tr.status} ({tr.message})"
+    c = pack(params, law)
+    y0, y1 = tr.initial_state, tr.final_state
+    du = (contact_potential(law.code, y1[0] - y1[1], c[2], c[6])
+          - contact_potential(law.code, y0[0] - y0[1], c[2], c[6]))
+    scale = 0.5 * params.M1 * params.v**2
+    gap = abs(tr.dissipated_energy - (tr.loop_area - du)) / scale
+    own = abs(tr.dissipated_energy - (energy(law.code, c, y0) - energy(law.code, c, y1))) / scale
+    if gap > 1e-8 or own > 1e-12:
+        return False, (f"energy lost {tr.dissipated_energy:.9g} J, contact work less potential change "
+                       f"{tr.loop_area - du:.9g} J (gap {gap:.2g} of the impact energy; allowed 1e-8): is the "
+                       "potential the elastic term's?")
+    if not law.is_conservative:
+        return True, f"gap {gap:.2g} of the impact energy (<= 1e-8); no potential (not conservative)"
+    # without damping the elastic term alone acts: the energy with its potential is constant through
+    # the contact (a wrong potential shows here, not at the ends, where it is 0)
+    elastic = params.replace(kappa=0.0) if law.reads("kappa") else params
+    steps = simulate(elastic, law, 4e-3, rtol=1e-12, save="steps")
+    ce = pack(elastic, law)
+    values = np.array([energy(law.code, ce, y) for y in steps.y])
+    drift = float(np.max(np.abs(values - values[0]))) / scale
+    if law.reads("kappa") and drift > 1e-8:
+        return False, (f"undamped, the energy with the law's potential varies by {drift:.2g} of the impact energy "
+                       "through the contact (allowed 1e-8): the potential is not the elastic term's")
+    return True, (f"gap {gap:.2g} of the impact energy (<= 1e-8); undamped energy constant to {drift:.2g}")
+
+
+def _momentum(law, params):
+    from .integrate import simulate
+
+    p = params.replace(target="free")
+    tr = simulate(p, law, 1e-3, rtol=1e-12)
+    momentum = p.M1 * tr.final_state[2] + p.M2 * tr.final_state[3]
+    err = abs(momentum - p.M1 * p.v) / (p.M1 * p.v)
+    return err <= 1e-10, f"relative change {err:.2g} (allowed 1e-10)"
+
+
+def _scipy(law, params):
+    """A rigid target, integrated by scipy from the force alone until the separation."""
+    from scipy.integrate import solve_ivp
+
+    from .integrate import simulate
+    from .model.laws import contact_force
+    from .model.rhs import pack
+
+    if law.is_filippov:
+        return None, "a Filippov law needs the stick/slip oracle (tests/oracle.py)"
+    p = params.replace(target="rigid")
+    c = pack(p, law)
+    K, damping, alpha, M1 = c[2], c[5], c[6], p.M1
+
+    def rates(t, z):
+        return [z[1], -contact_force(law.code, z[0], z[1], 1, K, damping, alpha) / M1]
+
+    def separation(t, z):
+        return z[0] if t > 0 else 1.0
+    separation.terminal, separation.direction = True, -1
+    contact_time = 3.2 * (M1 / K) ** 0.4 / p.v ** 0.2
+    sol = solve_ivp(rates, (0, 20 * contact_time), [0.0, p.v], method="DOP853", rtol=1e-12, atol=[1e-18, 1e-13],
+                    events=separation, dense_output=True)
+    if sol.status != 1:
+        return None, "scipy found no separation (a sticking or adhesive law): compared nothing"
+    t_sep, v_out = sol.t_events[0][0], sol.y_events[0][0][1]
+    ts = np.linspace(0, t_sep, 4001)
+    z = sol.sol(ts)
+    peak = max(contact_force(law.code, a, b, 1, K, damping, alpha) for a, b in zip(z[0], z[1], strict=True))
+    tr = simulate(p, law, rtol=1e-12)
+    separations = [e for e in tr.events if e.kind == "separation"]
+    if not separations:
+        return False, "the engine found no separation where scipy did"
+    ours = separations[0].state[2] - separations[0].state[3]
+    err_v = abs(ours - v_out) / p.v
+    err_f = abs(tr.max_force - peak) / peak
+    ok = err_v <= 1e-8 and err_f <= 1e-5
+    return ok, (f"rebound speed {-ours:.10g} m/s vs scipy {-v_out:.10g} (relative {err_v:.2g}, allowed 1e-8); "
+                f"max force relative {err_f:.2g} (scipy's sampled, allowed 1e-5)")
+
+
+def _oracle(law, params):
+    tests = Path(__file__).resolve().parent.parent / "tests"
+    if not (tests / "oracle.py").is_file():
+        return None, "tests/oracle.py not found (an installed package): scipy check above only"
+    sys.path.insert(0, str(tests))
+    try:
+        from oracle import oracle
+    except Exception as exc:  # noqa: BLE001 (another checkout's oracle)
+        return None, f"tests/oracle.py not importable ({type(exc).__name__})"
+    finally:
+        sys.path.remove(str(tests))
+    from .integrate import simulate
+
+    tr = simulate(params, law, 4e-3, rtol=1e-12)
+    ref = oracle(params, law, 4e-3, rtol=1e-12)
+    ours = sorted(zip(np.round(tr.event_t, 12), [e.kind for e in tr.events], strict=True))
+    theirs = sorted(zip(np.round(ref.times, 12), ref.kinds, strict=True))
+    kinds_ours, kinds_theirs = [k for _, k in ours], [k for _, k in theirs]
+    if kinds_ours != kinds_theirs:
+        return False, f"event kinds differ: engine {kinds_ours[:6]}..., oracle {kinds_theirs[:6]}..."
+    dt = max((abs(a - b) for (a, _), (b, _) in zip(ours, theirs, strict=True)), default=0.0)
+    df = abs(tr.max_force - ref.max_force) / ref.max_force if ref.max_force else 0.0
+    ok = dt <= 1e-9 * 4e-3 and df <= 1e-9
+    return ok, f"{len(ours)} events, times within {dt:.2g} s, max force relative {df:.2g} (allowed 4e-12 s, 1e-9)"
+
+
+def check_law(law, params=None, *, oracle: bool = True) -> LawReport:
+    """Run the conformance suite on ``law`` (a :class:`~phaseimpact.model.ContactLaw`, a
+    registered name, or a user law's name) and return a report with a verdict per check.
+
+    ``params`` defaults to the seed plate at ``v = 1`` m/s; the damping (``kappa``) is chosen for
+    the law so that its damping force is about 5 % of the elastic one.
+    """
+    from .model.laws import as_law
+    from .parameters import seed_parameters
+
+    law = as_law(law)
+    params = _case(seed_parameters(v=1.0) if params is None else params, law)
+    report = LawReport(law.label())
+    report.verdicts.append(_check("force", lambda: _force(law, params)))
+    report.verdicts.append(_check("partials", lambda: _partials(law, params)))
+    report.verdicts.append(_check("energy ledger", lambda: _energy(law, params)))
+    report.verdicts.append(_check("momentum", lambda: _momentum(law, params)))
+    report.verdicts.append(_check("scipy", lambda: _scipy(law, params)))
+    if oracle:
+        report.verdicts.append(_check("oracle", lambda: _oracle(law, params)))
+    return report

@@ -1,0 +1,249 @@
+r"""Your own contact law from Python: :func:`define_law`.
+
+A user law is plain Python: a force function ``force(delta, deltadot, K, damping, alpha)``
+(N; ``delta`` m, ``deltadot`` m/s, ``K`` the contact stiffness, ``damping`` the coefficient set
+with ``kappa``, ``alpha`` the exponent), and optionally its partial derivatives
+``partials(...) -> (dP/ddelta, dP/ddeltadot)`` and the potential of its elastic term
+``potential(delta, K, alpha)`` (J). numba compiles them into one C-callable function (about a
+second); the engine calls it through its address, carried in the law's kernel code
+(:mod:`phaseimpact.model.native`), so the engine itself is not recompiled for a new law.
+
+Example (the Kuwabara-Kono law written by hand)::
+
+    import math
+    import phaseimpact
+
+    def force(delta, deltadot, K, gamma, alpha):
+        return (K * delta + gamma * deltadot) * math.sqrt(delta)
+
+    phaseimpact.define_law("my-kk", force, damping=("gamma", "N s m-1.5"), damping_power=1.5)
+    phaseimpact.simulate(phaseimpact.seed_parameters(kappa=1e5), "my-kk")
+
+A unilateral law (the default) acts only while ``delta > 0``: the engine never calls its force
+at ``delta <= 0`` (:func:`define_law` checks that the function gives 0 there anyway when asked
+with ``delta = 0``). Filippov laws (a sign factor with stick and slip, like ``paper``) cannot be
+user laws yet.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import inspect
+import math
+import os
+import sys
+from dataclasses import dataclass
+
+from .laws import LAWS, NATIVE, REGISTRY, LawEntry, register
+
+__all__ = ["define_law", "load_law_file", "UserLawError"]
+
+_ARGUMENTS = {"force": 5, "partials": 5, "potential": 3}
+_SAMPLES = ((1e-6, 0.5), (1e-5, -0.3), (2e-5, 1.0), (1e-7, 0.0))  # (delta, deltadot), seed-like scales
+
+
+class UserLawError(ValueError):
+    """A user law that the engine cannot run (wrong signature, NaN force, ...): the message says
+    what to fix."""
+
+
+@dataclass(frozen=True)
+class NativeLaw:
+    """A user law's compiled function (kept alive here: the engine calls its address)."""
+
+    address: int
+    cfunc: object
+    digest: str
+    functions: dict
+
+
+def _check_signature(name: str, function) -> None:
+    if function is None:
+        return
+    if not callable(function):
+        raise UserLawError(f"{name} = {function!r} is not a function; allowed: a Python function of "
+                           f"{_ARGUMENTS[name]} numbers")
+    try:
+        parameters = inspect.signature(function).parameters.values()
+    except (TypeError, ValueError):
+        raise UserLawError(f"{name} = {function!r} has no readable signature; allowed: a plain Python "
+                           "function") from None
+    positional = [p for p in parameters if p.kind in (p.POSITIONAL_ONLY, p.POSITIONAL_OR_KEYWORD)]
+    required = [p for p in positional if p.default is p.empty]
+    if any(p.kind == p.VAR_POSITIONAL for p in parameters):
+        return
+    wanted = _ARGUMENTS[name]
+    if not (len(required) <= wanted <= len(positional)):
+        args = "(delta, deltadot, K, damping, alpha)" if wanted == 5 else "(delta, K, alpha)"
+        raise UserLawError(f"{name} {getattr(function, '__name__', '')}{inspect.signature(function)} has the wrong "
+                           f"signature; allowed: {name}{args}")
+
+
+def _python_value(name, function, args):
+    try:
+        value = function(*args)
+    except Exception as exc:  # noqa: BLE001 (the user's code: report whatever it raised)
+        raise UserLawError(f"{name}{args} raised {type(exc).__name__}: {exc}") from None
+    values = value if name == "partials" else (value,)
+    if name == "partials" and not (isinstance(value, tuple) and len(value) == 2):
+        raise UserLawError(f"partials{args} returned {value!r}; allowed: a tuple (dP/ddelta, dP/ddeltadot)")
+    for v in values:
+        try:
+            f = float(v)
+        except (TypeError, ValueError):
+            raise UserLawError(f"{name}{args} returned {value!r}; allowed: a float") from None
+        if not math.isfinite(f):
+            raise UserLawError(f"{name}{args} returned {value!r}: the {name} must be finite for delta > 0 "
+                               "(a NaN or an infinity would stop every run)")
+    return value
+
+
+def _validate(name, force, partials, potential, unilateral, K, damping, alpha):
+    for label, function in (("force", force), ("partials", partials), ("potential", potential)):
+        _check_signature(label, function)
+    for delta, deltadot in _SAMPLES:
+        args = (delta, deltadot, K, damping, alpha)
+        _python_value("force", force, args)
+        if partials is not None:
+            _python_value("partials", partials, args)
+        if potential is not None:
+            _python_value("potential", potential, (delta, K, alpha))
+    if unilateral:
+        at_zero = float(force(0.0, -0.5, K, damping, alpha))
+        if at_zero != 0.0:
+            raise UserLawError(f"law {name!r}: force(0, -0.5, ...) = {at_zero!r}, not 0: a unilateral law's force "
+                               "must vanish at the separation delta = 0 (pass unilateral=False for a law that also "
+                               "acts in tension)")
+
+
+def _source_digest(*functions) -> str:
+    digest = hashlib.sha256()
+    for f in functions:
+        if f is None:
+            digest.update(b"-")
+            continue
+        try:
+            digest.update(inspect.getsource(f).encode())
+        except (OSError, TypeError):
+            digest.update(f.__code__.co_code)
+    return digest.hexdigest()[:16]
+
+
+def _compile(force, partials, potential) -> NativeLaw:
+    """One C-callable function ``(which, delta, deltadot, mode, K, damping, alpha)`` for the law."""
+    import numba
+
+    from .native import SIGNATURE
+
+    try:
+        f = numba.njit(force)
+        dp = numba.njit(partials) if partials is not None else None
+        pot = numba.njit(potential) if potential is not None else None
+        has_partials, has_potential = dp is not None, pot is not None
+
+        def law(which, delta, deltadot, mode, K, damping, alpha):
+            if which == 0:
+                return f(delta, deltadot, K, damping, alpha)
+            if which == 3:
+                return pot(delta, K, alpha) if has_potential else 0.0
+            if has_partials:
+                pair = dp(delta, deltadot, K, damping, alpha)
+                return pair[0] if which == 1 else pair[1]
+            # central differences (a law without partials)
+            if which == 1:
+                h = 1e-6 * abs(delta) + 1e-15
+                return (f(delta + h, deltadot, K, damping, alpha) - f(delta - h, deltadot, K, damping, alpha)) / (2 * h)
+            h = 1e-6 * abs(deltadot) + 1e-12
+            return (f(delta, deltadot + h, K, damping, alpha) - f(delta, deltadot - h, K, damping, alpha)) / (2 * h)
+
+        if not has_partials:
+            dp = f  # typed but never called
+        if not has_potential:
+            pot = f
+        compiled = numba.cfunc(SIGNATURE)(law)
+    except numba.core.errors.NumbaError as exc:
+        first = str(exc).strip().splitlines()
+        detail = next((line for line in first if "rror" in line or "Untyped" in line or "Unknown" in line),
+                      first[0] if first else "")
+        raise UserLawError("numba cannot compile the law's functions (plain arithmetic and the math module "
+                           f"compile; Python objects do not): {detail.strip()}") from None
+    return NativeLaw(compiled.address, compiled, _source_digest(force, partials, potential),
+                     {"force": force, "partials": partials, "potential": potential})
+
+
+def define_law(name: str, force, *, partials=None, potential=None, unilateral: bool = True,
+               damping=("kappa", None), damping_power=None, clamp_option: bool = False,
+               description: str = "") -> LawEntry:
+    """Register a contact law of your own; it then runs wherever a shipped law does.
+
+    Parameters
+    ----------
+    name : str
+        The law's name (``simulate(params, name)``, ``--law name``); not a shipped law's.
+    force : function ``(delta, deltadot, K, damping, alpha) -> float``
+        The contact force P (N, positive pushing the bodies apart). Plain arithmetic and
+        :mod:`math`: numba compiles it.
+    partials : function ``(delta, deltadot, K, damping, alpha) -> (float, float)``, optional
+        ``(dP/ddelta, dP/ddeltadot)``; default: central differences of ``force``.
+    potential : function ``(delta, K, alpha) -> float``, optional
+        Potential of the elastic term (J), for the energy ledger; default: none (the law is then
+        not conservative: its whole contact work counts as dissipated).
+    unilateral : bool
+        The law acts only while ``delta > 0`` (its force must be 0 at ``delta = 0``).
+    damping : (str, str or None)
+        The damping coefficient's symbol and unit (set with ``kappa``); the unit defaults to
+        ``N s/m^damping_power``.
+    damping_power : float or None
+        The damping coefficient is in N s/m^damping_power; default ``1 + alpha``.
+    clamp_option : bool
+        Whether ``clamp=True`` is allowed (not implemented for user laws: the force function
+        clamps itself).
+    description : str
+
+    Returns
+    -------
+    LawEntry
+    """
+    if not isinstance(name, str) or not name or any(ch.isspace() for ch in name):
+        raise UserLawError(f"name = {name!r} is out of range; allowed: a non-empty name without spaces")
+    if name in LAWS:
+        raise UserLawError(f"name = {name!r} is a shipped law's; allowed: a new name")
+    if clamp_option:
+        raise UserLawError("clamp_option = True is not available for user laws: write max(P, 0) in the force")
+    if not (isinstance(damping, tuple) and len(damping) == 2 and isinstance(damping[0], str)):
+        raise UserLawError(f"damping = {damping!r} is out of range; allowed: (symbol, unit or None)")
+    if damping_power is not None and not (isinstance(damping_power, (int, float)) and math.isfinite(damping_power)):
+        raise UserLawError(f"damping_power = {damping_power!r} is out of range; allowed: a finite number or None")
+    _validate(name, force, partials, potential, unilateral, 1e9, 1e5, 1.5)
+    native = _compile(force, partials, potential)
+    power = (lambda alpha: 1.0 + alpha) if damping_power is None else (lambda alpha, p=float(damping_power): p)
+    entry = LawEntry(name, NATIVE, "kappa", False, bool(unilateral), potential is not None,
+                     description=description or f"user law ({getattr(force, '__module__', '')}."
+                                                f"{getattr(force, '__name__', 'force')})",
+                     damping_name=damping[0], damping_power=power, native=native,
+                     unit=None if damping[1] is None else str(damping[1]))
+    return register(entry)
+
+
+def load_law_file(path) -> list[str]:
+    """Run a Python file that defines laws (``--law-file``); return the names it registered."""
+    path = os.fspath(path)
+    before = {n: e for n, e in REGISTRY.items()}
+    if not os.path.isfile(path):
+        raise UserLawError(f"law file {path!r} does not exist")
+    import importlib.util
+
+    module_name = "phaseimpact_user_law_" + hashlib.sha1(os.path.abspath(path).encode()).hexdigest()[:12]
+    spec = importlib.util.spec_from_file_location(module_name, path)
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[module_name] = module
+    try:
+        spec.loader.exec_module(module)
+    except UserLawError:
+        raise
+    except Exception as exc:  # noqa: BLE001 (the user's file)
+        raise UserLawError(f"law file {path!r} failed: {type(exc).__name__}: {exc}") from None
+    added = [n for n, e in REGISTRY.items() if before.get(n) is not e]
+    if not added:
+        raise UserLawError(f"law file {path!r} defines no law; it should call phaseimpact.define_law(...)")
+    return added
