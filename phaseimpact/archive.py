@@ -1576,7 +1576,15 @@ def _same_number(a, b) -> bool:
 
 def _axis_text(name, values) -> str:
     values = np.asarray(values, dtype=float).ravel()
-    return f"{name}: {len(values)} values from {values[0]:.6g} to {values[-1]:.6g}" if values.size else f"{name}: empty"
+    # repr digits: a difference in the 11th digit must show in the message
+    return f"{name}: {len(values)} values from {values[0]!r} to {values[-1]!r}" if values.size else f"{name}: empty"
+
+
+def _t_end_text(t_end) -> str:
+    """``t_end`` as a reader knows it: NaN or None in an archive means each run until it settles."""
+    if t_end is None or (isinstance(t_end, float) and math.isnan(t_end)):
+        return "none (each run until its outcome settles)"
+    return f"{float(t_end)!r} s"
 
 
 def same_work(held: dict, kind: str, law: ContactLaw, params: Parameters, axes: dict, t_end, rtol) -> list[str]:
@@ -1598,9 +1606,9 @@ def same_work(held: dict, kind: str, law: ContactLaw, params: Parameters, axes: 
         differences.append("axes " + ", ".join(_axis_text(k, v) for k, v in held["axes"].items())
                            + " (asked " + ", ".join(_axis_text(k, v) for k, v in axes.items()) + ")")
     if not _same_number(held["t_end"], t_end):
-        differences.append(f"t_end {held['t_end']!r}")
+        differences.append(f"t_end {_t_end_text(held['t_end'])} (asked {_t_end_text(t_end)})")
     if not _same_number(held["rtol"], rtol):
-        differences.append(f"rtol {held['rtol']!r}")
+        differences.append(f"rtol {held['rtol']!r} (asked {rtol!r})")
     return differences
 
 

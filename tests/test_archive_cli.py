@@ -456,3 +456,18 @@ def test_quick_previews_go_to_the_preview_folder():
     ignored = subprocess.run(["git", "check-ignore", "-q", "figures/preview/x.png"],
                              cwd=study_cli.ROOT)
     assert ignored.returncode == 0  # previews never show up in git status
+
+
+def test_a_resume_of_other_work_names_what_differs_with_the_asked_value(tmp_path):
+    """The audit's "holds other work (t_end nan)": the held and the asked value both show, in
+    words, and axis ends differing in the 11th digit are visible."""
+    from _cli import run
+
+    out = tmp_path / "s.h5"
+    base = ["sweep", "--law", "paper", "--v", "1", "--kappa-min", "1e9", "--kappa-max", "1e14", "--num", "5",
+            "--no-progress", "--out", out]
+    assert run(base)[0] == 0
+    code, _, err = run([*base, "--t-end", "0.01", "--resume"])
+    assert code == 2 and "t_end none (each run until its outcome settles) (asked 0.01 s)" in err, err
+    code, _, err = run([*base[:8], "1.0000000001e14", *base[9:], "--resume"])
+    assert code == 2 and "100000000010000.0" in err, err
