@@ -3,6 +3,6 @@
 if __name__ == "__main__":  # a module scan that imports the package must not run it
     import sys
 
-    from .cli import main
+    from ._entry import main
 
     sys.exit(main())

@@ -266,3 +266,20 @@ def test_atlas_stops_with_the_resume_command_and_no_lock(tmp_path, warm, signum,
     assert sorted(p.name for p in tmp_path.iterdir()) == ["a.h5"]  # no lock, no temporary file
     done = archive.load(out).done
     assert 0 < np.count_nonzero(done) < done.size
+
+
+def test_ctrl_c_while_the_command_line_is_imported_ends_in_one_line(monkeypatch, capsys):
+    """The console script's first moments: a KeyboardInterrupt raised by the import of the command
+    line (made to happen here by a finder) gives one line and 130, no traceback."""
+    from phaseimpact import _entry
+
+    class Interrupting:
+        def find_spec(self, name, path=None, target=None):
+            if name == "phaseimpact.cli":
+                raise KeyboardInterrupt
+            return None
+
+    monkeypatch.delitem(sys.modules, "phaseimpact.cli", raising=False)
+    monkeypatch.setattr(sys, "meta_path", [Interrupting(), *sys.meta_path])
+    assert _entry.main() == 130
+    assert capsys.readouterr().err == "phaseimpact: interrupted\n"
