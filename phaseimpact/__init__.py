@@ -4,9 +4,7 @@ analysed as a dynamical system."""
 # First: phaseimpact._jit names its cache directory with it.
 __version__ = "0.2.0"
 
-import importlib
-
-from . import _environment
+from . import _environment, _lazy
 
 # NumPy's f2py reads SOURCE_DATE_EPOCH once, when it is first imported (SciPy and numba import it),
 # and crashes on a bad value; so a bad value is hidden while f2py imports here, then put back for
@@ -37,15 +35,4 @@ __all__ = [
     "__version__",
 ]
 
-
-def __getattr__(name):
-    module = _EXPORTS.get(name)
-    if module is None:
-        raise AttributeError(f"module 'phaseimpact' has no attribute {name!r}")
-    value = getattr(importlib.import_module(f".{module}", __name__), name)
-    globals()[name] = value
-    return value
-
-
-def __dir__():
-    return sorted(set(globals()) | set(_EXPORTS))
+__getattr__, __dir__ = _lazy.attach(__name__, globals(), _EXPORTS)

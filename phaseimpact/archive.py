@@ -82,6 +82,7 @@ from __future__ import annotations
 import contextlib
 import datetime
 import hashlib
+import io
 import itertools
 import json
 import math
@@ -105,7 +106,7 @@ from .model import ContactLaw
 from .parameters import Parameters
 
 __all__ = ["SCHEMA_VERSION", "KINDS", "CHUNK_POINTS", "Checkpoint", "save", "load", "describe", "same_work",
-           "check_overwrite", "kind_of", "created_timestamp", "DamagedArchiveError"]
+           "check_overwrite", "kind_of", "created_timestamp", "DamagedArchiveError", "to_xarray"]
 
 SCHEMA_VERSION = 3
 KINDS = ("sweep", "atlas", "critical-curve")
@@ -462,7 +463,10 @@ def _reserve(f, nbytes: int) -> None:
 
     HDF5 must never meet a full disk: a failed write leaves objects it can no longer close (their
     finalizers print a traceback each) and the interpreter's exit then crashes inside HDF5 (a
-    segfault). Reserved first, a full disk is an ``OSError`` here, before HDF5 writes."""
+    segfault). Reserved first, a full disk is an ``OSError`` here, before HDF5 writes. An archive
+    built in memory (:func:`to_xarray`) has no disk to reserve."""
+    if f.driver == "fileobj":
+        return
     fd = f.id.get_vfd_handle()
     reserve(fd, max(int(f.id.get_filesize()), os.fstat(fd).st_size) + nbytes + _RESERVE_MARGIN)
 
@@ -488,11 +492,7 @@ def _write_file(result, path: str, *, force: bool, spare_rows: int):
         try:
             with h5py.File(tmp, "w", libver=_LIBVER) as f:
                 _reserve(f, 0)  # the header, attributes and small datasets
-                if layout is None:
-                    _write_curve(f, result, created)
-                else:
-                    _write_sweep(f, result, created, layout, spare_rows)
-                f.attrs[_TEXT_DIGEST] = _texts_digest(f)
+                _write_result(f, result, created, layout, spare_rows)
                 _reserve(f, 0)  # what the close writes
         except (ValueError, RuntimeError) as error:
             disk = _as_disk_error(error)
@@ -501,6 +501,37 @@ def _write_file(result, path: str, *, force: bool, spare_rows: int):
             raise disk from None  # atomic_path names the path
         release_reserve(tmp)
     return None if layout is None else (layout.first, layout.count)
+
+
+def _write_result(f, result, created: str, layout, spare_rows: int) -> None:
+    if layout is None:
+        _write_curve(f, result, created)
+    else:
+        _write_sweep(f, result, created, layout, spare_rows)
+    f.attrs[_TEXT_DIGEST] = _texts_digest(f)
+
+
+def to_xarray(result: SweepResult | CriticalCurve):
+    """``result`` as an in-memory :class:`xarray.Dataset`, no file written: the same variables,
+    dimensions, units and attributes as ``xarray.open_dataset`` of the archive :func:`save` writes
+    (it is that archive, built in memory), so code written for one reads the other.
+
+    Example: ``ds = to_xarray(sweep(case, "paper", Grid([Axis("kappa", kappas, log=True)])))``,
+    then ``ds.max_force.plot()``. Needs xarray and h5netcdf (``pip install xarray h5netcdf``).
+    """
+    if not isinstance(result, (SweepResult, CriticalCurve)):
+        raise TypeError(f"cannot convert a {type(result).__name__}; allowed: a SweepResult or a CriticalCurve")
+    try:
+        import xarray
+    except ImportError:
+        raise ValueError("to_xarray needs xarray and h5netcdf: pip install xarray h5netcdf") from None
+    buffer = io.BytesIO()
+    with h5py.File(buffer, "w", libver=_LIBVER) as f:
+        _write_result(f, result, created_timestamp(),
+                      _sweep_layout(result) if isinstance(result, SweepResult) else None, 0)
+    buffer.seek(0)
+    with xarray.open_dataset(buffer, engine="h5netcdf") as ds:
+        return ds.load()
 
 
 def _texts_digest(f) -> str:

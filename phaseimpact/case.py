@@ -20,7 +20,8 @@ A case file has this schema (SI units; ``[projectile]`` and ``[plate]`` take the
     R2 = 2000.0
     [impact]       # v (m/s); optional kappa (N s/m^2.5, default 0), target (plate|rigid|free,
     v = 13.0       # default plate), law (default paper), contact (printed|unilateral, default
-                   # printed), restitution (1e-6 <= e <= 1, default none)
+                   # printed), restitution (1e-6 <= e <= 1, default none), law_file (a Python
+                   # file defining the law with phaseimpact.define_law, relative to the case file)
 
 Unknown keys, missing keys, wrong types and values out of range raise ``ValueError`` naming the
 dotted key, its value and the allowed range; so does an ``[impact]`` value its law never reads
@@ -135,7 +136,8 @@ THICKNESS_TO_PLATE_LIMIT = 0.2
 _MATERIAL_KEYS = {"E": "Pa", "nu": "-", "rho": "kg/m^3", "yield_strength": "Pa"}
 _MATERIAL_REQUIRED = ("E", "nu", "rho")
 _GEOMETRY_KEYS = ("a", "h", "R1", "R2")
-_IMPACT_DEFAULTS = {"kappa": 0.0, "target": "plate", "law": "paper", "contact": "printed", "restitution": None}
+_IMPACT_DEFAULTS = {"kappa": 0.0, "target": "plate", "law": "paper", "contact": "printed", "restitution": None,
+                    "law_file": None}
 _IMPACT_KEYS = ("v", *_IMPACT_DEFAULTS)
 _TOP_KEYS = ("name", "description", "source", "projectile", "plate", "geometry", "impact")
 _TABLES = ("projectile", "plate", "geometry", "impact")
@@ -227,6 +229,23 @@ def _impact_from(table) -> dict:
         require("impact.restitution", e, "1e-6 <= impact.restitution <= 1", math.isfinite(e) and 1e-6 <= e <= 1)
         out["restitution"] = e
     return {key: out[key] for key in _IMPACT_KEYS}
+
+
+def _load_law_file(value, origin: str) -> str:
+    """Run ``impact.law_file`` (its laws then pass ``impact.law``'s check); returns its absolute
+    path, so that the case as recorded (archives, JSON) finds it from anywhere."""
+    from .model.userlaw import load_law_file
+
+    path = Path(_string("impact.law_file", value, "a path to a .py file"))
+    if not path.is_absolute() and origin not in ("<dict>", "") and Path(origin).suffix == ".toml":
+        path = Path(origin).resolve().parent / path
+    if path.suffix != ".py":
+        raise ValueError(f"impact.law_file = {value!r} is out of range; allowed: a .py file")
+    try:
+        load_law_file(path)
+    except ValueError as exc:
+        raise ValueError(f"impact.law_file: {exc}") from None
+    return str(path.resolve())
 
 
 def _check_read_by_law(impact: dict) -> None:
@@ -374,7 +393,10 @@ def case_from_dict(data, origin: str = "<dict>") -> Case:
             if table not in data:
                 raise ValueError(f"missing table [{table}]")
         text = {key: _string(key, data[key]) for key in ("name", "description", "source") if key in data}
-        impact = _impact_from(data["impact"])
+        impact_table = data["impact"]
+        if isinstance(impact_table, Mapping) and impact_table.get("law_file") is not None:
+            impact_table = {**impact_table, "law_file": _load_law_file(impact_table["law_file"], origin)}
+        impact = _impact_from(impact_table)
         _check_read_by_law(impact)
         return Case(
             name=text.get("name", Path(origin).stem if origin != "<dict>" else "case"),

@@ -27,8 +27,6 @@ import signal
 import sys
 import threading
 
-import numpy as np
-
 from . import __version__
 from ._atomic import check_target, exclusive
 from .case import QUANTITIES, SETTABLE, setting_name
@@ -63,6 +61,9 @@ PLANES = ("delta,deltadot", "x1,x1dot", "x2,x2dot")
 #: Figure formats ``plot`` and ``portrait`` write, with the first bytes of such a file.
 FIGURE_FORMATS = {".png": (b"\x89PNG",), ".pdf": (b"%PDF",), ".svg": (b"<?xml", b"<svg")}
 KAPPA_UNIT = "N s/m^2.5"
+#: Version of the ``--json`` contract (``phaseimpact/schemas/cli-<version>.json``): raised when a key
+#: is removed or changes meaning; new keys do not raise it.
+JSON_SCHEMA_VERSION = 1
 
 
 #: argparse takes "-inf" or "-1e-300" for an option (its own pattern knows "-1" and "-.5" only): every
@@ -279,19 +280,28 @@ def _finite(value):
     """JSON-safe: non-finite numbers become null, NumPy scalars plain numbers."""
     if isinstance(value, dict):
         return {str(k): _finite(v) for k, v in value.items()}
-    if isinstance(value, (list, tuple, np.ndarray)):
+    np = sys.modules.get("numpy")  # a NumPy value means NumPy is imported: asking costs no import
+    if isinstance(value, (list, tuple)) or (np is not None and isinstance(value, np.ndarray)):
         return [_finite(v) for v in value]
-    if isinstance(value, (bool, np.bool_)):
+    if isinstance(value, bool) or (np is not None and isinstance(value, np.bool_)):
         return bool(value)
-    if isinstance(value, (float, np.floating)):
+    if isinstance(value, float) or (np is not None and isinstance(value, np.floating)):
         return float(value) if math.isfinite(value) else None
-    if isinstance(value, np.integer):
+    if np is not None and isinstance(value, np.integer):
         return int(value)
     return value
 
 
-def _print_json(obj) -> None:
-    print(json.dumps(_finite(obj), allow_nan=False, indent=2))
+def _print_json(args, obj: dict) -> None:
+    """The one JSON object of ``--json``: ``schema_version`` and ``command`` first, then ``obj``
+    (``phaseimpact/schemas/cli-1.json`` describes every command's keys)."""
+    header = {"schema_version": JSON_SCHEMA_VERSION, "command": args.command}
+    print(json.dumps(_finite({**header, **obj}), allow_nan=False, indent=2))
+
+
+def _progress(args) -> bool:
+    """Whether to draw a progress bar: for people (stderr a terminal), never into a log file."""
+    return sys.stderr.isatty() and not args.no_progress
 
 
 def _note(text: str) -> None:
@@ -421,8 +431,11 @@ def _setup(args, *, law=True) -> Setup:
 
 def _check_critical_law(law) -> None:
     if not law.is_filippov:
-        raise ValueError(f"law = {law.name!r} is out of range for the critical damping; allowed: paper "
-                         "(the other laws have no stick phases to split: see 'phaseimpact transitions')")
+        from .model import REGISTRY
+
+        allowed = ", ".join(n for n, entry in REGISTRY.items() if entry.filippov)
+        raise ValueError(f"law = {law.name!r} is out of range for the critical damping; allowed: a Filippov law "
+                         f"({allowed}; the others have no stick phases to split: see 'phaseimpact transitions')")
 
 
 def _check_reads_kappa(law, what: str) -> None:
@@ -481,7 +494,7 @@ def cmd_cases(args) -> int:
 
     cases = list_cases()
     if args.json:
-        _print_json({"cases": cases})
+        _print_json(args, {"cases": cases})
     else:
         width = max(len(c["name"]) for c in cases)
         for c in cases:
@@ -505,9 +518,10 @@ def cmd_check_law(args) -> int:
                          f"{', '.join(REGISTRY)} or FILE.py")
     reports = [check_law(law) for law in law_variants(names)]
     if args.json:
-        _print_json([{"law": r.law, "passed": r.passed,
-                      "checks": [{"check": v.check, "passed": v.passed, "detail": v.detail} for v in r.verdicts]}
-                     for r in reports])
+        _print_json(args, {"passed": all(r.passed for r in reports),
+                           "laws": [{"law": r.law, "passed": r.passed,
+                                     "checks": [{"check": v.check, "passed": v.passed, "detail": v.detail}
+                                                for v in r.verdicts]} for r in reports]})
     else:
         print("\n".join(str(r) for r in reports))
     return EXIT_OK if all(r.passed for r in reports) else EXIT_FAILURE
@@ -518,7 +532,7 @@ def cmd_warmup(args) -> int:
 
     out = warmup()
     if args.json:
-        _print_json(out)
+        _print_json(args, out)
     elif out["cache"] is None:
         print(f"compiled in {out['seconds']:.1f} s for this process only: nothing is cached ({out['reason']})")
     else:
@@ -549,7 +563,7 @@ def cmd_params(args) -> int:
     out["validity"] = validity(p, case.plate, case.projectile, case.geometry)
     out["case"] = case.as_dict()
     if args.json:
-        _print_json(out)
+        _print_json(args, out)
     else:
         print(f"case {case.name}: {case.description}" if case.description else f"case {case.name}")
         for k, value in out.items():
@@ -600,7 +614,7 @@ def cmd_simulate(args) -> int:
                                  for d, w in zip(delta_stick, dwell, strict=True)],
            "case": setup.case.as_dict()}
     if args.json:
-        _print_json(out)
+        _print_json(args, out)
     else:
         print(f"{law.label()} on a {p.target} target ({setup.case.name}), v = {p.v:g} m/s, "
               f"{law.entry.damping_name} = {out['kappa']:.4g} {law.damping_unit(p.alpha)}")
@@ -639,7 +653,7 @@ def cmd_fixed_points(args) -> int:
            "target": p.target,
            "equilibria": [e.as_dict() for e in found], "case": setup.case.as_dict()}
     if args.json:
-        _print_json(out)
+        _print_json(args, out)
         return EXIT_OK
     print(f"equilibria of {law.label()} on a {p.target} target ({setup.case.name}), docs/physics.md §5 "
           "(kappa and v move none: the damping acts through deltadot, zero at rest)")
@@ -681,7 +695,7 @@ def cmd_critical(args) -> int:
     if args.exponents:
         out["exponents"] = result.exponents
     if args.json:
-        _print_json(out)
+        _print_json(args, out)
     else:
         unit = law.damping_unit(params.alpha)
         kc = "not found" if result.kappa_c is None else f"{result.kappa_c:.10g} {unit}"
@@ -738,7 +752,7 @@ def cmd_transitions(args) -> int:
            "count": count, "transitions": [t.as_dict() for t in found], "kappa_rtol": args.kappa_rtol,
            "rtol": args.rtol, "samples": args.samples, "warnings": notes, "case": setup.case.as_dict()}
     if args.json:
-        _print_json(out)
+        _print_json(args, out)
     else:
         print(f"transitions of {law.label()} ({setup.case.name}) at v = {params.v:g} m/s, kappa in "
               f"[{args.kappa_min:g}, {args.kappa_max:g}] {law.damping_unit(params.alpha)} (counts: {count})")
@@ -776,6 +790,8 @@ def _run_grid(args, setup: Setup, axes: list):
     Every check (the grid, the archive at ``--out``, the scheduler) comes before any work. Returns
     the result, or None when interrupted (the resume command is printed).
     """
+    import numpy as np
+
     from . import archive
     from .continuation import Grid, atlas
     from .continuation._parallel import check_scheduler
@@ -810,7 +826,7 @@ def _run_grid(args, setup: Setup, axes: list):
 
         try:
             result = atlas(setup.case, setup.law, axes, t_end=args.t_end, n_jobs=args.jobs, backend=args.backend,
-                           scheduler=args.scheduler, rtol=args.rtol, progress=not args.no_progress,
+                           scheduler=args.scheduler, rtol=args.rtol, progress=_progress(args),
                            previous=previous, on_chunk=checkpoint)
         except KeyboardInterrupt as stop:  # Ctrl-C or SIGTERM: one line, the checkpoint stays
             saved = ""
@@ -829,6 +845,8 @@ def _run_grid(args, setup: Setup, axes: list):
 
 
 def _histogram(values, computed) -> dict:
+    import numpy as np
+
     counts = np.unique(np.asarray(values)[computed], return_counts=True)
     return {int(k): int(n) for k, n in zip(*counts, strict=True)}
 
@@ -840,6 +858,8 @@ def _outcome_name(code) -> str:
 
 
 def _grid_summary(result, out_path, setup: Setup) -> dict:
+    import numpy as np
+
     computed = result.status >= 0
     failed = result.failed
     failures = {}
@@ -897,7 +917,7 @@ def _finish_grid(args, result, setup: Setup) -> int:
         return EXIT_INTERRUPTED
     summary = _grid_summary(result, args.out, setup)
     if args.json:
-        _print_json(summary)
+        _print_json(args, summary)
     else:
         _print_grid_summary(summary)
     if summary["failed"]:
@@ -909,6 +929,8 @@ def _finish_grid(args, result, setup: Setup) -> int:
 
 
 def cmd_sweep(args) -> int:
+    import numpy as np
+
     from .continuation import Axis
 
     _check_grid_options(args)
@@ -920,6 +942,8 @@ def cmd_sweep(args) -> int:
 
 
 def cmd_atlas(args) -> int:
+    import numpy as np
+
     _check_grid_options(args)
     setup = _setup(args)
     names = [axis.name for axis in args.axis]
@@ -966,6 +990,8 @@ def cmd_atlas(args) -> int:
 
 def _curve_values(args, setup: Setup):
     """``(param, values)`` of a critical curve, checked (both ends valid cases) before any work."""
+    import numpy as np
+
     shorthand = args.v_min is not None or args.v_max is not None
     if shorthand and (args.param is not None or args.from_ is not None or args.to is not None):
         raise ValueError("--v-min/--v-max and --param/--from/--to contradict each other: --v-min A --v-max B is "
@@ -1009,6 +1035,8 @@ def _curve_values(args, setup: Setup):
 def _check_curve_overwrite(out, args, setup: Setup, param, values, what) -> None:
     """Like ``archive.check_overwrite``, comparing the values asked for (a curve also stores the
     intermediate steps of its continuation) and what it continues."""
+    import numpy as np
+
     from . import archive
 
     if args.force or not os.path.exists(out):
@@ -1032,6 +1060,8 @@ def _check_curve_overwrite(out, args, setup: Setup, param, values, what) -> None
 
 
 def cmd_critical_curve(args) -> int:
+    import numpy as np
+
     from . import archive
     from .continuation import critical_curve, transitions
     from .continuation.transition import RunFailed
@@ -1085,7 +1115,7 @@ def cmd_critical_curve(args) -> int:
         try:
             curve = critical_curve(setup.case, law, param, values, what=what, rtol=args.kappa_rtol,
                                    integrator_rtol=args.rtol, contact_index=index, kappa_start=start,
-                                   progress=not args.no_progress)
+                                   progress=_progress(args))
         except RunFailed as error:  # every input was checked: this is the curve's own failure
             print(f"phaseimpact: the curve failed to start: {error}; nothing written", file=sys.stderr)
             return EXIT_FAILURE
@@ -1098,7 +1128,7 @@ def cmd_critical_curve(args) -> int:
               "steps": int(len(curve.values)), "message": curve.message, "kappa_rtol": args.kappa_rtol,
               "rtol": args.rtol, "case": setup.case.as_dict()}
     if args.json:
-        _print_json(result)
+        _print_json(args, result)
     else:
         unit = SETTABLE.get(param, (PARAM_UNITS.get(param, ""),))[0]
         for x, k, closed in zip(curve.values[asked], curve.kappa[asked], curve.closed_form[asked], strict=True):
@@ -1162,7 +1192,7 @@ def cmd_plot(args) -> int:
     with exclusive(args.out, "out"):
         plotting.save(fig, args.out)
     if args.json:
-        _print_json({"out": args.out, "archive": args.archive, "kind": kind})
+        _print_json(args, {"out": args.out, "archive": args.archive, "kind": kind})
     else:
         print(f"wrote {args.out} ({kind} of {args.archive})")
     return EXIT_OK
@@ -1176,6 +1206,8 @@ def _portrait_runs(args, setup: Setup):
     """Each ``--kappa``'s run until its outcome settles (for the events, the counts and the title) and
     the same run sampled for drawing: where the integrator stepped (a few points per step) and the
     first contact finely; a permanent stick is drawn on for two plate periods (the stuck pair's orbit)."""
+    import numpy as np
+
     from .integrate import scales, simulate
 
     summaries, drawn = [], []
@@ -1215,7 +1247,7 @@ def cmd_portrait(args) -> int:
                "n_stick": tr.n_stick, "n_contacts": tr.n_contacts, "cut": tr.cut, "t_stop": tr.t_stop}
               for k, tr in zip(args.kappas, summaries, strict=True)]
     if args.json:
-        _print_json({"out": args.out, **_law_fields(setup), "v": setup.params.v, "plane": list(plane),
+        _print_json(args, {"out": args.out, **_law_fields(setup), "v": setup.params.v, "plane": list(plane),
                      "panels": panels, "case": setup.case.as_dict()})
     else:
         print(f"wrote {args.out}: {len(panels)} panel(s) in the ({', '.join(plane)}) plane")
@@ -1347,7 +1379,8 @@ def build_parser() -> argparse.ArgumentParser:
             p.add_argument("--resume", action="store_true",
                            help="complete the partial archive --out (same options) without recomputing its "
                                 "finished points; failed points are recomputed")
-        p.add_argument("--no-progress", action="store_true", help="no progress bar on stderr")
+        p.add_argument("--no-progress", action="store_true",
+                       help="no progress bar (there is one only when stderr is a terminal)")
 
     def figure_out(p):
         p.add_argument("--out", type=_figure_path, required=True, metavar="FIG.png",
@@ -1421,9 +1454,10 @@ def build_parser() -> argparse.ArgumentParser:
     json_option(p)
     p.set_defaults(func=cmd_fixed_points)
 
-    p = add("critical", "the critical damping kappa_c and kappa_2 at one speed (law paper)",
-            "The critical damping kappa_c of eq. 8 (law paper): where the first stick stops being permanent "
-            "(an adding-sliding bifurcation), and kappa_2, from which the run makes exactly two stick phases.")
+    p = add("critical", "the critical damping kappa_c and kappa_2 at one speed (law paper, or a Filippov user law)",
+            "The critical damping kappa_c of eq. 8 (law paper, or a Filippov user law): where the first stick "
+            "stops being permanent (an adding-sliding bifurcation), and kappa_2, from which the run makes exactly "
+            "two stick phases.")
     case_options(p)
     law_options(p, restitution=False)
     speed(p)

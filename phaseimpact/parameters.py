@@ -20,10 +20,9 @@ from __future__ import annotations
 import dataclasses
 import math
 import numbers
+import sys
 from collections.abc import Mapping
 from dataclasses import dataclass
-
-import numpy as np
 
 __all__ = [
     "Material",
@@ -99,9 +98,10 @@ def require_choice(name: str, value, choices) -> None:
 
 def is_number(value) -> bool:
     """True for any real number type (int, float, NumPy scalars and 0-d arrays), False for ``bool``."""
-    if isinstance(value, np.ndarray):  # a 0-d array is a scalar (np.array(1.0), a reduction's result)
+    np = sys.modules.get("numpy")  # a NumPy value means NumPy is imported: asking costs no import
+    if np is not None and isinstance(value, np.ndarray):  # a 0-d array is a scalar (a reduction's result)
         return value.ndim == 0 and value.dtype.kind in "iuf"
-    return isinstance(value, numbers.Real) and not isinstance(value, (bool, np.bool_))
+    return isinstance(value, numbers.Real) and not isinstance(value, bool)
 
 
 def _is_finite(value) -> bool:

@@ -700,3 +700,14 @@ def test_sigkill_mid_checkpoint_then_resume_equals_uninterrupted(tmp_path, small
     result = atlas(seed_parameters(), "paper", AXES, previous=previous, on_chunk=archive.Checkpoint(path))
     assert_same_result(result, small_atlas)
     assert_same_result(archive.load(path), small_atlas)
+
+
+def test_to_xarray_is_the_archive_in_memory(tmp_path, small_atlas):
+    """Same variables, dimensions, attributes and values as the archive opened from disk."""
+    path = archive.save(small_atlas, tmp_path / "atlas.h5")
+    memory = archive.to_xarray(small_atlas)
+    with xr.open_dataset(path, engine="h5netcdf") as disk:
+        xr.testing.assert_identical(memory, disk.load())
+    assert memory.max_force.dims == ("kappa", "v") and memory.kappa.attrs["units"] == "N s m-2.5"
+    with pytest.raises(TypeError, match="SweepResult or a CriticalCurve"):
+        archive.to_xarray([1, 2])

@@ -83,7 +83,7 @@ def test_seed_case_is_reference_section_2():
     p = case.parameters()
     assert f"{p.M1:.6f}" == "0.263056" and f"{p.K:.5e}" == "2.17570e+10"
     assert case.impact == {"v": 1.0, "kappa": 0.0, "target": "plate", "law": "paper", "contact": "printed",
-                           "restitution": None}
+                           "restitution": None, "law_file": None}
 
 
 def test_case_parameters_overrides():

@@ -509,3 +509,11 @@ def test_atlas_refine_axis_must_be_an_axis():
     code, _, err = run(["atlas", "--law", "paper", "--axis", "kappa=1e11:1e13:3:log", "--refine", "v",
                         "--out", "/tmp/never.h5"])
     assert code == 2 and "refine" in err
+
+
+def test_no_progress_bar_goes_into_a_log(tmp_path):
+    """stderr redirected (a log file, a pipe): notes and errors only, never a bar's redraws."""
+    code, _, err = run(["sweep", "--law", "hunt-crossley", "--kappa-min", "1e9", "--kappa-max", "1e10", "--num", "4",
+                        "--t-end", "1e-3", "--out", tmp_path / "s.h5"])
+    assert code == 0
+    assert "pt/s" not in err and "%|" not in err and "\r" not in err, err

@@ -6,10 +6,12 @@ import textwrap
 
 import numpy as np
 import pytest
+from oracle import oracle
 
 import phaseimpact
 from phaseimpact import ContactLaw, check_law, define_law, seed_parameters, simulate
 from phaseimpact.cli import main
+from phaseimpact.continuation import critical_damping
 from phaseimpact.model import REGISTRY
 from phaseimpact.model.userlaw import UserLawError
 
@@ -182,3 +184,72 @@ def test_check_law_of_a_shipped_law_passes(capsys):
     out = capsys.readouterr().out
     assert "kuwabara-kono: passed" in out and "kuwabara-kono clamp: passed" in out
     assert phaseimpact.check_law("hunt-crossley").passed
+
+
+def paper_magnitude(delta, deltadot, K, kappa, alpha):
+    return (K + kappa * deltadot) * abs(delta) ** alpha
+
+
+def stiffening_magnitude(delta, deltadot, K, kappa, alpha):
+    """eq. 8 with an elastic term that stiffens with depth: its stick bound is not K |delta|^alpha."""
+    return (K * (1.0 + abs(delta) / 2e-5) + kappa * deltadot) * abs(delta) ** alpha
+
+
+@pytest.mark.parametrize("unilateral", [False, True], ids=["printed", "unilateral"])
+def test_a_filippov_user_law_runs_like_paper(unilateral):
+    define_law("user-paper", paper_magnitude, filippov=True, unilateral=unilateral)
+    shipped = ContactLaw("paper", contact="unilateral" if unilateral else "printed")
+    for kappa in (3e9, 2e12):  # below kappa_c (a permanent stick) and above (breaks)
+        p = seed_parameters(v=1.0, kappa=kappa)
+        mine, ref = simulate(p, "user-paper", 2e-3, rtol=1e-12), simulate(p, shipped, 2e-3, rtol=1e-12)
+        assert [e.kind for e in mine.events] == [e.kind for e in ref.events]
+        np.testing.assert_allclose(mine.event_t, ref.event_t, rtol=1e-9, atol=1e-15)
+        assert (mine.n_stick, mine.outcome) == (ref.n_stick, ref.outcome)
+    p = seed_parameters(v=1.0)
+    assert critical_damping(p, "user-paper").kappa_c == pytest.approx(critical_damping(p, shipped).kappa_c, rel=1e-9)
+
+
+def test_a_filippov_user_law_sticks_within_its_own_bound():
+    """The stick holds while the force that keeps the bodies together is within |P(delta, 0)|, the
+    law's own (here not paper's K |delta|^alpha): the engine's kappa_c separates a permanent stick
+    from a break in the scipy oracle, which reads the bound from the force function alone."""
+    define_law("stiffening", stiffening_magnitude, filippov=True, unilateral=False)
+    p = seed_parameters(v=1.0)
+    kc = critical_damping(p, "stiffening").kappa_c
+    assert abs(kc / critical_damping(p, "paper").kappa_c - 1) > 0.01
+    for factor, breaks in ((1 - 1e-4, False), (1 + 1e-4, True)):
+        ref = oracle(p.replace(kappa=kc * factor), "stiffening", 2e-3, rtol=1e-12)
+        assert ("slip" in ref.kinds) == breaks, ref.kinds
+        mine = simulate(p.replace(kappa=kc * factor), "stiffening", 2e-3, rtol=1e-12)
+        assert [e.kind for e in mine.events] == ref.kinds
+    report = check_law("stiffening")
+    assert report.passed, str(report)
+
+
+def test_a_filippov_law_has_no_potential():
+    with pytest.raises(UserLawError, match="potential is not allowed with filippov = True"):
+        define_law("bad-filippov", paper_magnitude, filippov=True, potential=lambda d, K, a: 0.0)
+
+
+def test_a_case_file_names_its_law_file(tmp_path, capsys):
+    """``impact.law_file`` (relative to the case file) is run when the case is read: the case alone
+    runs the law, and the case as recorded names the file by its absolute path."""
+    from phaseimpact.case import load_case
+
+    (tmp_path / "laws").mkdir()
+    (tmp_path / "laws" / "mylaw.py").write_text(LAW_FILE.replace("file-kk", "case-kk"))
+    case_file = tmp_path / "case.toml"
+    case_file.write_text(load_case("seed").to_toml().replace('law = "paper"', 'law = "case-kk"\nlaw_file = '
+                                                             '"laws/mylaw.py"').replace("kappa = 0.0", "kappa = 1e4"))
+    case = load_case(case_file)
+    assert case.impact["law"] == "case-kk"
+    assert case.impact["law_file"] == str((tmp_path / "laws" / "mylaw.py").resolve())
+    assert main(["simulate", "--case", str(case_file), "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["law"] == "case-kk" and out["kappa_unit"] == "N s/m^1.5"
+    assert out["case"]["impact"]["law_file"] == case.impact["law_file"]
+    missing = tmp_path / "missing.toml"
+    missing.write_text(case_file.read_text().replace("laws/mylaw.py", "laws/none.py"))
+    with pytest.raises(SystemExit) as stop:  # --case is read while the arguments are parsed
+        main(["simulate", "--case", str(missing)])
+    assert stop.value.code == 2 and "impact.law_file: law file" in capsys.readouterr().err

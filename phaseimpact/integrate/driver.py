@@ -1152,7 +1152,7 @@ def _summarize(code, c, y0, y, mode, status, reason, t_stop, max_force, max_inde
             first_stick = i
             s[S_FIRST_STICK_T] = ev[i, EV_T]
             s[S_FIRST_STICK_DELTA] = ev[i, EV_Y + X1] - ev[i, EV_Y + X2]
-            s[S_FIRST_STICK_MARGIN] = stick_margin(c, ev[i, EV_Y:EV_Y + 5])
+            s[S_FIRST_STICK_MARGIN] = stick_margin(code, c, ev[i, EV_Y:EV_Y + 5])
         if kind == SEPARATION and first_stick >= 0 and math.isnan(s[S_T_RUN]):
             s[S_T_RUN] = ev[i, EV_T]
     if status != SUCCESS:

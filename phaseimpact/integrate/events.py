@@ -32,9 +32,9 @@ from ..model.laws import (
     RUNAWAY_ENERGY_FACTOR,  # noqa: F401 (re-exported)
     STUCK,
     force_partials,
-    hertz_power,
     is_filippov,
     is_unilateral,
+    stick_bound,
 )
 from ..model.rhs import (
     ALPHA_,
@@ -88,7 +88,7 @@ def event_value(code, c, y, f, force, mode, energy_limit, column):
         # jump never falls inside a step (a break right after it would be stepped over)
         return y[X2] if stuck and c[SPRINGS_] > 0 else 1.0
     if column == STICK_BREAK:
-        return stick_break_distance(c, y) if stuck else 1.0
+        return stick_break_distance(code, c, y) if stuck else 1.0
     if column == DELTADOT:
         return 1.0 if stuck else y[V1] - y[V2]
     if column == FORCE_RATE:
@@ -160,10 +160,7 @@ def restarts(code, column, mode, settle):
 
 @kernel
 def _stick_bound(code, c, y):
-    delta = y[X1] - y[X2]
-    if is_unilateral(code) and delta <= 0:
-        return 0.0
-    return c[K_] * hertz_power(abs(delta), c[ALPHA_])
+    return stick_bound(code, y[X1] - y[X2], c[K_], c[DAMP_], c[ALPHA_])
 
 
 @kernel(python=True)
@@ -209,7 +206,7 @@ def transition(code, c, column, y, mode, settle):
             common = 0.0 if c[RIGID_] > 0 else (c[M1_] * y[V1] + c[M2_] * y[V2]) / (c[M1_] + c[M2_])
             y[V1] = common
             y[V2] = common
-            if settle and stick_margin(c, y) >= 0:
+            if settle and stick_margin(code, c, y) >= 0:
                 action = STOP_SETTLED
             return STICK, STUCK, action
         new = 1 if required > 0 else (-1 if required < 0 else 0)

@@ -45,9 +45,8 @@ package, in this module only:
    :func:`contact_potential` (a Filippov law has none). A branch reads the flags from ``code``:
    :data:`UNILATERAL` (the kernels already return 0 for ``delta <= 0``), :data:`CLAMP`
    (``P >= 0``), and the sign factor of a :data:`FILIPPOV` law from ``mode``. (A Filippov law
-   sticks while the required force stays within ``K |delta|^alpha``, ``paper``'s elastic term:
-   ``_stick_bound`` in :mod:`phaseimpact.integrate.events`; a Filippov law with another elastic
-   term needs its bound there as well.)
+   sticks while the required force stays within its force at rest, :func:`stick_bound`;
+   ``paper``'s is its elastic term ``K |delta|^alpha``: a new form gives its own there.)
 3. :func:`register` a :class:`LawEntry`: name, form, damping source (``"kappa"``,
    ``"restitution"`` or None), the flags, the options it allows (``"clamp"``, ``"bilateral"``,
    ``"contact"``), the damping's exponent ``damping_power(alpha)`` (its unit is
@@ -66,14 +65,13 @@ import math
 import types as _types
 from dataclasses import dataclass, field
 
-import numpy as np
-
 from .._jit import kernel
-from ..parameters import Parameters, require, require_choice
+from ..parameters import Parameters, is_number, require, require_choice
 
 __all__ = [
     "LawEntry", "REGISTRY", "LAWS", "CONTACT_READINGS", "ContactLaw", "as_law", "law_variants", "register",
-    "contact_force", "force_partials", "contact_potential", "hertz_power", "is_filippov", "is_unilateral",
+    "contact_force", "force_partials", "contact_potential", "stick_bound", "hertz_power", "is_filippov",
+    "is_unilateral",
     "STUCK", "PLAIN", "RUNAWAY_ENERGY_FACTOR", "GUARD_ENERGY_FACTOR",
 ]
 
@@ -86,6 +84,8 @@ ELASTIC, HUNT_CROSSLEY, PAPER, KUWABARA_KONO, NATIVE = 0, 1, 2, 3, 7
 # What a user law's compiled function returns (its first argument).
 FORCE, D_DELTA, D_RATE, POTENTIAL = 0, 1, 2, 3
 STUCK, PLAIN = 0, 2
+#: The sign factor a Filippov law's force at rest is read with (its magnitude: the stick bound).
+STUCK_SIGN = 1
 CONTACT_READINGS = ("printed", "unilateral")
 OPTIONS = ("bilateral", "clamp", "contact")
 
@@ -154,7 +154,7 @@ def _native_py(address, which, delta, deltadot, mode, K, damping, alpha):
 
 
 #: A user law's compiled function at ``address``: ``which`` of FORCE, D_DELTA, D_RATE, POTENTIAL.
-#: (Callers pass ``np.int64`` constants: a bare constant is typed as a literal, one more compile each.)
+#: (Callers pass ``int(WHICH)``: a bare constant is typed as a literal, one more compile each.)
 _native = kernel(_types.FunctionType(
     _native_py.__code__, _NativeGlobals(__name__=__name__, __builtins__=__builtins__), "_native"))
 
@@ -177,8 +177,8 @@ def _kuwabara_kono_partials(code, delta, deltadot, K, damping, alpha, stiffness)
 @kernel
 def _native_partials(code, delta, deltadot, mode, K, damping, alpha):
     address = code >> ADDRESS_SHIFT
-    return (_native(address, np.int64(D_DELTA), delta, deltadot, mode, K, damping, alpha),
-            _native(address, np.int64(D_RATE), delta, deltadot, mode, K, damping, alpha))
+    return (_native(address, int(D_DELTA), delta, deltadot, mode, K, damping, alpha),
+            _native(address, int(D_RATE), delta, deltadot, mode, K, damping, alpha))
 
 
 # The branches of the laws added after the first ones call out-of-line kernels: the body of
@@ -205,7 +205,7 @@ def contact_force(code, delta, deltadot, mode, K, damping, alpha):
     if form == KUWABARA_KONO:
         return _kuwabara_kono_force(code, delta, deltadot, K, damping, alpha)
     if form == NATIVE:
-        return _native(code >> ADDRESS_SHIFT, np.int64(FORCE), delta, deltadot, mode, K, damping, alpha)
+        return _native(code >> ADDRESS_SHIFT, int(FORCE), delta, deltadot, mode, K, damping, alpha)
     # paper (eq. 8)
     sign = _sign(deltadot) if mode == PLAIN else float(mode)
     return (K + damping * deltadot) * hertz_power(abs(delta), alpha) * sign
@@ -247,9 +247,21 @@ def contact_potential(code, delta, K, alpha):
     if (code & UNILATERAL) != 0 and delta <= 0:
         return 0.0
     if (code >> FORM_SHIFT) & FORM_MASK == NATIVE:
-        return _native(code >> ADDRESS_SHIFT, np.int64(POTENTIAL), delta, 0.0, np.int64(1), K, 0.0, alpha)
+        return _native(code >> ADDRESS_SHIFT, int(POTENTIAL), delta, 0.0, int(PLAIN), K, 0.0, alpha)
     ad = abs(delta)
     return K * ad * hertz_power(ad, alpha) / (alpha + 1.0)
+
+
+@kernel(python=True)
+def stick_bound(code, delta, K, damping, alpha):
+    """The largest force a stuck Filippov contact gives at ``delta`` (N): ``|P(delta, 0)|``, the
+    law's force at rest (``paper``: its elastic term ``K |delta|^alpha``). The stick holds while
+    the force that keeps the bodies together stays within it (docs/physics.md §5)."""
+    if (code & UNILATERAL) != 0 and delta <= 0:
+        return 0.0
+    if (code >> FORM_SHIFT) & FORM_MASK == NATIVE:
+        return abs(_native(code >> ADDRESS_SHIFT, int(FORCE), delta, 0.0, int(STUCK_SIGN), K, damping, alpha))
+    return K * hertz_power(abs(delta), alpha)
 
 
 def _number_text(x: float) -> str:
@@ -404,8 +416,7 @@ class ContactLaw:
         if self.restitution is not None:
             e = self.restitution
             require("restitution", e, "a number with 1e-6 <= e <= 1",
-                    isinstance(e, (int, float, np.floating, np.integer)) and not isinstance(e, bool)
-                    and math.isfinite(e) and 1e-6 <= e <= 1)
+                    is_number(e) and math.isfinite(e) and 1e-6 <= e <= 1)
             object.__setattr__(self, "restitution", float(e))
             if entry.damping != "restitution" and not entry.inverse:
                 allowed = [n for n, x in REGISTRY.items() if x.damping == "restitution" or x.inverse]

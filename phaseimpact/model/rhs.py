@@ -29,8 +29,8 @@ from .laws import (
     contact_force,
     contact_potential,
     force_partials,
-    hertz_power,
     is_filippov,
+    stick_bound,
 )
 
 __all__ = [
@@ -244,7 +244,7 @@ def target_reach(c, y):
 
 
 @kernel(python=True)
-def stick_orbit(c, y):
+def stick_orbit(code, c, y):
     """Amplitude ``A`` of the stuck pair's orbit and the ``|x2|`` at which the stick breaks.
 
     The pair oscillates with conserved energy ``M v^2/2 + Kb x2^2/2 + Km x2^4/4``
@@ -253,7 +253,7 @@ def stick_orbit(c, y):
     """
     M = c[M1_] + c[M2_]
     amplitude = _orbit_amplitude(c, y[X2], y[V2], M)
-    bound = M / c[M1_] * c[K_] * hertz_power(abs(y[X1] - y[X2]), c[ALPHA_])
+    bound = M / c[M1_] * stick_bound(code, y[X1] - y[X2], c[K_], c[DAMP_], c[ALPHA_])
     if c[KM_] > 0:
         p = c[KB_] / (3.0 * c[KM_])
         if p > 0:
@@ -266,7 +266,7 @@ def stick_orbit(c, y):
 
 
 @kernel(python=True)
-def stick_margin(c, y):
+def stick_margin(code, c, y):
     """Relative margin of a stick entered at ``y``: ``1 - M1/M S(A) / (K |delta*|^alpha)``.
 
     ``>= 0``: the stick never breaks (permanent); the critical damping is its root
@@ -274,8 +274,8 @@ def stick_margin(c, y):
     """
     if c[SPRINGS_] == 0:
         return 1.0
-    amplitude, _ = stick_orbit(c, y)
-    bound = c[K_] * hertz_power(abs(y[X1] - y[X2]), c[ALPHA_])
+    amplitude, _ = stick_orbit(code, c, y)
+    bound = stick_bound(code, y[X1] - y[X2], c[K_], c[DAMP_], c[ALPHA_])
     required = c[M1_] / (c[M1_] + c[M2_]) * spring_force(c, amplitude)
     if bound <= 0:
         return -math.inf if required > 0 else 1.0
@@ -283,7 +283,7 @@ def stick_margin(c, y):
 
 
 @kernel(python=True)
-def stick_break_distance(c, y):
+def stick_break_distance(code, c, y):
     """Stick-break event function, monotone along each half-swing of the stuck pair, m.
 
     ``x_break - |x2|`` swinging out and ``x_break - 2A + |x2|`` swinging back (continuous at the
@@ -294,7 +294,7 @@ def stick_break_distance(c, y):
     """
     if c[SPRINGS_] == 0:
         return 1.0
-    amplitude, x_break = stick_orbit(c, y)
+    amplitude, x_break = stick_orbit(code, c, y)
     if amplitude <= x_break:
         return 1.0
     x2 = y[X2]

@@ -21,8 +21,17 @@ Example (the Kuwabara-Kono law written by hand)::
 
 A unilateral law (the default) acts only while ``delta > 0``: the engine never calls its force
 at ``delta <= 0`` (:func:`define_law` checks that the function gives 0 there anyway when asked
-with ``delta = 0``). Filippov laws (a sign factor with stick and slip, like ``paper``) cannot be
-user laws yet.
+with ``delta = 0``).
+
+A Filippov law (``filippov=True``, like ``paper``, eq. 8) gives the force's magnitude
+``g(delta, deltadot)``; the engine multiplies it by the sign factor ``sgn(deltadot)`` (the slip's
+direction, and the stick/slip modes of docs/physics.md §5) and sticks while the force that keeps
+the bodies together stays within ``|g(delta, 0)|``. ``paper`` itself, as a user law::
+
+    def force(delta, deltadot, K, kappa, alpha):
+        return (K + kappa * deltadot) * abs(delta) ** alpha
+
+    phaseimpact.define_law("my-paper", force, filippov=True, unilateral=False)
 """
 
 from __future__ import annotations
@@ -34,7 +43,7 @@ import os
 import sys
 from dataclasses import dataclass
 
-from .laws import LAWS, NATIVE, REGISTRY, LawEntry, register
+from .laws import GUARD_ENERGY_FACTOR, LAWS, NATIVE, PLAIN, REGISTRY, RUNAWAY_ENERGY_FACTOR, LawEntry, register
 
 __all__ = ["define_law", "load_law_file", "UserLawError"]
 
@@ -129,8 +138,9 @@ def _source_digest(*functions) -> str:
     return digest.hexdigest()[:16]
 
 
-def _compile(force, partials, potential) -> NativeLaw:
-    """One C-callable function ``(which, delta, deltadot, mode, K, damping, alpha)`` for the law."""
+def _compile(force, partials, potential, filippov) -> NativeLaw:
+    """One C-callable function ``(which, delta, deltadot, mode, K, damping, alpha)`` for the law
+    (a Filippov law's: with the sign factor of ``mode``, as ``paper``'s kernel)."""
     import numba
 
     from .native import SIGNATURE
@@ -141,7 +151,8 @@ def _compile(force, partials, potential) -> NativeLaw:
         pot = numba.njit(potential) if potential is not None else None
         has_partials, has_potential = dp is not None, pot is not None
 
-        def law(which, delta, deltadot, mode, K, damping, alpha):
+        @numba.njit
+        def unsigned(which, delta, deltadot, K, damping, alpha):
             if which == 0:
                 return f(delta, deltadot, K, damping, alpha)
             if which == 3:
@@ -155,6 +166,16 @@ def _compile(force, partials, potential) -> NativeLaw:
                 return (f(delta + h, deltadot, K, damping, alpha) - f(delta - h, deltadot, K, damping, alpha)) / (2 * h)
             h = 1e-6 * abs(deltadot) + 1e-12
             return (f(delta, deltadot + h, K, damping, alpha) - f(delta, deltadot - h, K, damping, alpha)) / (2 * h)
+
+        plain = PLAIN
+
+        def law(which, delta, deltadot, mode, K, damping, alpha):
+            value = unsigned(which, delta, deltadot, K, damping, alpha)
+            if not filippov or which == 3:
+                return value
+            if mode == plain:  # the sign read literally (fixed-step methods)
+                return value if deltadot > 0 else (-value if deltadot < 0 else 0.0)
+            return value * mode  # +-1 slipping, 0 stuck (the stuck force is not the law's)
 
         if not has_partials:
             dp = f  # typed but never called
@@ -172,7 +193,7 @@ def _compile(force, partials, potential) -> NativeLaw:
 
 
 def define_law(name: str, force, *, partials=None, potential=None, unilateral: bool = True,
-               damping=("kappa", None), damping_power=None, clamp_option: bool = False,
+               filippov: bool = False, damping=("kappa", None), damping_power=None, clamp_option: bool = False,
                description: str = "") -> LawEntry:
     """Register a contact law of your own; it then runs wherever a shipped law does.
 
@@ -181,8 +202,9 @@ def define_law(name: str, force, *, partials=None, potential=None, unilateral: b
     name : str
         The law's name (``simulate(params, name)``, ``--law name``); not a shipped law's.
     force : function ``(delta, deltadot, K, damping, alpha) -> float``
-        The contact force P (N, positive pushing the bodies apart). Plain arithmetic and
-        :mod:`math`: numba compiles it.
+        The contact force P (N, positive pushing the bodies apart); of a Filippov law, its
+        magnitude (the engine applies the sign factor). Plain arithmetic and :mod:`math`: numba
+        compiles it.
     partials : function ``(delta, deltadot, K, damping, alpha) -> (float, float)``, optional
         ``(dP/ddelta, dP/ddeltadot)``; default: central differences of ``force``.
     potential : function ``(delta, K, alpha) -> float``, optional
@@ -190,6 +212,10 @@ def define_law(name: str, force, *, partials=None, potential=None, unilateral: b
         not conservative: its whole contact work counts as dissipated).
     unilateral : bool
         The law acts only while ``delta > 0`` (its force must be 0 at ``delta = 0``).
+    filippov : bool
+        The force is ``force(...) sgn(deltadot)``, with stick and slip (like ``paper``): the
+        stick holds while the force that keeps the bodies together is within
+        ``|force(delta, 0, ...)|``. Such a law has no potential.
     damping : (str, str or None)
         The damping coefficient's symbol and unit (set with ``kappa``); the unit defaults to
         ``N s/m^damping_power``.
@@ -214,13 +240,19 @@ def define_law(name: str, force, *, partials=None, potential=None, unilateral: b
         raise UserLawError(f"damping = {damping!r} is out of range; allowed: (symbol, unit or None)")
     if damping_power is not None and not (isinstance(damping_power, (int, float)) and math.isfinite(damping_power)):
         raise UserLawError(f"damping_power = {damping_power!r} is out of range; allowed: a finite number or None")
+    if not isinstance(filippov, bool):
+        raise UserLawError(f"filippov = {filippov!r} is out of range; allowed: True or False")
+    if filippov and potential is not None:
+        raise UserLawError("potential is not allowed with filippov = True: the elastic term of a Filippov law "
+                           "acts like friction (docs/physics.md §4), it has no potential")
     _validate(name, force, partials, potential, unilateral, 1e9, 1e5, 1.5)
-    native = _compile(force, partials, potential)
+    native = _compile(force, partials, potential, filippov)
     power = (lambda alpha: 1.0 + alpha) if damping_power is None else (lambda alpha, p=float(damping_power): p)
-    entry = LawEntry(name, NATIVE, "kappa", False, bool(unilateral), potential is not None,
+    entry = LawEntry(name, NATIVE, "kappa", filippov, bool(unilateral), potential is not None,
                      description=description or f"user law ({getattr(force, '__module__', '')}."
                                                 f"{getattr(force, '__name__', 'force')})",
                      damping_name=damping[0], damping_power=power, native=native,
+                     runaway_factor=RUNAWAY_ENERGY_FACTOR if filippov else GUARD_ENERGY_FACTOR,
                      unit=None if damping[1] is None else str(damping[1]))
     return register(entry)
 

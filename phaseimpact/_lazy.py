@@ -1,0 +1,25 @@
+"""Names a package exports but imports on first use (PEP 562), so that importing the package
+costs only what is used: the commands that integrate nothing never import NumPy, SciPy or numba."""
+
+from __future__ import annotations
+
+import importlib
+
+
+def attach(package: str, namespace: dict, exports: dict[str, str]):
+    """``(__getattr__, __dir__)`` for ``package``: ``exports`` maps a name to the submodule (relative
+    to ``package``) that defines it; the first access imports it and keeps the value in
+    ``namespace`` (the package's globals), so later accesses cost nothing."""
+
+    def __getattr__(name):
+        module = exports.get(name)
+        if module is None:
+            raise AttributeError(f"module {package!r} has no attribute {name!r}")
+        value = getattr(importlib.import_module(f".{module}", package), name)
+        namespace[name] = value
+        return value
+
+    def __dir__():
+        return sorted(set(namespace) | set(exports))
+
+    return __getattr__, __dir__
