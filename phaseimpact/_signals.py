@@ -14,7 +14,9 @@ Two problems, one mechanism:
   ("CPUDispatcher(run) returned a result with an exception set") or a NULL type pointer and a
   segfault. :func:`handler` therefore only records a signal that arrives inside that callback
   (:data:`deferred`); the caller of the compiled run raises it with :func:`check` once the result
-  is back.
+  is back. The same for a signal that arrives while Python runs a weak-reference callback or a
+  ``__del__`` (an object freed, often inside h5py or NumPy): Python prints "Exception ignored" there
+  and drops the ``KeyboardInterrupt``, and an atlas ran on to its end and exited 0.
 
 A signal's byte is left in the pipe when it is acted on, so that every thread running compiled
 code sees it and stops; a later run that is woken by such an old byte (nothing :data:`deferred`)
@@ -27,6 +29,7 @@ import ctypes
 import os
 import signal
 import threading
+import weakref
 
 import llvmlite.binding as llvm
 from llvmlite import ir
@@ -89,13 +92,15 @@ if config.DISABLE_JIT:
         return False
 
 
-def _in_numba_callback(frame) -> bool:
-    """Is ``frame`` inside numba's callback that builds a compiled function's result?"""
+def _in_ignoring_context(frame) -> bool:
+    """Is ``frame`` inside code whose exceptions Python or numba drop: numba's callback that builds a
+    compiled function's result, a weak-reference callback or a finaliser (``__del__``)?"""
     from numba.core import serialize
 
     code = serialize._numba_unpickle.__code__
     while frame is not None:
-        if frame.f_code is code:
+        f_code = frame.f_code
+        if f_code is code or f_code.co_name == "__del__" or f_code.co_filename == weakref.__file__:
             return True
         frame = frame.f_back
     return False
@@ -109,8 +114,8 @@ def _raise(signum: int):
 
 def handler(signum, frame):
     """SIGINT/SIGTERM: raise ``KeyboardInterrupt`` (:class:`Terminated`), or record the signal when
-    it arrives inside numba's result callback (an exception there is lost or crashes)."""
-    if _in_numba_callback(frame):
+    it arrives where an exception is lost or crashes (:func:`_in_ignoring_context`)."""
+    if _in_ignoring_context(frame):
         deferred.append(signum)
         return
     _raise(signum)

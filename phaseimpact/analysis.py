@@ -39,11 +39,39 @@ __all__ = [
     "phase_portrait",
 ]
 
+#: The phase planes: the relative motion, the projectile's and the target's.
 PLANES = (("delta", "deltadot"), ("x1", "x1dot"), ("x2", "x2dot"))
 
 
 def plane_coordinates(y: np.ndarray, plane) -> tuple[np.ndarray, np.ndarray]:
-    """The two coordinates of states ``y`` (shape ``(..., 5)``) in ``plane``."""
+    """The two coordinates of states ``y`` (shape ``(..., 5)``) in ``plane``.
+
+    Parameters
+    ----------
+    y : ndarray, shape (..., 5) (or (..., 4))
+        States ``(x1, x2, x1dot, x2dot[, W])``, m and m/s (e.g. ``Trajectory.y``).
+    plane : pair of str
+        One of :data:`PLANES`.
+
+    Returns
+    -------
+    tuple of ndarray
+        The position (m) and the velocity (m/s) of the plane, each of shape ``y.shape[:-1]``.
+
+    Raises
+    ------
+    ValueError
+        For a plane not in :data:`PLANES`.
+
+    Examples
+    --------
+    >>> from phaseimpact import seed_parameters, simulate
+    >>> from phaseimpact.analysis import plane_coordinates
+    >>> tr = simulate(seed_parameters(kappa=3e9), "paper", 2e-3, save="steps")
+    >>> delta, deltadot = plane_coordinates(tr.y, ("delta", "deltadot"))
+    >>> delta.shape == tr.t.shape, f"{delta.max():.4g} m"
+    (True, '3.547e-05 m')
+    """
     plane = _check_plane(plane)
     if plane[0] == "delta":
         return y[..., X1] - y[..., X2], y[..., V1] - y[..., V2]
@@ -78,6 +106,16 @@ class AsymptoticPoints:
         Distance tolerance relative to the plane's extent (0 for ``events``).
     min_dwell : float
         Shortest dwell that counts, s.
+
+    ``len()`` is the number of points.
+
+    Examples
+    --------
+    >>> from phaseimpact import seed_parameters, simulate
+    >>> from phaseimpact.analysis import find_asymptotic_points
+    >>> points = find_asymptotic_points(simulate(seed_parameters(kappa=3e9), "paper"))
+    >>> len(points), points.method, points.dwell.tolist()
+    (1, 'events', [inf])
     """
 
     plane: tuple
@@ -109,6 +147,39 @@ def find_asymptotic_points(trajectory: Trajectory, plane=("delta", "deltadot"), 
         Distance tolerance for ``distance``, relative to the plane's extent (0 < tol < 1).
     min_dwell : float, optional
         Shortest dwell that counts, s; default 1% of the Hertz contact time.
+
+    Returns
+    -------
+    AsymptoticPoints
+        The points in order of first arrival, with their dwell times.
+
+    Raises
+    ------
+    ValueError
+        For a plane not in :data:`PLANES`, ``tol`` out of range, an unknown ``method``,
+        ``events`` on a trajectory without events (RK4) or outside the relative plane, or
+        ``distance`` on a trajectory without samples.
+
+    Examples
+    --------
+    A permanent stick is one asymptotic point; above ``kappa_c`` each stick phase is a point of
+    its own (docs/physics.md §5):
+
+    >>> from phaseimpact import seed_parameters, simulate
+    >>> from phaseimpact.analysis import find_asymptotic_points
+    >>> len(find_asymptotic_points(simulate(seed_parameters(kappa=3e9), "paper")))
+    1
+    >>> points = find_asymptotic_points(simulate(seed_parameters(kappa=2e12), "paper"))
+    >>> [f"{d:.3g}" for d in points.points[:, 0]]
+    ['7.78e-06', '8.03e-06']
+
+    From samples alone (``distance``), the same permanent stick:
+
+    >>> import numpy as np
+    >>> tr = simulate(seed_parameters(kappa=3e9), "paper", 2e-3, save=np.linspace(0, 2e-3, 201))
+    >>> points = find_asymptotic_points(tr, method="distance")
+    >>> len(points), f"{points.points[0, 0]:.4g} m"
+    (1, '3.547e-05 m')
     """
     plane = _check_plane(plane)
     if not (math.isfinite(tol) and 0 < tol < 1):
@@ -207,6 +278,14 @@ class Equilibrium:
         One of :data:`STABILITY_LABELS`, from the eigenvalues alone (:func:`_stability`).
     note : str
         What the linearisation does not say (the nonlinear stability of the set or point).
+
+    Examples
+    --------
+    >>> from phaseimpact import seed_parameters
+    >>> from phaseimpact.analysis import fixed_points
+    >>> stuck = fixed_points(seed_parameters(), "paper")[0]
+    >>> stuck.kind, stuck.name, stuck.dimension, stuck.coordinates, stuck.stability
+    ('set', 'stuck', 1, ('x1', 'x2', 'v'), 'non-hyperbolic')
     """
 
     kind: str
@@ -222,7 +301,21 @@ class Equilibrium:
     note: str
 
     def as_dict(self) -> dict:
-        """Plain types for JSON; eigenvalues as ``{"re", "im"}`` pairs."""
+        """Plain types for JSON; eigenvalues as ``{"re", "im"}`` pairs.
+
+        Returns
+        -------
+        dict
+            The attributes by name; arrays as lists, eigenvalues as ``{"re", "im"}`` (1/s).
+
+        Examples
+        --------
+        >>> from phaseimpact import ContactLaw, seed_parameters
+        >>> from phaseimpact.analysis import fixed_points
+        >>> rest = fixed_points(seed_parameters(), ContactLaw("abrate", bilateral=True))[0].as_dict()
+        >>> rest["kind"], rest["conditions"]["delta"], [f"{z['im']:.4g}" for z in rest["eigenvalues"]][:2]
+        ('point', '= 0', ['6261', '-6261'])
+        """
         return {"kind": self.kind, "name": self.name, "description": self.description,
                 "conditions": dict(self.conditions), "dimension": self.dimension,
                 "state": self.state.tolist(), "members": self.members.tolist(),
@@ -271,6 +364,35 @@ def fixed_points(params: Parameters, law: ContactLaw | str = "paper") -> list[Eq
     Returns the equilibria with their linearisation (:class:`Equilibrium`); ``kappa`` and ``v``
     move none of them (the damping acts through ``deltadot``, zero at rest), ``v`` sets only the
     spacing of the samples (the Hertz indentation).
+
+    Parameters
+    ----------
+    params : Parameters
+        The case; its ``target`` (plate, rigid, free) decides where the target may rest.
+    law : ContactLaw or str, default "paper"
+        Any law, with its options (``contact="unilateral"``, ``bilateral=True``...).
+
+    Returns
+    -------
+    list of Equilibrium
+        The separated set (unilateral laws), the stuck set (``paper``) or the rest point
+        (bilateral laws), in that order.
+
+    Raises
+    ------
+    ValueError
+        For an unknown law.
+
+    Examples
+    --------
+    >>> from phaseimpact import ContactLaw, seed_parameters
+    >>> from phaseimpact.analysis import fixed_points
+    >>> [(e.name, e.stability) for e in fixed_points(seed_parameters(), "abrate")]
+    [('separated', 'non-hyperbolic')]
+    >>> [(e.name, e.kind) for e in fixed_points(seed_parameters(), ContactLaw("paper", contact="unilateral"))]
+    [('separated', 'set'), ('stuck', 'set')]
+    >>> [f"{abs(z):.4g}" for z in fixed_points(seed_parameters(), "paper")[0].eigenvalues]
+    ['0', '4599', '4599']
     """
     law = as_law(law)
     s = params.hertz_indentation  # spacing of the samples along a set
@@ -388,6 +510,46 @@ def phase_portrait(params: Parameters, law: ContactLaw | str, kappas=None, *, sp
 
     Each keeps its steps (or the times in ``save``) and its events, so
     ``plane_coordinates(tr.y, plane)`` and ``tr.events`` draw it.
+
+    Parameters
+    ----------
+    params : Parameters
+        The base case.
+    law : ContactLaw or str
+        The law of every run.
+    kappas : sequence of float, optional
+        Damping values, N s/m^(1+alpha) (N s/m^2.5 for alpha = 3/2).
+    speeds : sequence of float, optional
+        Impact speeds, m/s.
+    states : array of shape (k, 4), optional
+        Initial states ``(x1, x2, x1dot, x2dot)``, m and m/s, finite.
+    t_end : float, optional
+        Horizon of every run, s; default: until its outcome settles.
+    save : "steps" or array of times, default "steps"
+        What each run keeps, as for :func:`~phaseimpact.simulate`.
+    rtol : float, default 1e-10
+        Integrator tolerance.
+
+    Returns
+    -------
+    list of Trajectory
+        One per value given, in order (for :func:`phaseimpact.plotting.plot_portraits`).
+
+    Raises
+    ------
+    ValueError
+        Unless exactly one of ``kappas``, ``speeds`` and ``states`` is given, for states that are
+        not finite rows of four, or for any argument :func:`~phaseimpact.simulate` refuses.
+
+    Examples
+    --------
+    >>> from phaseimpact import seed_parameters
+    >>> from phaseimpact.analysis import phase_portrait
+    >>> runs = phase_portrait(seed_parameters(), "paper", [1e9, 2e12], t_end=2e-3)
+    >>> [tr.outcome for tr in runs], all(len(tr.t) > 2 for tr in runs)
+    (['bounded', 'ratchet-escape'], True)
+    >>> [tr.params.v for tr in phase_portrait(seed_parameters(), "abrate", speeds=[0.5, 1.0], t_end=2e-3)]
+    [0.5, 1.0]
     """
     from .integrate import simulate
 

@@ -108,7 +108,9 @@ from .parameters import Parameters
 __all__ = ["SCHEMA_VERSION", "KINDS", "CHUNK_POINTS", "Checkpoint", "save", "load", "describe", "same_work",
            "check_overwrite", "kind_of", "created_timestamp", "DamagedArchiveError", "to_xarray"]
 
+#: The layout written (module docstring); schemas 1 and 2 still load, a newer one is refused.
 SCHEMA_VERSION = 3
+#: What an archive holds: a sweep (one axis), an atlas (two or more) or a continued curve.
 KINDS = ("sweep", "atlas", "critical-curve")
 CONVENTIONS = "CF-1.8"
 #: Points of one chunk of a grid variable (a C-order slab; 64 KiB of float64).
@@ -173,7 +175,29 @@ def _float(value) -> float:
 
 
 def created_timestamp() -> str:
-    """Now, or ``SOURCE_DATE_EPOCH`` (seconds since 1970, UTC) when set: reproducible builds."""
+    """Now, or ``SOURCE_DATE_EPOCH`` (seconds since 1970, UTC) when set: reproducible builds.
+
+    Returns
+    -------
+    str
+        ISO 8601 in UTC, to the second (the archives' ``created`` attribute).
+
+    Raises
+    ------
+    ValueError
+        For a ``SOURCE_DATE_EPOCH`` that is not an integer number of seconds in range.
+
+    Examples
+    --------
+    >>> import os
+    >>> from phaseimpact.archive import created_timestamp
+    >>> os.environ["SOURCE_DATE_EPOCH"] = "0"
+    >>> created_timestamp()
+    '1970-01-01T00:00:00+00:00'
+    >>> del os.environ["SOURCE_DATE_EPOCH"]
+    >>> created_timestamp().endswith("+00:00")
+    True
+    """
     epoch = os.environ.get("SOURCE_DATE_EPOCH", "").strip()
     if epoch:
         try:
@@ -203,7 +227,33 @@ def _base_parameters(base) -> Parameters:
 
 def kind_of(result) -> str:
     """The archive kind of a result (or of a :class:`Grid`): ``sweep`` (one axis), ``atlas`` (two or
-    more) or ``critical-curve``."""
+    more) or ``critical-curve``.
+
+    Parameters
+    ----------
+    result : SweepResult, Grid or CriticalCurve
+        What would be archived.
+
+    Returns
+    -------
+    str
+        One of :data:`KINDS`.
+
+    Raises
+    ------
+    TypeError
+        For anything else.
+
+    Examples
+    --------
+    >>> from phaseimpact import seed_parameters
+    >>> from phaseimpact.archive import kind_of
+    >>> from phaseimpact.continuation import atlas, sweep
+    >>> kind_of(sweep(seed_parameters(), "paper", [1e9, 1e13]))
+    'sweep'
+    >>> kind_of(atlas(seed_parameters(), "paper", {"kappa": [1e9, 1e13], "v": [1.0, 2.0]}).grid)
+    'atlas'
+    """
     if isinstance(result, CriticalCurve):
         return "critical-curve"
     grid = result.grid if isinstance(result, SweepResult) else result
@@ -427,17 +477,47 @@ def _digest(tree) -> str:
 def save(result: SweepResult | CriticalCurve, path, *, force: bool = False) -> str:
     """Write ``result`` to ``path`` atomically (temporary file, fsync, rename) under its write lock.
 
+    The layout is the module docstring's (netCDF-4 / CF-1.8, schema :data:`SCHEMA_VERSION`); a
+    reader or a crash sees the previous file or the complete new one.
+
     Parameters
     ----------
     result : SweepResult or CriticalCurve
+        A sweep, an atlas (complete or partial) or a continued curve.
     path : str or path-like
-    force : bool
+        The archive to write (conventionally ``.h5``).
+    force : bool, default False
         Replace ``path`` even if it exists and is not a phaseimpact archive. Without it such a file
         is refused (``ValueError``); an existing archive is replaced. (The command line also refuses
         an archive of other work: see :func:`check_overwrite`.)
 
-    Returns the path. Raises ``ValueError`` (before writing anything) for a path that cannot be
-    written, and :class:`phaseimpact._atomic.PathLockedError` if another process is writing ``path``.
+    Returns
+    -------
+    str
+        ``path``.
+
+    Raises
+    ------
+    TypeError
+        If ``result`` is neither a SweepResult nor a CriticalCurve.
+    ValueError
+        (Before writing anything) for a path that cannot be written or an existing file that is not
+        an archive (without ``force``), and :class:`phaseimpact._atomic.PathLockedError` (a
+        ``ValueError``) if another process is writing ``path``.
+    OSError
+        For a full disk or a failing write (the previous file is kept).
+
+    Examples
+    --------
+    >>> import os, tempfile
+    >>> from phaseimpact import seed_parameters
+    >>> from phaseimpact.archive import load, save
+    >>> from phaseimpact.continuation import sweep
+    >>> path = os.path.join(tempfile.mkdtemp(), "sweep.h5")
+    >>> save(sweep(seed_parameters(), "paper", [1e9, 1e12, 1e13]), path) == path
+    True
+    >>> load(path).outcome_names().tolist()
+    ['permanent-stick', 'permanent-stick', 'ratchet-escape']
     """
     if not isinstance(result, (SweepResult, CriticalCurve)):
         raise TypeError(f"cannot archive a {type(result).__name__}")
@@ -516,8 +596,35 @@ def to_xarray(result: SweepResult | CriticalCurve):
     dimensions, units and attributes as ``xarray.open_dataset`` of the archive :func:`save` writes
     (it is that archive, built in memory), so code written for one reads the other.
 
-    Example: ``ds = to_xarray(sweep(case, "paper", Grid([Axis("kappa", kappas, log=True)])))``,
-    then ``ds.max_force.plot()``. Needs xarray and h5netcdf (``pip install xarray h5netcdf``).
+    Example: ``ds = to_xarray(sweep(case, "paper", kappas))``, then ``ds.max_force.plot()``. Needs
+    xarray and h5netcdf (``pip install xarray h5netcdf``).
+
+    Parameters
+    ----------
+    result : SweepResult or CriticalCurve
+        What :func:`save` would write.
+
+    Returns
+    -------
+    xarray.Dataset
+        Loaded in memory: one dimension per axis (or the curve's parameter), the summary columns
+        with their units, the stick phases along ``stick``, the header as attributes.
+
+    Raises
+    ------
+    TypeError
+        If ``result`` is neither a SweepResult nor a CriticalCurve.
+    ValueError
+        When xarray or h5netcdf is not installed.
+
+    Examples
+    --------
+    >>> from phaseimpact import seed_parameters
+    >>> from phaseimpact.archive import to_xarray
+    >>> from phaseimpact.continuation import sweep
+    >>> ds = to_xarray(sweep(seed_parameters(), "paper", [1e9, 1e12, 1e13]))
+    >>> dict(ds.sizes), ds["max_force"].attrs["units"], ds["kappa"].attrs["units"]
+    ({'kappa': 3, 'stick': 4}, 'N', 'N s m-2.5')
     """
     if not isinstance(result, (SweepResult, CriticalCurve)):
         raise TypeError(f"cannot convert a {type(result).__name__}; allowed: a SweepResult or a CriticalCurve")
@@ -754,8 +861,39 @@ class Checkpoint:
 
     Attributes
     ----------
+    path : str
+        The archive.
+    force, fsync : bool
+        As given.
     in_place, rewrites : int
         How many calls wrote in place, and how many rewrote the whole file.
+    saved : int or None
+        Points done in the last complete checkpoint (None before the first): what the file holds
+        even when a call is interrupted while it writes (the file then is not read meanwhile).
+
+    Raises
+    ------
+    TypeError
+        When called with anything but a SweepResult.
+    ValueError
+        As :func:`save` (a path that cannot be written, another process writing it).
+    OSError
+        For a full disk or a failing write (the last complete checkpoint is kept).
+
+    Examples
+    --------
+    >>> import os, tempfile
+    >>> from phaseimpact import seed_parameters
+    >>> from phaseimpact.archive import Checkpoint, load, save
+    >>> from phaseimpact.continuation import atlas
+    >>> checkpoint = Checkpoint(os.path.join(tempfile.mkdtemp(), "atlas.h5"))
+    >>> result = atlas(seed_parameters(), "paper", {"kappa": [1e11, 1e13], "v": [1.0, 2.0]}, on_chunk=checkpoint)
+    >>> checkpoint.rewrites, checkpoint.in_place
+    (1, 0)
+    >>> save(result, checkpoint.path) == checkpoint.path
+    True
+    >>> load(checkpoint.path).summary()["computed"]
+    4
     """
 
     def __init__(self, path, *, force: bool = False, fsync: bool = True):
@@ -764,12 +902,14 @@ class Checkpoint:
         self.fsync = bool(fsync)
         self.in_place = 0
         self.rewrites = 0
+        self.saved: int | None = None
         self._disk: _OnDisk | None = None
 
     def __repr__(self) -> str:
         return f"Checkpoint({self.path!r}, in_place={self.in_place}, rewrites={self.rewrites})"
 
     def __call__(self, result: SweepResult) -> None:
+        """Write ``result``'s points computed since the previous call (the first call: the whole file)."""
         if not isinstance(result, SweepResult):
             raise TypeError(f"Checkpoint writes a SweepResult, not a {type(result).__name__}")
         with exclusive(self.path, "path"):
@@ -782,6 +922,7 @@ class Checkpoint:
             except BaseException:
                 self._disk = None  # whatever happened, read the file again next time
                 raise
+            self.saved = int(np.count_nonzero(result.done))
 
     # -- whole file -----------------------------------------------------------------------------
 
@@ -1089,7 +1230,35 @@ class _Damaged(ValueError):
 
 class DamagedArchiveError(ValueError):
     """An archive whose bytes or content are damaged; the message names the file and the damage.
-    ``reason`` is the damage alone."""
+    ``reason`` is the damage alone.
+
+    Raised by :func:`load` and :func:`describe`; a ``ValueError``, so a caller that refuses bad
+    input catches it with the rest.
+
+    Parameters
+    ----------
+    path : str
+        The archive.
+    reason : str
+        What is damaged.
+    checksum : bool, default False
+        The damage is a failed checksum (a read that may succeed when tried again, if a
+        checkpoint was rewriting the chunk).
+
+    Attributes
+    ----------
+    path, reason, checksum
+        As given.
+
+    Examples
+    --------
+    >>> from phaseimpact.archive import DamagedArchiveError
+    >>> error = DamagedArchiveError("atlas.h5", "status holds code 9")
+    >>> isinstance(error, ValueError), error.reason
+    (True, 'status holds code 9')
+    >>> str(error)
+    "'atlas.h5' is an incomplete or damaged phaseimpact archive: status holds code 9"
+    """
 
     def __init__(self, path: str, reason: str, *, checksum: bool = False):
         super().__init__(f"{path!r} is an incomplete or damaged phaseimpact archive: {reason}")
@@ -1273,6 +1442,39 @@ def load(path):
 
     Raises ``ValueError`` naming the file for a missing, foreign, truncated, damaged or newer-schema
     file (:class:`DamagedArchiveError`, naming the damage too, for a damaged one).
+
+    Parameters
+    ----------
+    path : str or path-like
+        An archive written by :func:`save` or :class:`Checkpoint` (schema 1 to
+        :data:`SCHEMA_VERSION`).
+
+    Returns
+    -------
+    SweepResult or CriticalCurve
+        With its base case, law, axes, ``t_end`` and settings, ready to be completed
+        (``previous=``) or plotted.
+
+    Raises
+    ------
+    ValueError
+        As above; :class:`DamagedArchiveError` for a damaged file.
+
+    Examples
+    --------
+    >>> import os, tempfile
+    >>> from phaseimpact import seed_parameters
+    >>> from phaseimpact.archive import load, save
+    >>> from phaseimpact.continuation import critical_curve
+    >>> path = save(critical_curve(seed_parameters(), "paper", "v", [1.0, 2.0]),
+    ...             os.path.join(tempfile.mkdtemp(), "curve.h5"))
+    >>> curve = load(path)
+    >>> type(curve).__name__, curve.what, [f"{k:.4g}" for k in curve.kappa[curve.requested]]
+    ('CriticalCurve', 'kappa_c', ['1.499e+12', '9.542e+11'])
+    >>> load(os.path.join(tempfile.mkdtemp(), "missing.h5"))
+    Traceback (most recent call last):
+    ...
+    ValueError: ...
     """
     return _retrying(_load, os.fspath(path))
 
@@ -1567,6 +1769,34 @@ def describe(path) -> dict:
     Returns ``{"kind", "law", "parameters", "axes", "t_end", "rtol", "schema_version"}``
     (``axes``: ``{name: values}``, names as given, e.g. ``plate.E``). Raises ``ValueError`` if
     ``path`` is not a phaseimpact archive, or its header or axes are damaged.
+
+    Parameters
+    ----------
+    path : str or path-like
+        An archive.
+
+    Returns
+    -------
+    dict
+        ``kind`` (one of :data:`KINDS`), ``law`` (the law as a dict), ``parameters`` (the base's
+        :class:`~phaseimpact.Parameters` as a dict, SI), ``axes``, ``t_end`` (s; NaN: each run
+        until its outcome settles), ``rtol`` and ``schema_version``.
+
+    Raises
+    ------
+    ValueError
+        As above (:class:`DamagedArchiveError` for a damaged one).
+
+    Examples
+    --------
+    >>> import os, tempfile
+    >>> from phaseimpact import seed_parameters
+    >>> from phaseimpact.archive import describe, save
+    >>> from phaseimpact.continuation import sweep
+    >>> path = save(sweep(seed_parameters(), "paper", [1e9, 1e13]), os.path.join(tempfile.mkdtemp(), "s.h5"))
+    >>> held = describe(path)
+    >>> held["kind"], held["law"]["name"], held["axes"]["kappa"].tolist(), held["t_end"], held["schema_version"]
+    ('sweep', 'paper', [1000000000.0, 10000000000000.0], nan, 3)
     """
     return _retrying(_describe, os.fspath(path))
 
@@ -1619,7 +1849,44 @@ def _t_end_text(t_end) -> str:
 
 
 def same_work(held: dict, kind: str, law: ContactLaw, params: Parameters, axes: dict, t_end, rtol) -> list[str]:
-    """What differs between an archive's :func:`describe` and the work asked for (empty: the same)."""
+    """What differs between an archive's :func:`describe` and the work asked for (empty: the same).
+
+    Parameters
+    ----------
+    held : dict
+        :func:`describe` of the archive.
+    kind : str
+        One of :data:`KINDS`.
+    law : ContactLaw
+        The law asked for.
+    params : Parameters
+        The base case's parameters asked for.
+    axes : dict
+        ``{name: values}`` asked for, in order.
+    t_end : float or None
+        The horizon asked for, s (None or NaN: each run until its outcome settles).
+    rtol : float
+        The integrator tolerance asked for.
+
+    Returns
+    -------
+    list of str
+        One phrase per difference (kind, law, parameters, axes, ``t_end``, ``rtol``), each with
+        both values.
+
+    Examples
+    --------
+    >>> import os, tempfile
+    >>> from phaseimpact import seed_parameters
+    >>> from phaseimpact.archive import describe, same_work, save
+    >>> from phaseimpact.continuation import sweep
+    >>> s = sweep(seed_parameters(), "paper", [1e9, 1e13])
+    >>> held = describe(save(s, os.path.join(tempfile.mkdtemp(), "s.h5")))
+    >>> same_work(held, "sweep", s.law, seed_parameters(), {"kappa": s.kappa}, None, 1e-10)
+    []
+    >>> same_work(held, "sweep", s.law, seed_parameters(), {"kappa": s.kappa}, None, 1e-9)
+    ['rtol 1e-10 (asked 1e-09)']
+    """
     differences = []
     if held["kind"] != kind:
         differences.append(f"kind {held['kind']!r}, not {kind!r}")
@@ -1646,7 +1913,39 @@ def same_work(held: dict, kind: str, law: ContactLaw, params: Parameters, axes: 
 def check_overwrite(path, kind: str, law: ContactLaw, params: Parameters, axes: dict, t_end, rtol, *,
                     force: bool = False, name: str = "out") -> None:
     """Refuse (``ValueError``) to replace ``path`` unless it is missing, or an archive of the same work
-    (kind, law, parameters, axis values, ``t_end`` and ``rtol``), or ``force`` is set."""
+    (kind, law, parameters, axis values, ``t_end`` and ``rtol``), or ``force`` is set.
+
+    Parameters
+    ----------
+    path : str or path-like
+        The file a command would write.
+    kind, law, params, axes, t_end, rtol
+        The work asked for, as for :func:`same_work`.
+    force : bool, default False
+        Allow any replacement (the command line's ``--force``).
+    name : str, default "out"
+        How the message names ``path`` (the command line's option).
+
+    Raises
+    ------
+    ValueError
+        For an existing file that is not an archive, a damaged archive, or an archive of other
+        work (the message lists the differences).
+
+    Examples
+    --------
+    >>> import os, tempfile
+    >>> from phaseimpact import seed_parameters
+    >>> from phaseimpact.archive import check_overwrite, save
+    >>> from phaseimpact.continuation import sweep
+    >>> s = sweep(seed_parameters(), "paper", [1e9, 1e13])
+    >>> path = save(s, os.path.join(tempfile.mkdtemp(), "s.h5"))
+    >>> check_overwrite(path, "sweep", s.law, seed_parameters(), {"kappa": s.kappa}, None, 1e-10)
+    >>> check_overwrite(path, "sweep", s.law, seed_parameters(), {"kappa": s.kappa}, None, 1e-9)
+    Traceback (most recent call last):
+    ...
+    ValueError: out = '...s.h5' holds other work (rtol 1e-10 (asked 1e-09)); refusing to overwrite it ...
+    """
     path = os.fspath(path)
     if force or not os.path.exists(path):
         return

@@ -51,6 +51,7 @@ else:  # pragma: no cover - Python 3.10
     import tomli as tomllib
 
 from .parameters import (
+    FIRST_YIELD_FACTOR,
     KAPPA_MAX,
     STEEL,
     TARGETS,
@@ -86,6 +87,8 @@ __all__ = [
     "hertz_contact",
     "validity",
     "validity_for_force",
+    "plastic_contact",
+    "plastic_validity",
     "R1_TO_PLATE_LIMIT",
     "THICKNESS_TO_PLATE_LIMIT",
 ]
@@ -121,8 +124,6 @@ _TEXT_SETTINGS = ("target", "law", "contact")
 _IMPACT_SETTINGS = ("v", "kappa", "restitution", "target", "law", "contact")
 
 CONTACTS = ("printed", "unilateral")
-#: First yield under a Hertz contact at ``p0 = 1.60 Y`` (von Mises, nu = 0.3; Johnson 1985, §4.2 and §11.4).
-FIRST_YIELD_FACTOR = 1.60
 #: Hertz theory assumes a contact radius small against the radius: ``a0 / R`` above this is out of range
 #: (assumed limit; Johnson 1985, §4.1 requires ``a << R``).
 CONTACT_RATIO_LIMIT = 0.3
@@ -723,6 +724,49 @@ def validity(params: Parameters, plate_material: Material | None,
         raise ValueError("R = None: validity needs the effective radius R")
     return _reasons(scales["peak_pressure"], scales["contact_radius"], params, plate_material, projectile_material,
                     geometry)
+
+
+def plastic_contact(force: float, params: Parameters) -> dict:
+    """Contact radius and peak pressure under Thornton's elastic-perfectly plastic sphere (Thornton
+    1997, eq. 4-9) for a normal force ``force`` (N) on its loading curve: Hertz
+    (:func:`hertz_contact`) up to the yield force ``F_y``; beyond, the pressure is capped at the
+    limiting pressure ``p_y`` and the contact grows as ``a^2 = (2 F + F_y) / (2 pi p_y)``."""
+    p_y = params.limiting_pressure
+    if p_y is None:
+        raise ValueError("limiting_pressure = None: the plastic contact needs the limiting pressure p_y (a case with "
+                         "a yield_strength)")
+    hertz = hertz_contact(force, params)
+    if hertz["peak_pressure"] <= p_y:
+        return hertz
+    e_star = 0.75 * params.K / math.sqrt(params.R)
+    delta_y = params.R * (0.5 * math.pi * p_y / e_star) ** 2
+    f_y = params.K * delta_y**1.5
+    return {"contact_radius": math.sqrt((2.0 * force + f_y) / (2.0 * math.pi * p_y)), "peak_pressure": p_y}
+
+
+def plastic_validity(force: float, params: Parameters, geometry: Geometry | None = None) -> str:
+    """The regime of an impact under Thornton's law (its peak force ``force``, N): elastic below the
+    yield velocity ``v_y``, elastic-plastic above (the model's own range: the pressure is capped at
+    ``p_y``); then, as :func:`validity`, a contact radius beyond ``CONTACT_RATIO_LIMIT * R`` and a
+    geometry outside the plate model."""
+    v_y = params.yield_velocity
+    if v_y is None:
+        raise ValueError("limiting_pressure = None: the regime needs the limiting pressure p_y (a case with a "
+                         "yield_strength)")
+    ratio = params.v / v_y
+    regime = (f"elastic (v = {ratio:.3g} v_y, v_y = {v_y:.3g} m/s: Thornton's law is Hertz here)" if ratio <= 1
+              else f"elastic-plastic (v = {ratio:.3g} v_y, v_y = {v_y:.3g} m/s; pressure capped at "
+                   f"p_y = {params.limiting_pressure:.3g} Pa: Thornton's range)")
+    reasons = []
+    radius = plastic_contact(force, params)["contact_radius"]
+    if radius / params.R > CONTACT_RATIO_LIMIT:
+        reasons.append(f"contact radius {radius:.3g} m is {radius / params.R:.2g} R (the sphere model needs a << R; "
+                       f"limit {CONTACT_RATIO_LIMIT:g} R): out of range")
+    if geometry is not None:
+        plate = _plate_reasons(geometry, params.target)
+        if plate:
+            reasons.append("; ".join(plate) + ": the plate model is out of its range")
+    return "; ".join([regime, *reasons])
 
 
 def validity_for_force(force: float, params: Parameters, plate_material: Material | None,

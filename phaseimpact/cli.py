@@ -545,7 +545,8 @@ def cmd_warmup(args) -> int:
 PARAM_UNITS = {"M1": "kg", "M2": "kg", "K": "N/m^1.5", "Kb": "N/m", "Km": "N/m^3", "alpha": "", "kappa": KAPPA_UNIT,
                "v": "m/s", "R": "m", "contact_time": "s", "plate_period": "s", "indentation": "m", "peak_force": "N",
                "contact_radius": "m", "peak_pressure": "Pa", "first_yield_pressure": "Pa",
-               "pressure_to_first_yield": "", "hertz_mass": "kg"}
+               "pressure_to_first_yield": "", "hertz_mass": "kg", "limiting_pressure": "Pa",
+               "yield_velocity": "m/s"}
 
 
 def cmd_params(args) -> int:
@@ -561,6 +562,10 @@ def cmd_params(args) -> int:
                             else f"reduced mass M1 M2/(M1+M2) ({p.target} target)")
     out.update(hertz_scales(p, case.plate))
     out["validity"] = validity(p, case.plate, case.projectile, case.geometry)
+    # Thornton's elastic-plastic law (--law thornton) yields at v_y, where the Hertz peak pressure
+    # reaches p_y = 1.6 Y of the weaker body (null without a yield strength)
+    out["limiting_pressure"] = p.limiting_pressure
+    out["yield_velocity"] = p.yield_velocity
     out["case"] = case.as_dict()
     if args.json:
         _print_json(args, out)
@@ -579,13 +584,16 @@ def cmd_params(args) -> int:
 def _contact_reading(trajectory, setup: Setup) -> dict:
     """Hertz contact radius and peak pressure at the run's largest force, and whether elastic Hertz
     contact holds there (null when the run has no finite force)."""
-    from .case import hertz_contact, validity_for_force
+    from .case import hertz_contact, plastic_contact, plastic_validity, validity_for_force
 
     force = trajectory.max_force
     if not (isinstance(force, float) and math.isfinite(force)) or setup.params.R is None:
         return {"peak_pressure": None, "contact_radius": None, "validity": "unknown: the run has no finite peak force"}
     force = max(force, 0.0)
     case = setup.case
+    if setup.law.entry.plastic:  # the pressure is capped at p_y: Hertz's reading does not apply
+        return {**plastic_contact(force, setup.params),
+                "validity": plastic_validity(force, setup.params, case.geometry)}
     return {**hertz_contact(force, setup.params),
             "validity": validity_for_force(force, setup.params, case.plate, case.projectile, case.geometry)}
 
@@ -606,6 +614,8 @@ def cmd_simulate(args) -> int:
            "status": trajectory.status, "stop_reason": trajectory.stop_reason, "message": trajectory.message,
            "t_end": trajectory.t_end, "t_stop": trajectory.t_stop, **q.as_dict(),
            **_contact_reading(trajectory, setup),
+           **({"limiting_pressure": p.limiting_pressure, "yield_velocity": p.yield_velocity}
+              if law.entry.plastic else {}),
            "n_stick": trajectory.n_stick, "n_contacts": trajectory.n_contacts, "t_run": trajectory.t_run,
            "cut": trajectory.cut, "outcome": trajectory.outcome,
            "stick_points": [{"t": t, "delta": d, "dwell": w}
@@ -829,13 +839,14 @@ def _run_grid(args, setup: Setup, axes: list):
                            scheduler=args.scheduler, rtol=args.rtol, progress=_progress(args),
                            previous=previous, on_chunk=checkpoint)
         except KeyboardInterrupt as stop:  # Ctrl-C or SIGTERM: one line, the checkpoint stays
-            saved = ""
-            if os.path.exists(out):
+            saved, done = "", checkpoint.saved  # an interrupted checkpoint write leaves the previous one
+            if done is None and os.path.exists(out):  # none written yet: a resumed archive's own points
                 try:
                     done = int(np.count_nonzero(archive.load(out).done))
-                    saved = f"; {done} of {size} points are saved in {out}"
                 except ValueError:
-                    saved = ""
+                    done = None
+            if done is not None:
+                saved = f"; {done} of {size} points are saved in {out}"
             print(f"phaseimpact: {_stopped(stop)}{saved}; resume with: {_resume_command(args.argv)}", file=sys.stderr)
             stop.reported = True
             raise
@@ -1595,7 +1606,138 @@ def build_parser() -> argparse.ArgumentParser:
     figure_out(p)
     json_option(p)
     p.set_defaults(func=cmd_portrait)
+
+    p = add("train", "a train of impacts: one projectile every T seconds on the plate as the last left it",
+            "A projectile of the case arrives every --period seconds on the plate as the previous impacts left it "
+            "(the impact map, docs/physics.md §7): per impact the plate's state before it, its amplitude, the peak "
+            "force, the energy dissipated and the restitution; --fixed-point adds the period-1 orbit of the map "
+            "with its Floquet multipliers.")
+    case_options(p)
+    law_options(p)
+    speed(p)
+    damping(p)
+    target(p)
+    p.add_argument("--period", type=_real("period", 0.0, None, low_open=True, unit="s"), required=True, metavar="T",
+                   help="time between arrivals, s, T > 0")
+    p.add_argument("--impacts", type=_integer("impacts", 1, 100_000), default=20,
+                   help="number of impacts, 1 to 100000 (default: %(default)s)")
+    p.add_argument("--fixed-point", action="store_true", help="also find the period-1 orbit and its multipliers")
+    tolerance(p)
+    json_option(p)
+    p.set_defaults(func=cmd_train)
+
+    p = add("orbit-diagram", "the impact map's attractor over T, kappa or v",
+            "The impact map iterated at each value of --param (the period T, kappa or v) from a plate at rest: "
+            "--transients impacts dropped, then --samples plate states kept (one point each); the number of "
+            "distinct points tells a fixed point (1), a period-k orbit (k) or irregular motion.")
+    case_options(p)
+    law_options(p)
+    speed(p)
+    damping(p)
+    target(p)
+    p.add_argument("--param", choices=("T", "kappa", "v"), required=True, help="the parameter varied")
+    p.add_argument("--from", dest="from_", type=_real("from"), required=True, metavar="A",
+                   help="first value (s, N s/m^(1+alpha) or m/s)")
+    p.add_argument("--to", type=_real("to"), required=True, metavar="B", help="last value")
+    p.add_argument("--num", type=_integer("num", 1, MAX_CURVE_POINTS), default=50,
+                   help=f"values, 1 to {MAX_CURVE_POINTS} (default: %(default)s)")
+    p.add_argument("--log", action="store_true", help="log-spaced values (default: linear spacing)")
+    p.add_argument("--period", type=_real("period", 0.0, None, low_open=True, unit="s"), default=None, metavar="T",
+                   help="time between arrivals (s) when --param is not T (default: none)")
+    p.add_argument("--transients", type=_integer("transients", 0, 100_000), default=200,
+                   help="impacts dropped at each value (default: %(default)s)")
+    p.add_argument("--samples", type=_integer("samples", 1, 100_000), default=50,
+                   help="impacts kept at each value (default: %(default)s)")
+    p.add_argument("--jobs", type=_integer("jobs", 1, MAX_JOBS), default=1,
+                   help="values computed side by side in threads (default: %(default)s)")
+    p.add_argument("--out", type=_figure_path, default=None, metavar="FIG.png",
+                   help="also draw the diagram into this figure, .png, .pdf or .svg (default: none)")
+    p.add_argument("--force", action="store_true", help="replace --out even if it is not a figure (default: refuse)")
+    tolerance(p)
+    json_option(p)
+    p.set_defaults(func=cmd_orbit_diagram)
     return parser
+
+
+def cmd_train(args) -> int:
+    from .integrate import scales
+    from .train import impact_train, map_fixed_point
+
+    setup = _setup(args)
+    p, law = setup.params, setup.law
+    _note(f"{args.impacts} impacts of {law.label()}, one every {args.period:g} s")
+    train = impact_train(p, law, args.period, args.impacts, rtol=args.rtol)
+    orbit = map_fixed_point(p, law, args.period) if args.fixed_point else None
+    out = {**_law_fields(setup), "v": p.v, "kappa": law.kappa(p), "kappa_unit": law.damping_unit(p.alpha),
+           "target": p.target, "plate_period": scales(p).plate_period, **train.as_dict(),
+           "fixed_point": None if orbit is None else orbit.as_dict(), "case": setup.case.as_dict()}
+    failed = [s for s in train.status if s != "success"]
+    if args.json:
+        _print_json(args, out)
+    else:
+        print(f"{law.label()} on a {p.target} target ({setup.case.name}), v = {p.v:g} m/s, one impact every "
+              f"{args.period:g} s (plate period {out['plate_period']:.6g} s)")
+        print(f"  {'n':>5} {'x2 before (m)':>14} {'x2dot (m/s)':>12} {'amplitude (m)':>14} {'peak force (N)':>14} "
+              f"{'dissipated (J)':>14} {'restitution':>11}")
+        for n in range(args.impacts):
+            print(f"  {n:5d} {train.plate[n, 0]:14.6g} {train.plate[n, 1]:12.6g} {train.amplitude[n]:14.6g} "
+                  f"{train.peak_force[n]:14.6g} {train.dissipated_energy[n]:14.6g} {train.restitution[n]:11.6g}")
+        if train.overlap.any():
+            print(f"  note: {int(train.overlap.sum())} projectile(s) still in contact when the next one arrived")
+        if orbit is not None:
+            mult = ", ".join(f"{m.real:.6g}{m.imag:+.3g}i" for m in orbit.multipliers)
+            print(f"  period-1 orbit: x2 = {orbit.plate[0]:.9g} m, x2dot = {orbit.plate[1]:.9g} m/s before each "
+                  f"impact; multipliers {mult} ({'stable' if orbit.stable else 'unstable'})"
+                  + ("" if orbit.converged else f"; {orbit.message}"))
+    if failed:
+        print(f"phaseimpact: {len(failed)} run(s) of the train failed ({failed[0]})", file=sys.stderr)
+        return EXIT_FAILURE
+    return EXIT_OK
+
+
+def cmd_orbit_diagram(args) -> int:
+    import numpy as np
+
+    from . import plotting
+    from .train import orbit_diagram
+
+    if args.out is not None:
+        _check_figure_target(args.out, args.force)
+    setup = _setup(args)
+    if args.param != "T" and args.period is None:
+        raise ValueError(f"period = None is out of range for --param {args.param}; allowed: --period T (s) > 0")
+    if args.param == "kappa":
+        _check_reads_kappa(setup.law, "orbit-diagram value")
+    values = (np.geomspace(args.from_, args.to, args.num) if args.log else np.linspace(args.from_, args.to, args.num))
+    if args.param == "v":
+        for x in (args.from_, args.to):
+            _check_in_range("v", x, *V_RANGE, "m/s", "--from/--to")
+    elif args.param == "kappa":
+        for x in (args.from_, args.to):
+            _check_in_range("kappa", x, 0.0, KAPPA_MAX, KAPPA_UNIT, "--from/--to")
+    elif min(args.from_, args.to) <= 0:
+        raise ValueError(f"T = {min(args.from_, args.to)!r} is out of range; allowed: T > 0 (s)")
+    _note(f"orbit diagram of {setup.law.label()} over {args.param}: {args.num} values x "
+          f"{args.transients + args.samples} impacts")
+    diagram = orbit_diagram(setup.params, setup.law, args.param, values, period=args.period,
+                            transients=args.transients, samples=args.samples, rtol=args.rtol, n_jobs=args.jobs)
+    if args.out is not None:
+        with exclusive(args.out, "out"):
+            title = f"{setup.law.label()}, {setup.case.name}, v = {setup.params.v:g} m/s"
+            plotting.save(plotting.plot_orbit_diagram(diagram, title=title), args.out)
+    out = {"out": args.out, **_law_fields(setup), "v": setup.params.v, "param": args.param,
+           "period": args.period, "values": diagram.values.tolist(), "transients": args.transients,
+           "samples": args.samples, "distinct": diagram.distinct.tolist(),
+           "x2": diagram.plate[:, :, 0].tolist(), "x2dot": diagram.plate[:, :, 1].tolist(),
+           "case": setup.case.as_dict()}
+    if args.json:
+        _print_json(args, out)
+    else:
+        counts = {int(k): int(n) for k, n in zip(*np.unique(diagram.distinct, return_counts=True), strict=True)}
+        print(f"orbit diagram over {args.param}: {args.num} values; distinct points after {args.transients} "
+              f"impacts (1: fixed point, k: period k, {args.samples}: irregular): {counts}"
+              + (f"; wrote {args.out}" if args.out else ""))
+    return EXIT_OK
 
 
 #: Commands that compile and integrate nothing: they start without the engine (numba, SciPy).

@@ -25,6 +25,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 
 __all__ = [
+    "FIRST_YIELD_FACTOR",
     "Material",
     "Geometry",
     "Parameters",
@@ -242,6 +243,10 @@ class Parameters:
         Effective contact radius ``R1 R2/(R1+R2)``, m, filled by :func:`derive_parameters`; not
         used by the equations of motion, only by contact radius and pressure (Hertz). ``None``
         when the parameters are given directly without it.
+    limiting_pressure : float or None
+        Thornton's limiting contact pressure ``p_y``, Pa, read by the ``thornton`` law only: the
+        Hertz peak pressure at first yield, ``1.60 Y`` of the weaker body with a ``yield_strength``
+        (:data:`FIRST_YIELD_FACTOR`), filled by :func:`derive_parameters`; ``None`` without one.
     """
 
     M1: float
@@ -254,6 +259,7 @@ class Parameters:
     v: float = 1.0
     target: str = "plate"
     R: float | None = None
+    limiting_pressure: float | None = None
 
     def __post_init__(self):
         for name in ("M1", "M2", "K", "alpha"):
@@ -262,9 +268,11 @@ class Parameters:
         for name in ("Kb", "Km", "kappa"):
             require_nonnegative(name, getattr(self, name))
         require_choice("target", self.target, TARGETS)
-        if self.R is not None:
-            require("R", self.R, "a finite number > 0, or None", _is_finite(self.R) and self.R > 0)
-        _store_floats(self, ("M1", "M2", "K", "Kb", "Km", "alpha", "kappa", "v", "R"))
+        for name in ("R", "limiting_pressure"):
+            value = getattr(self, name)
+            if value is not None:
+                require(name, value, "a finite number > 0, or None", _is_finite(value) and value > 0)
+        _store_floats(self, ("M1", "M2", "K", "Kb", "Km", "alpha", "kappa", "v", "R", "limiting_pressure"))
 
     def replace(self, **changes) -> Parameters:
         """A copy with ``changes`` applied (and validated); unknown names raise ``ValueError``."""
@@ -286,6 +294,20 @@ class Parameters:
         return self.M1 * self.M2 / (self.M1 + self.M2)
 
     @property
+    def yield_velocity(self) -> float | None:
+        """Impact speed at which the Hertz peak pressure reaches :attr:`limiting_pressure`, m/s
+        (Thornton 1997, eq. 7): ``v_y = sqrt(4 K delta_y^(5/2) / (5 m))`` (the undamped Hertz
+        impact's energy ``2/5 F_y delta_y``) with ``delta_y = R (pi p_y / (2 E*))^2``,
+        ``E* = 3 K / (4 sqrt(R))`` and ``m`` the reduced mass; for a sphere on a rigid wall
+        ``v_y = (pi^2 / sqrt(40)) sqrt(p_y^5 / (E*^4 rho)) = 1.56 sqrt(p_y^5 / (E*^4 rho))``.
+        None without a limiting pressure or a radius."""
+        if self.limiting_pressure is None or self.R is None:
+            return None
+        e_star = 0.75 * self.K / math.sqrt(self.R)
+        delta_y = self.R * (0.5 * math.pi * self.limiting_pressure / e_star) ** 2
+        return math.sqrt(4.0 * self.K * delta_y**2.5 / (5.0 * self.reduced_mass))
+
+    @property
     def hertz_indentation(self) -> float:
         """Largest indentation of the undamped impact of the reduced mass, m (docs/physics.md §4):
         ``((alpha+1) m v^2 / (2K))^(1/(alpha+1))``, ``(5 m v^2/(4K))^(2/5)`` for Hertz."""
@@ -297,6 +319,8 @@ class Parameters:
 
 
 PARAMETER_NAMES = tuple(f.name for f in dataclasses.fields(Parameters))
+#: First yield under a Hertz contact at ``p0 = 1.60 Y`` (von Mises, nu = 0.3; Johnson 1985, §4.2 and §11.4).
+FIRST_YIELD_FACTOR = 1.60
 #: Material names accepted by :func:`seed_parameters`: ``projectile_E``, ..., ``plate_yield_strength``.
 MATERIAL_NAMES = tuple(f"{body}_{field}" for body in BODIES for field in MATERIAL_FIELDS)
 #: Every name :func:`seed_parameters` and :func:`parameters_with` accept as an override.
@@ -344,7 +368,10 @@ def derive_parameters(
     Kb = 4.0 * math.pi * E * g.h**3 / (3.0 * (1 - nu**2) * g.a**2)  # eq. 5a with h^3
     km_denominator = (1 - nu**2) if membrane == "printed" else (1 - nu)
     Km = (353 - 191 * nu) * math.pi * E * g.h / (648 * km_denominator * g.a**2)  # eq. 5b
-    return Parameters(M1=M1, M2=M2, K=K, Kb=Kb, Km=Km, alpha=alpha, kappa=kappa, v=v, target=target, R=R)
+    strengths = [m.yield_strength for m in (projectile, plate) if m.yield_strength is not None]
+    p_y = FIRST_YIELD_FACTOR * min(strengths) if strengths else None
+    return Parameters(M1=M1, M2=M2, K=K, Kb=Kb, Km=Km, alpha=alpha, kappa=kappa, v=v, target=target, R=R,
+                      limiting_pressure=p_y)
 
 
 def _replace_material(material: Material, prefix: str, changes: Mapping) -> Material:

@@ -25,11 +25,12 @@ from ._atomic import atomic_path  # noqa: E402
 
 __all__ = ["STYLE", "style", "figure", "plot_displacements", "plot_force", "plot_hysteresis",
            "mark_points", "save", "save_h5", "figure_format", "FIGURE_FORMATS", "UM", "MS", "OUTCOME_COLOURS",
-           "axis_label", "plot_atlas", "plot_sweep", "plot_curve", "plot_portraits"]
+           "axis_label", "plot_atlas", "plot_sweep", "plot_curve", "plot_portraits", "plot_orbit_diagram"]
 
 UM = 1e6  #: m -> µm
 MS = 1e3  #: s -> ms
 
+#: matplotlib rcParams of the study figures (:func:`style`).
 STYLE = {
     "figure.dpi": 110,
     "savefig.dpi": 110,
@@ -49,19 +50,88 @@ STYLE = {
 
 @contextlib.contextmanager
 def style():
-    """Context in which figures use :data:`STYLE`."""
+    """Context in which figures use :data:`STYLE`.
+
+    Yields
+    ------
+    None
+        Inside the ``with`` block, matplotlib's rcParams are :data:`STYLE`; they are restored after.
+
+    Examples
+    --------
+    >>> import matplotlib.pyplot as plt
+    >>> from phaseimpact.plotting import STYLE, style
+    >>> with style():
+    ...     print(plt.rcParams["font.size"] == STYLE["font.size"])
+    True
+    """
     with plt.rc_context(STYLE):
         yield
 
 
 def figure(nrows=1, ncols=1, *, width=7.0, height=None, **kwargs):
-    """``plt.subplots`` in the study style (call inside :func:`style`)."""
+    """``plt.subplots`` in the study style (call inside :func:`style`).
+
+    Parameters
+    ----------
+    nrows, ncols : int, default 1
+        The grid of axes.
+    width : float, default 7.0
+        Figure width, inches.
+    height : float, optional
+        Figure height, inches; default 2.4 per row.
+    **kwargs
+        Passed to :func:`matplotlib.pyplot.subplots` (``sharex``...).
+
+    Returns
+    -------
+    fig : matplotlib.figure.Figure
+    axes : ndarray of Axes, shape (nrows, ncols)
+        Always 2-d (``squeeze=False``).
+
+    Examples
+    --------
+    >>> import matplotlib.pyplot as plt
+    >>> from phaseimpact.plotting import figure, style
+    >>> with style():
+    ...     fig, axes = figure(1, 3)
+    >>> axes.shape, fig.get_size_inches().tolist()
+    ((1, 3), [7.0, 2.4])
+    >>> plt.close(fig)
+    """
     height = height if height is not None else 2.4 * nrows
     return plt.subplots(nrows, ncols, figsize=(width, height), squeeze=False, **kwargs)
 
 
 def plot_displacements(ax, trajectory, *, label="", relative=True, linestyle="-"):
-    """x1, x2 (and x1 - x2) against time, µm vs ms."""
+    """x1, x2 (and x1 - x2) against time, µm vs ms.
+
+    Parameters
+    ----------
+    ax : matplotlib.axes.Axes
+        Where to draw.
+    trajectory : Trajectory
+        A run with samples (``save="steps"`` or a time grid).
+    label : str, default ""
+        Appended to each line's label.
+    relative : bool, default True
+        Also draw the indentation ``x1 - x2``.
+    linestyle : str, default "-"
+        Line style of the three lines.
+
+    Examples
+    --------
+    >>> import matplotlib.pyplot as plt
+    >>> from phaseimpact import seed_parameters, simulate
+    >>> from phaseimpact.plotting import figure, plot_displacements, style
+    >>> tr = simulate(seed_parameters(kappa=3e9), "paper", 2e-4, save="steps")
+    >>> with style():
+    ...     fig, axes = figure()
+    ...     plot_displacements(axes[0, 0], tr, label="paper")
+    >>> [line.get_label() for line in axes[0, 0].lines]
+    ['$x_1$ projectile paper', '$x_2$ target paper', '$x_1-x_2$ paper']
+    >>> plt.close(fig)
+    """
     t = trajectory.t * MS
     suffix = f" {label}" if label else ""
     ax.plot(t, trajectory.x1 * UM, "C0", ls=linestyle, label=f"$x_1$ projectile{suffix}")
@@ -73,21 +143,102 @@ def plot_displacements(ax, trajectory, *, label="", relative=True, linestyle="-"
 
 
 def plot_force(ax, trajectory, *, label=None, **kwargs):
-    """Contact force (N) against time (ms)."""
+    """Contact force (N) against time (ms).
+
+    Parameters
+    ----------
+    ax : matplotlib.axes.Axes
+        Where to draw.
+    trajectory : Trajectory
+        A run with samples (``save="steps"`` or a time grid).
+    label : str, optional
+        The line's label.
+    **kwargs
+        Passed to :meth:`matplotlib.axes.Axes.plot`.
+
+    Examples
+    --------
+    >>> import matplotlib.pyplot as plt
+    >>> from phaseimpact import seed_parameters, simulate
+    >>> from phaseimpact.plotting import figure, plot_force, style
+    >>> tr = simulate(seed_parameters(kappa=3e9), "paper", 2e-4, save="steps")
+    >>> with style():
+    ...     fig, axes = figure()
+    ...     plot_force(axes[0, 0], tr, color="k")
+    >>> axes[0, 0].get_xlabel(), axes[0, 0].get_ylabel()
+    ('time t (ms)', 'contact force P (N)')
+    >>> plt.close(fig)
+    """
     ax.plot(trajectory.t * MS, trajectory.force, label=label, **kwargs)
     ax.set_xlabel("time t (ms)")
     ax.set_ylabel("contact force P (N)")
 
 
 def plot_hysteresis(ax, trajectory, *, label=None, **kwargs):
-    """Contact force (N) against indentation delta = x1 - x2 (µm)."""
+    """Contact force (N) against indentation delta = x1 - x2 (µm).
+
+    Parameters
+    ----------
+    ax : matplotlib.axes.Axes
+        Where to draw.
+    trajectory : Trajectory
+        A run with samples (``save="steps"`` or a time grid).
+    label : str, optional
+        The line's label.
+    **kwargs
+        Passed to :meth:`matplotlib.axes.Axes.plot`.
+
+    Examples
+    --------
+    >>> import matplotlib.pyplot as plt
+    >>> from phaseimpact import seed_parameters, simulate
+    >>> from phaseimpact.plotting import figure, plot_hysteresis, style
+    >>> tr = simulate(seed_parameters(kappa=1e9), "hunt-crossley", save="steps")
+    >>> with style():
+    ...     fig, axes = figure()
+    ...     plot_hysteresis(axes[0, 0], tr, label="hunt-crossley")
+    >>> len(axes[0, 0].lines), axes[0, 0].get_ylabel()
+    (1, 'contact force P (N)')
+    >>> plt.close(fig)
+    """
     ax.plot(trajectory.delta * UM, trajectory.force, label=label, **kwargs)
     ax.set_xlabel(r"indentation $\delta = x_1 - x_2$ (µm)")
     ax.set_ylabel("contact force P (N)")
 
 
 def mark_points(ax, points, *, label="stick point", color="k", marker="o", scale=(UM, 1.0)):
-    """Mark asymptotic points (array (k, 2), SI units) in a phase plane."""
+    """Mark asymptotic points (array (k, 2), SI units) in a phase plane.
+
+    Parameters
+    ----------
+    ax : matplotlib.axes.Axes
+        Where to draw.
+    points : array of shape (k, 2)
+        Points in SI units (e.g. :attr:`phaseimpact.analysis.AsymptoticPoints.points`); none: nothing
+        is drawn.
+    label : str, default "stick point"
+        The legend label (the count is appended).
+    color : str, default "k"
+        Edge colour of the hollow markers.
+    marker : str, default "o"
+        Marker.
+    scale : pair of float, default (UM, 1.0)
+        Factors of the two coordinates (µm and m/s for the ``(delta, deltadot)`` plane).
+
+    Examples
+    --------
+    >>> import matplotlib.pyplot as plt
+    >>> from phaseimpact import seed_parameters, simulate
+    >>> from phaseimpact.analysis import find_asymptotic_points
+    >>> from phaseimpact.plotting import figure, mark_points, style
+    >>> points = find_asymptotic_points(simulate(seed_parameters(kappa=2e12), "paper")).points
+    >>> with style():
+    ...     fig, axes = figure()
+    ...     mark_points(axes[0, 0], points)
+    >>> axes[0, 0].get_legend_handles_labels()[1]
+    ['stick point (2)']
+    >>> plt.close(fig)
+    """
     points = np.asarray(points, dtype=float).reshape(-1, 2)
     if len(points):
         ax.plot(points[:, 0] * scale[0], points[:, 1] * scale[1], ls="none", marker=marker, mfc="none",
@@ -105,7 +256,33 @@ FIGURE_FORMATS = {
 
 def figure_format(path) -> str:
     """The format of a figure ``path`` from its suffix (``png`` when it has none); ``ValueError`` for a
-    format :func:`save` does not write (call it before the work that makes the figure)."""
+    format :func:`save` does not write (call it before the work that makes the figure).
+
+    Parameters
+    ----------
+    path : str or path-like
+        The figure's file.
+
+    Returns
+    -------
+    str
+        A key of :data:`FIGURE_FORMATS`.
+
+    Raises
+    ------
+    ValueError
+        For a suffix other than ``.png``, ``.pdf`` or ``.svg`` (any case).
+
+    Examples
+    --------
+    >>> from phaseimpact.plotting import figure_format
+    >>> figure_format("atlas.SVG"), figure_format("atlas")
+    ('svg', 'png')
+    >>> figure_format("atlas.jpg")
+    Traceback (most recent call last):
+    ...
+    ValueError: figure 'atlas.jpg' has format 'jpg'; allowed: .png, .pdf, .svg
+    """
     suffix = os.path.splitext(os.fspath(path))[1].lstrip(".").lower()
     fmt = suffix or "png"
     if fmt not in FIGURE_FORMATS:
@@ -120,6 +297,37 @@ def save(fig, path, dpi=110):
     Written atomically (temporary file, then rename) and without the matplotlib version or a
     creation date in its metadata, so the same figure gives the same bytes on every run (SVG: its
     element ids are hashed with a fixed salt, not a random one).
+
+    Parameters
+    ----------
+    fig : matplotlib.figure.Figure
+        The figure; closed afterwards, also when the write fails.
+    path : str or path-like
+        Where to write; the suffix gives the format (:func:`figure_format`).
+    dpi : float, default 110
+        Resolution of PNG (and of rasterised parts of PDF and SVG), dots per inch.
+
+    Returns
+    -------
+    str
+        ``path``.
+
+    Raises
+    ------
+    ValueError
+        For a format not in :data:`FIGURE_FORMATS`, a path that cannot be written, or another
+        process writing it.
+
+    Examples
+    --------
+    >>> import os, tempfile
+    >>> from phaseimpact.plotting import figure, save, style
+    >>> with style():
+    ...     fig, axes = figure()
+    ...     _ = axes[0, 0].plot([0, 1], [0, 1])
+    >>> path = save(fig, os.path.join(tempfile.mkdtemp(), "figs", "line.svg"))
+    >>> os.path.basename(path), os.path.getsize(path) > 0
+    ('line.svg', True)
     """
     path = os.fspath(path)
     try:
@@ -135,6 +343,38 @@ def save_h5(path, datasets: dict, attrs: dict | None = None):
     """Write ``{name: (array, units)}`` to HDF5 ``path`` atomically (temp file, then ``os.replace``).
 
     Names may contain ``/`` for groups; ``attrs`` go on the root (strings or numbers).
+
+    Parameters
+    ----------
+    path : str or path-like
+        The file to write.
+    datasets : dict
+        ``{name: (array, units)}``; strings are stored as bytes, arrays of more than 64 elements
+        gzip-compressed; ``units`` becomes each dataset's attribute.
+    attrs : dict, optional
+        Root attributes.
+
+    Returns
+    -------
+    str or path-like
+        ``path``.
+
+    Raises
+    ------
+    ValueError
+        For a path that cannot be written or another process writing it.
+
+    Examples
+    --------
+    >>> import os, tempfile
+    >>> import h5py, numpy as np
+    >>> from phaseimpact.plotting import save_h5
+    >>> path = save_h5(os.path.join(tempfile.mkdtemp(), "data.h5"),
+    ...                {"t": (np.linspace(0, 1e-3, 5), "s"), "runs/law": (["paper", "abrate"], "1")},
+    ...                {"case": "seed"})
+    >>> with h5py.File(path) as f:
+    ...     print(sorted(f), f["t"].attrs["units"], f["runs/law"][()].tolist(), f.attrs["case"])
+    ['runs', 't'] s [b'paper', b'abrate'] seed
     """
     import h5py
 
@@ -180,7 +420,32 @@ def _damping_unit(law, base) -> str:
 
 def axis_label(name: str, law=None, base=None) -> str:
     """``name (unit)`` for a parameter of an axis or a curve (SI units); ``kappa`` is named and
-    united by ``law``'s entry when given (``base``: the case, for its exponent alpha)."""
+    united by ``law``'s entry when given (``base``: the case, for its exponent alpha).
+
+    Parameters
+    ----------
+    name : str
+        A parameter (``kappa``, ``v``, ``M1``...) or a case quantity (``plate.E``, ``R1``...).
+    law : ContactLaw, optional
+        Whose entry names the damping coefficient and gives its unit.
+    base : Parameters or Case, optional
+        The case (its ``alpha`` sets the damping's unit).
+
+    Returns
+    -------
+    str
+        The label, in matplotlib mathtext.
+
+    Examples
+    --------
+    >>> from phaseimpact import seed_parameters
+    >>> from phaseimpact.model import as_law
+    >>> from phaseimpact.plotting import axis_label
+    >>> axis_label("v"), axis_label("plate.E")
+    ('impact speed $v$ (m/s)', 'plate.E (Pa)')
+    >>> print(axis_label("kappa", as_law("kuwabara-kono"), seed_parameters()))
+    $\\gamma$ (N s/m$^{1.5}$)
+    """
     from .case import SETTABLE
 
     if name == "kappa" and law is not None:
@@ -234,6 +499,22 @@ def plot_atlas(result, *, contours: str | None = None, curves=()):
         Overlay the lines where this count changes (labelled ``n|n+1``; at most ten levels).
     curves : sequence of CriticalCurve
         Continued curves to overlay: ``kappa`` against the parameter of the atlas's other axis.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        For :func:`save`. Refined boundaries in ``result.extras["boundaries"]`` are marked.
+
+    Examples
+    --------
+    >>> from phaseimpact import seed_parameters
+    >>> from phaseimpact.continuation import atlas
+    >>> from phaseimpact.plotting import plot_atlas
+    >>> a = atlas(seed_parameters(), "paper", {"kappa": [1e11, 1e12, 1e13], "v": [0.5, 2.0]})
+    >>> fig = plot_atlas(a, contours="n_stick")
+    >>> fig.axes[0].get_title()
+    'paper contact=printed, case parameters: 3 x 2 points'
+    >>> import matplotlib.pyplot as plt; plt.close(fig)
     """
     from matplotlib.colors import BoundaryNorm, ListedColormap
 
@@ -297,7 +578,29 @@ def plot_atlas(result, *, contours: str | None = None, curves=()):
 def plot_sweep(result):
     """A sweep (one axis): the long-time count (stick phases for ``paper``, contacts otherwise) and the
     largest force against the axis, each point coloured by its outcome class; points whose horizon cut
-    the run (the count is a lower bound) drawn as upward triangles."""
+    the run (the count is a lower bound) drawn as upward triangles.
+
+    Parameters
+    ----------
+    result : SweepResult
+        With one axis (:func:`~phaseimpact.continuation.sweep`).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        Two panels sharing the axis, for :func:`save`.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from phaseimpact import seed_parameters
+    >>> from phaseimpact.continuation import sweep
+    >>> from phaseimpact.plotting import plot_sweep
+    >>> fig = plot_sweep(sweep(seed_parameters(), "paper", np.geomspace(1e9, 1e14, 5)))
+    >>> len(fig.axes), fig.axes[0].get_title()
+    (2, 'paper contact=printed, case parameters: 5 values of kappa')
+    >>> import matplotlib.pyplot as plt; plt.close(fig)
+    """
     axis = result.grid.axes[0]
     x = np.asarray(axis.values)
     outcomes = result.outcome_names()
@@ -351,7 +654,30 @@ def _geometric(values) -> bool:
 def plot_curve(curve):
     """A continued curve: ``kappa`` (``kappa_c``, ``kappa_2`` or a grazing value) against its parameter,
     the values asked for as dots (intermediate continuation steps as small dots), the closed
-    form dashed where it exists."""
+    form dashed where it exists.
+
+    Parameters
+    ----------
+    curve : CriticalCurve
+        From :func:`~phaseimpact.continuation.critical_curve` (values lost are marked with crosses).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        For :func:`save`.
+
+    Examples
+    --------
+    >>> from phaseimpact import seed_parameters
+    >>> from phaseimpact.continuation import critical_curve
+    >>> from phaseimpact.plotting import plot_curve
+    >>> fig = plot_curve(critical_curve(seed_parameters(), "paper", "v", [1.0, 2.0]))
+    >>> print(fig.axes[0].get_ylabel())
+    $\\kappa_c$ (N s/m$^{2.5}$)
+    >>> fig.axes[0].get_legend_handles_labels()[1][1:]
+    ['values asked for', 'intermediate steps', 'closed-form $\\\\kappa_c$ (docs/physics.md §5)']
+    >>> import matplotlib.pyplot as plt; plt.close(fig)
+    """
     x = np.asarray(curve.values, dtype=float)
     y = np.asarray(curve.kappa, dtype=float)
     asked = np.asarray(curve.requested, dtype=bool)
@@ -390,6 +716,55 @@ EVENT_MARKERS = {
 }
 
 
+def plot_orbit_diagram(diagram, *, title: str = ""):
+    """An orbit diagram of the impact map: the plate's position before each sampled impact against
+    the parameter (one dot per sample), and the number of distinct points per value.
+
+    Parameters
+    ----------
+    diagram : OrbitDiagram
+        From :func:`phaseimpact.train.orbit_diagram`.
+    title : str
+        The figure's title.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        For :func:`save`.
+
+    Examples
+    --------
+    >>> from phaseimpact import seed_parameters
+    >>> from phaseimpact.train import orbit_diagram
+    >>> from phaseimpact.plotting import plot_orbit_diagram
+    >>> d = orbit_diagram(seed_parameters(), "hunt-crossley", "T", [2e-3, 3e-3], transients=5, samples=3)
+    >>> fig = plot_orbit_diagram(d)
+    >>> print(fig.axes[1].get_xlabel())
+    period T between impacts (s)
+    >>> import matplotlib.pyplot as plt; plt.close(fig)
+    """
+    labels = {"T": "period T between impacts (s)", "kappa": r"damping $\kappa$ (law's unit)",
+              "v": "impact speed v (m/s)"}
+    values = np.asarray(diagram.values, dtype=float)
+    samples = diagram.plate.shape[1]
+    with style():
+        fig, axes = figure(2, 1, width=5.6, height=5.0, sharex=True)
+        ax = axes[0, 0]
+        ax.plot(np.repeat(values, samples), diagram.plate[:, :, 0].ravel() * 1e6, ".", color="k", ms=1.2,
+                mew=0, rasterized=True)
+        ax.set_ylabel(r"plate position $x_2$ before impact (µm)")
+        if title:
+            ax.set_title(title)
+        ax = axes[1, 0]
+        ax.plot(values, diagram.distinct, "C0.-", ms=3, lw=0.6)
+        ax.set_yscale("log")
+        ax.set_ylabel("distinct points")
+        ax.set_xlabel(labels[diagram.param])
+        if diagram.param != "T" and values.min() > 0 and values.max() / values.min() > 100:
+            ax.set_xscale("log")
+    return fig
+
+
 def plot_portraits(trajectories, plane=("delta", "deltadot"), *, summaries=None, title: str = ""):
     """One phase portrait per trajectory, with its events.
 
@@ -411,6 +786,27 @@ def plot_portraits(trajectories, plane=("delta", "deltadot"), *, summaries=None,
     and in the ``(delta, deltadot)`` plane as the point ``(delta*, 0)`` it rests at: a filled star
     for a permanent stick (an asymptotic point), hollow circles for transient ones. Each panel's
     title gives ``kappa``, the outcome and the counts.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        Up to three panels a row, for :func:`save`.
+
+    Raises
+    ------
+    ValueError
+        For a plane not in :data:`phaseimpact.analysis.PLANES`, or ``summaries`` of another
+        length than ``trajectories``.
+
+    Examples
+    --------
+    >>> from phaseimpact import seed_parameters
+    >>> from phaseimpact.analysis import phase_portrait
+    >>> from phaseimpact.plotting import plot_portraits
+    >>> fig = plot_portraits(phase_portrait(seed_parameters(), "paper", [1e9, 2e12], t_end=2e-3))
+    >>> [ax.get_title().splitlines()[1] for ax in fig.axes]
+    ['1 stick phase, 1 contact (at least: cut)', '2 stick phases, 1 contact']
+    >>> import matplotlib.pyplot as plt; plt.close(fig)
     """
     from .analysis import plane_coordinates
 

@@ -17,6 +17,8 @@ __all__ = ["ImpactQuantities", "impact_quantities"]
 class ImpactQuantities:
     """What one impact produced (SI units).
 
+    Made by :func:`impact_quantities`; undefined quantities are None, never NaN.
+
     Attributes
     ----------
     max_force : float
@@ -35,6 +37,14 @@ class ImpactQuantities:
     loop_area : float
         ``integral of P d(delta)`` over the run, J: the area of the force-indentation loop
         (equal to the dissipated energy whenever the run ends out of contact).
+
+    Examples
+    --------
+    >>> from phaseimpact import seed_parameters, simulate
+    >>> from phaseimpact.quantities import impact_quantities
+    >>> q = impact_quantities(simulate(seed_parameters(v=1.0, kappa=1e9), "hunt-crossley"))
+    >>> print(f"{q.max_force:.4g} N, {q.contact_duration:.4g} s, e = {q.restitution:.3f}")
+    4760 N, 0.0001095 s, e = 0.924
     """
 
     max_force: float
@@ -46,12 +56,57 @@ class ImpactQuantities:
     loop_area: float
 
     def as_dict(self) -> dict:
+        """The quantities as a plain dict (for JSON; None stays None).
+
+        Returns
+        -------
+        dict
+            ``{name: value}`` in the order of the attributes.
+
+        Examples
+        --------
+        >>> from phaseimpact import seed_parameters, simulate
+        >>> from phaseimpact.quantities import impact_quantities
+        >>> d = impact_quantities(simulate(seed_parameters(kappa=3e9), "paper")).as_dict()
+        >>> list(d)[:3], d["restitution"]
+        (['max_force', 'max_indentation', 'contact_duration'], None)
+        """
         return asdict(self)
 
 
 def impact_quantities(trajectory: Trajectory) -> ImpactQuantities:
     """Derive :class:`ImpactQuantities` from ``trajectory`` (its summary; energies from its own
-    initial state, docs/physics.md §4)."""
+    initial state, docs/physics.md §4).
+
+    Works for summary runs (no samples) as well as dense ones: everything is read from the
+    summary vector and the event log.
+
+    Parameters
+    ----------
+    trajectory : Trajectory
+        A run of :func:`~phaseimpact.simulate`.
+
+    Returns
+    -------
+    ImpactQuantities
+        Forces in N, lengths in m, times in s, energies in J; None where undefined (no
+        separation: no contact duration, restitution or time of equal displacement).
+
+    Raises
+    ------
+    TypeError
+        If ``trajectory`` is not a :class:`~phaseimpact.Trajectory`.
+
+    Examples
+    --------
+    >>> from phaseimpact import seed_parameters, simulate
+    >>> from phaseimpact.quantities import impact_quantities
+    >>> q = impact_quantities(simulate(seed_parameters(v=1.0, kappa=3e9), "paper"))
+    >>> print(f"{q.max_force:.4g} N, {q.dissipated_energy:.4g} J")
+    4629 N, 0.07114 J
+    >>> q.restitution is None  # a permanent stick never separates
+    True
+    """
     if not isinstance(trajectory, Trajectory):
         raise TypeError(f"trajectory = {trajectory!r} has the wrong type ({type(trajectory).__name__}); allowed: a "
                         "Trajectory (from simulate())")

@@ -27,6 +27,8 @@ STUDIES = (
     "critical_surface",
     "grazing",
     "erosion",
+    "plastic",
+    "train",
     "max_force_vs_kappa",
     "rk4_critical",
     "claims",

@@ -44,6 +44,10 @@ def outputs(tmp_path_factory):
         "warmup": ["warmup"],
         "plot": ["plot", tmp / "s.h5", "--out", tmp / "s.png"],
         "portrait": ["portrait", "--kappa", "3e9", "--out", tmp / "p.png"],
+        "train": ["train", "--law", "hunt-crossley", "--kappa", "3e9", "--period", "3e-3", "--impacts", "3",
+                  "--fixed-point"],
+        "orbit-diagram": ["orbit-diagram", "--law", "hunt-crossley", "--param", "T", "--from", "2e-3", "--to", "3e-3",
+                          "--num", "2", "--transients", "3", "--samples", "2"],
     }
     out = {}
     for name, argv in argvs.items():  # in order: plot reads the sweep's archive

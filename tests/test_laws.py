@@ -15,7 +15,8 @@ from phaseimpact.model.rhs import energy
 
 VARIANTS = law_variants()
 IDS = [law.label() for law in VARIANTS]
-SEED = seed_parameters(v=1.0, kappa=3e9)
+#: limiting_pressure: read by the plastic law (thornton) only, which yields well below 1 m/s with it
+SEED = seed_parameters(v=1.0, kappa=3e9, limiting_pressure=2e9)
 #: Every law damped as Hunt-Crossley is at SEED (the same dimensionless damping number), not with one
 #: kappa for all: kappa = 3e9 N s/m^1.5 would overdamp Kuwabara-Kono by four orders of magnitude.
 A_SEED = damping_number(SEED, "hunt-crossley")
@@ -104,9 +105,12 @@ def test_momentum_is_conserved_without_target_springs(law):
     assert momentum == pytest.approx(p.M1 * p.v, rel=1e-10)
 
 
-@pytest.mark.parametrize("law", VARIANTS, ids=IDS)
+@pytest.mark.parametrize("law", [law for law in VARIANTS if not law.entry.memory],
+                         ids=[law.label() for law in VARIANTS if not law.entry.memory])
 def test_engine_matches_the_scipy_oracle(law):
-    """Same event sequence (coincident events may swap), times and max force within 1e-9."""
+    """Same event sequence (coincident events may swap), times and max force within 1e-9. (The oracle
+    has no law memory: Thornton's law is checked against its closed forms and a scipy run restarted
+    at the turning point, tests/test_thornton.py.)"""
     tr = simulate(case_for(law), law, 4e-3, rtol=1e-12)
     ref = oracle(case_for(law), law, 4e-3, rtol=1e-12)
     ours = sorted(zip(np.round(tr.event_t, 12), [e.kind for e in tr.events], strict=True))

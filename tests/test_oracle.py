@@ -27,6 +27,8 @@ RESTITUTIONS = (0.3, 0.9)
 def _cases():
     cases = []
     for entry in REGISTRY.values():
+        if entry.memory:  # the oracle has no law memory: tests/test_thornton.py (closed forms, scipy restarted)
+            continue
         options = [{}] + [{"clamp": True}] * ("clamp" in entry.options) + [{"bilateral": True}] * (
             "bilateral" in entry.options) + [{"contact": "unilateral"}] * ("contact" in entry.options)
         for option in options:

@@ -283,3 +283,22 @@ def test_ctrl_c_while_the_command_line_is_imported_ends_in_one_line(monkeypatch,
     monkeypatch.setattr(sys, "meta_path", [Interrupting(), *sys.meta_path])
     assert _entry.main() == 130
     assert capsys.readouterr().err == "phaseimpact: interrupted\n"
+
+
+@pytest.mark.parametrize("where", ["weakref", "__del__"])
+def test_a_signal_where_python_drops_exceptions_is_raised_after_the_run(monkeypatch, where):
+    """A Ctrl-C that lands in a weak-reference callback or a finaliser would be printed as "Exception
+    ignored" and lost (an atlas then ran to its end and exited 0): it is deferred to the caller of
+    the compiled run instead."""
+    import weakref
+
+    monkeypatch.setattr(_signals, "deferred", [])
+    namespace = {}
+    name, filename = ("remove", weakref.__file__) if where == "weakref" else ("__del__", "<finaliser>")
+    exec(compile(f"import sys\ndef {name}():\n    return sys._getframe()\n", filename, "exec"), namespace)  # noqa: S102
+    frame = namespace[name]()
+    _signals.handler(signal.SIGINT, frame)  # records, does not raise
+    assert _signals.deferred == [signal.SIGINT]
+    with pytest.raises(KeyboardInterrupt):
+        _signals.check(False)
+    assert _signals.deferred == []

@@ -281,7 +281,7 @@ def heyoka_ratios():
 # ------------------------------------------------------------------------------------------------ table
 
 R, D, C = "README.md", "docs/physics.md", "figures/claims.md"
-ST, ER = "studies/staircase.py", "studies/erosion.py"
+ST, ER, PL = "studies/staircase.py", "studies/erosion.py", "studies/plastic.py"
 
 STATEMENTS = [
     # README, findings
@@ -513,7 +513,9 @@ EXEMPT = {
     D: {"100": "the confirmation's tolerance factor (a setting, continuation/confirm.py), 'rtol / 100'",
         "7850": "input (steel density)", "353": "eq. 5b's formula", "191": "eq. 5b's formula",
         "648": "eq. 5b's formula", "6.35": "the speed of an example point (input)",
-        "3.2145": "the literature's rounded value, quoted as such", "2002": "year", "2008": "year"},
+        "3.2145": "the literature's rounded value, quoted as such", "2002": "year", "2008": "year",
+        "1997": "year", "383": "page (Thornton 1997, J. Appl. Mech. 64:383)"},
+    PL: {"1997": "year", "383": "page (Thornton 1997, J. Appl. Mech. 64:383)"},
     ER: {"1985": "year", "11.4": "Johnson's section", "100": "input (grain size)", "300": "input (grain sizes)",
          "150": "input (speed range)", "120": "input (blade-tip speed range)"},
 }

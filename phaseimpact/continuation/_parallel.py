@@ -97,3 +97,13 @@ def run_chunks(batches, *, rtol: float, settle: bool, stop_on, n_jobs: int, back
     finally:
         if client is not None:
             client.close()
+
+
+def map_in_threads(function, items, n_jobs: int) -> list:
+    """``[function(item) for item in items]`` in ``n_jobs`` threads (joblib), in order. For work
+    whose compiled part releases the GIL (the driver's runs): the Python between runs is serial."""
+    if n_jobs == 1 or len(items) == 1:
+        return [function(item) for item in items]
+    import joblib
+
+    return joblib.Parallel(n_jobs=n_jobs, prefer="threads")(joblib.delayed(function)(item) for item in items)

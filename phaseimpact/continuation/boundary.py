@@ -25,7 +25,7 @@ __all__ = ["Boundaries", "refine_boundaries"]
 
 @dataclass(frozen=True)
 class Boundaries:
-    """Refined boundary points of an atlas.
+    """Refined boundary points of an atlas, as :func:`refine_boundaries` returns them.
 
     Attributes
     ----------
@@ -37,6 +37,15 @@ class Boundaries:
         Outcome class codes on the low and high side along ``axis``.
     rtol : float
         Relative width of each refined bracket.
+
+    Examples
+    --------
+    >>> from phaseimpact import seed_parameters
+    >>> from phaseimpact.continuation import atlas, refine_boundaries
+    >>> a = atlas(seed_parameters(), "paper", {"kappa": [1e11, 1e12, 1e13], "v": [1.0, 2.0]})
+    >>> b = refine_boundaries(a, "kappa", rtol=1e-4)
+    >>> len(b), b.axis, b.points.shape
+    (2, 'kappa', (2, 2))
     """
 
     axis: str
@@ -51,7 +60,50 @@ class Boundaries:
 
 def refine_boundaries(result: SweepResult, axis: str = "kappa", *, rtol: float = 1e-8,
                       integrator_rtol: float | None = None) -> Boundaries:
-    """Locate every class change along ``axis`` between neighbouring points of ``result``."""
+    """Locate every class change along ``axis`` between neighbouring points of ``result``.
+
+    Where two neighbouring grid points along ``axis`` end in different outcome classes (both
+    computed, neither failed), the boundary between them is located by bisection on the class
+    (geometric midpoints on a log axis), all other coordinates held, until the bracket's
+    relative width is below ``rtol``. For a Filippov law's edge between a permanent stick and the
+    rest, the class is read from the sign of the first stick's margin (its root is ``kappa_c``,
+    docs/physics.md §5), so no run has to reach the escape.
+
+    Parameters
+    ----------
+    result : SweepResult
+        A sweep or atlas (:func:`~phaseimpact.continuation.atlas`).
+    axis : str, default "kappa"
+        The axis to refine along; one of ``result.grid.names``.
+    rtol : float, default 1e-8
+        Relative width of each final bracket, ``1e-14 <= rtol <= 0.1``.
+    integrator_rtol : float, optional
+        Tolerance of the runs; default the result's own (``result.settings["rtol"]``).
+
+    Returns
+    -------
+    Boundaries
+        One point per class change, in the order of the grid lines, each at its bracket's
+        (geometric) midpoint.
+
+    Raises
+    ------
+    ValueError
+        If ``axis`` is not an axis of ``result`` or ``rtol`` is out of range.
+    RunFailed
+        When a run of a Filippov law's margin fails numerically (naming its kappa).
+
+    Examples
+    --------
+    >>> from phaseimpact import seed_parameters
+    >>> from phaseimpact.continuation import atlas, refine_boundaries
+    >>> a = atlas(seed_parameters(), "paper", {"kappa": [1e11, 1e12, 1e13], "v": [1.0, 2.0]})
+    >>> b = refine_boundaries(a, "kappa", rtol=1e-4)
+    >>> for (kappa, v), lo, hi in zip(b.points, b.below, b.above):
+    ...     print(f"v = {v} m/s: kappa_c = {kappa:.4g} N s/m^2.5, outcome {lo} -> {hi}")
+    v = 1.0 m/s: kappa_c = 1.499e+12 N s/m^2.5, outcome 1 -> 2
+    v = 2.0 m/s: kappa_c = 9.542e+11 N s/m^2.5, outcome 1 -> 2
+    """
     grid = result.grid
     names = grid.names
     if axis not in names:

@@ -28,14 +28,30 @@ _RTOL_FLOOR = 1e-13
 
 
 def tighter(rtol: float) -> float:
-    """The tolerance a count is confirmed at."""
+    """The tolerance a count is confirmed at: ``rtol / CONFIRM_FACTOR``, not below 1e-13.
+
+    Parameters
+    ----------
+    rtol : float
+        The integrator tolerance of the count.
+
+    Returns
+    -------
+    float
+
+    Examples
+    --------
+    >>> from phaseimpact.continuation.confirm import tighter
+    >>> tighter(1e-10), tighter(1e-12)
+    (1e-12, 1e-13)
+    """
     return max(rtol / CONFIRM_FACTOR, _RTOL_FLOOR)
 
 
 def stick_sequence_violation(trajectory) -> str | None:
     """Why the stick phases of a ``paper`` run cannot be the motion of eq. 8, or None.
 
-    Two invariants hold whatever the tolerance:
+    Three invariants hold whatever the tolerance:
 
     * a slip from one stick to the next (no reversal between) moves ``delta`` in the direction of
       its mode: an outward slip (``deltadot > 0``) re-sticks deeper, an inward one shallower
@@ -43,6 +59,23 @@ def stick_sequence_violation(trajectory) -> str | None:
     * the break of the first stick is followed by a second stick: the first slip above
       ``kappa_c`` goes deeper and is damped, so an escape right after it is a missed re-stick;
     * a run that ends slipping has ``deltadot`` of its mode's sign (else its zero was stepped over).
+
+    Parameters
+    ----------
+    trajectory : Trajectory
+        A run of ``paper`` (or another Filippov law); a summary run is enough (the event log).
+
+    Returns
+    -------
+    str or None
+        The first broken invariant in words (times in s, ``delta`` in m), or None when all hold.
+
+    Examples
+    --------
+    >>> from phaseimpact import seed_parameters, simulate
+    >>> from phaseimpact.continuation import stick_sequence_violation
+    >>> print(stick_sequence_violation(simulate(seed_parameters(kappa=2e12), "paper")))
+    None
     """
     kinds = trajectory.event_kind
     y = trajectory.event_y
@@ -73,7 +106,7 @@ def stick_sequence_violation(trajectory) -> str | None:
 
 @dataclass(frozen=True)
 class ConfirmedCount:
-    """A stick count at one ``kappa`` and how far it can be trusted.
+    """A stick count at one ``kappa`` and how far it can be trusted (:func:`confirmed_count`).
 
     Attributes
     ----------
@@ -89,6 +122,14 @@ class ConfirmedCount:
         Why not confirmed ("" when confirmed).
     n_stick_tight : int or None
         The count at the tighter tolerance (None if that run was not made or broke an invariant).
+    disagree : bool
+        Not confirmed only because the two tolerances count differently (no invariant broken).
+
+    Examples
+    --------
+    >>> from phaseimpact.continuation import ConfirmedCount
+    >>> ConfirmedCount(3, 0.01, False, False, "3 stick phases at rtol 1e-10, 4 at rtol 1e-12", 4).disagree
+    True
     """
 
     n_stick: int
@@ -112,7 +153,39 @@ def _count(params, law, rtol):
 
 
 def confirmed_count(params, law, rtol: float) -> ConfirmedCount:
-    """Count the stick phases of ``paper`` at ``params`` and confirm the count (module docstring)."""
+    """Count the stick phases of ``paper`` at ``params`` and confirm the count (module docstring).
+
+    The run (until its outcome settles) must keep the invariants of
+    :func:`stick_sequence_violation`, and a re-run at :func:`tighter` tolerance must keep them too
+    and give the same count (and the same cut); a failed run is not confirmed either.
+
+    Parameters
+    ----------
+    params : Parameters
+        The case, with its ``kappa`` (N s/m^(1+alpha)).
+    law : ContactLaw or str
+        ``paper`` or another Filippov law.
+    rtol : float
+        Integrator tolerance of the count, within :data:`~phaseimpact.integrate.RTOL_RANGE`.
+
+    Returns
+    -------
+    ConfirmedCount
+        The count at ``rtol``, whether it is confirmed and, if not, why.
+
+    Raises
+    ------
+    ValueError
+        For an argument :func:`~phaseimpact.simulate` refuses.
+
+    Examples
+    --------
+    >>> from phaseimpact import seed_parameters
+    >>> from phaseimpact.continuation import confirmed_count
+    >>> c = confirmed_count(seed_parameters(v=1.0, kappa=2e12), "paper", 1e-10)
+    >>> c.n_stick, c.confirmed, c.n_stick_tight, c.cut
+    (2, True, 2, False)
+    """
     run, violation = _count(params, law, rtol)
     if violation is not None:
         return ConfirmedCount(run.n_stick, run.t_run, run.cut, False, violation)

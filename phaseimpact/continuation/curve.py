@@ -29,6 +29,7 @@ from .transition import (
 
 __all__ = ["CriticalCurve", "critical_curve", "CURVE_QUANTITIES"]
 
+#: What :func:`critical_curve` continues.
 CURVE_QUANTITIES = ("kappa_c", "kappa_2", "grazing")
 
 
@@ -52,7 +53,26 @@ class CriticalCurve:
         The predictor's value at each point (how good the continuation's steps were).
     what : str
         ``kappa_c``, ``kappa_2`` or ``grazing`` (with ``contact_index``).
-    law, base, rtol
+    law : ContactLaw
+        The law.
+    base : Parameters or Case
+        The case whose ``param`` was varied.
+    rtol : float
+        Relative tolerance of each located value.
+    contact_index : int
+        ``grazing``: which extremum of ``delta`` touches zero.
+    message : str
+        Where the curve was lost, or which ``kappa_2`` values are unconfirmed ("" when neither).
+
+    Examples
+    --------
+    >>> from phaseimpact import seed_parameters
+    >>> from phaseimpact.continuation import critical_curve
+    >>> c = critical_curve(seed_parameters(), "paper", "v", [1.0, 2.0])
+    >>> c.param, c.what, c.requested.tolist(), repr(c.message)
+    ('v', 'kappa_c', [True, False, False, True], "''")
+    >>> c.kappa_c is c.kappa, c.v is c.values
+    (True, True)
     """
 
     param: str
@@ -70,10 +90,12 @@ class CriticalCurve:
 
     @property
     def kappa_c(self) -> np.ndarray:
+        """:attr:`kappa` under its older name."""
         return self.kappa
 
     @property
     def v(self) -> np.ndarray:
+        """:attr:`values` under its older name (the impact speed, when ``param`` is ``v``)."""
         return self.values
 
 
@@ -92,6 +114,75 @@ def critical_curve(base: Parameters | Case, law: ContactLaw | str, param: str, v
     Raises ``ValueError`` for bad arguments (before any work) and
     :class:`~phaseimpact.continuation.transition.RunFailed` when no start point is found; a curve
     lost on the way ends there, with :attr:`CriticalCurve.message` saying where.
+
+    The first point is found independently (:func:`~phaseimpact.continuation.critical_damping`,
+    or the root of :func:`~phaseimpact.continuation.delta_extremum` near ``kappa_start``); each
+    next one is predicted by a secant in log-log and corrected by Brent's method within 2 %, then
+    20 %, of the prediction; where both fail the step is halved (at most ``max_halvings`` times
+    per value). ``kappa_2`` rides on the continued ``kappa_c`` (:func:`locate_kappa_2` at each
+    point); an unconfirmed ``kappa_2`` is NaN, named in the message.
+
+    Parameters
+    ----------
+    base : Parameters or Case
+        The case; a :class:`~phaseimpact.case.Case` allows material and geometry parameters.
+    law : ContactLaw or str
+        A Filippov law (``paper``) for ``kappa_c`` and ``kappa_2``; a unilateral law for ``grazing``.
+    param : str
+        The second parameter (``v``, ``R1``, ``plate.E``...; not ``kappa``).
+    values : sequence of float
+        Its values, SI units: non-empty, 1-d, finite, distinct, in the order to walk.
+    what : {"kappa_c", "kappa_2", "grazing"}, default "kappa_c"
+        The quantity to continue (:data:`CURVE_QUANTITIES`).
+    rtol : float, default 1e-10
+        Relative tolerance of each located value (``kappa_c``'s start: ``1e-14 <= rtol <= 1e-2``).
+    integrator_rtol : float, default 1e-10
+        Tolerance of every run, within :data:`~phaseimpact.integrate.RTOL_RANGE`.
+    contact_index : int, default 1
+        ``grazing``: which extremum of ``delta`` touches zero (the ``extremum`` of a
+        :class:`~phaseimpact.continuation.Transition`).
+    kappa_start : float, optional
+        ``grazing`` (required): the grazing value at the first point, N s/m^(1+alpha), e.g. from
+        :func:`~phaseimpact.continuation.transitions`; refined there if a root lies within 0.1 %.
+    max_halvings : int, default 6
+        Step halvings allowed before a value counts as lost.
+    progress : bool, default False
+        Draw a progress bar on stderr.
+
+    Returns
+    -------
+    CriticalCurve
+        The values walked (asked for and intermediate), ``kappa`` at each (N s/m^(1+alpha)), the
+        closed form (``kappa_c``, ``kappa_2``) and the predictions.
+
+    Raises
+    ------
+    ValueError
+        For ``what`` not in :data:`CURVE_QUANTITIES`, a law that does not fit ``what``,
+        ``param = "kappa"``, bad ``values`` (or a case invalid at either end), or ``grazing``
+        without ``kappa_start``.
+    RunFailed
+        When no start point is found, or a run of the walk fails numerically.
+
+    Examples
+    --------
+    >>> from phaseimpact import seed_parameters
+    >>> from phaseimpact.continuation import critical_curve
+    >>> c = critical_curve(seed_parameters(), "paper", "v", [1.0, 2.0, 4.0])
+    >>> for v, kappa, asked in zip(c.values, c.kappa, c.requested):
+    ...     print(f"v = {v:.3g} m/s: kappa_c = {kappa:.4g} N s/m^2.5{'' if asked else ' (step)'}")
+    v = 1 m/s: kappa_c = 1.499e+12 N s/m^2.5
+    v = 1.19 m/s: kappa_c = 1.34e+12 N s/m^2.5 (step)
+    v = 1.41 m/s: kappa_c = 1.197e+12 N s/m^2.5 (step)
+    v = 2 m/s: kappa_c = 9.542e+11 N s/m^2.5
+    v = 4 m/s: kappa_c = 6.052e+11 N s/m^2.5
+
+    A material parameter needs a case:
+
+    >>> from phaseimpact.case import load_case
+    >>> c = critical_curve(load_case("seed"), "paper", "plate.E", [1e11, 2.1e11])
+    >>> [f"{k:.4g}" for k in c.kappa]
+    ['1.36e+12', '1.499e+12']
     """
     from scipy.optimize import brentq  # imported where used: 0.5 s at start-up
     law = as_law(law)

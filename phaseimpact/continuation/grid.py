@@ -29,7 +29,28 @@ _NUMERIC_FIELDS = tuple(n for n in PARAMETER_NAMES if n not in ("target", "R"))
 
 @dataclass(frozen=True)
 class Axis:
-    """One named axis: ``values`` (1-d, finite) and whether it is meant to be read on a log scale."""
+    """One named axis: ``values`` (1-d, finite) and whether it is meant to be read on a log scale.
+
+    Build one with :meth:`make` (which checks the values) or :func:`parse_axis` (from text); a
+    :class:`Grid` checks the name and the range of the values against its base case and law.
+
+    Attributes
+    ----------
+    name : str
+        A parameter name (``kappa``, ``v``, ``M1``...; ``plate.E``, ``R1``... on a Case base).
+    values : ndarray of float, shape (n,)
+        The parameter's values, in SI units (``kappa`` in N s/m^(1+alpha), ``v`` in m/s).
+    log : bool
+        Drawn and refined on a log scale.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from phaseimpact.continuation import Axis
+    >>> a = Axis.make("kappa", np.geomspace(1e9, 1e12, 4))
+    >>> a.name, len(a.values), a.log
+    ('kappa', 4, True)
+    """
 
     name: str
     values: np.ndarray
@@ -37,6 +58,38 @@ class Axis:
 
     @classmethod
     def make(cls, name: str, values, log: bool | None = None) -> Axis:
+        """An axis from a name and a sequence of numbers, checked.
+
+        Parameters
+        ----------
+        name : str
+            The parameter's name (checked against the case by :class:`Grid`).
+        values : sequence or ndarray of numbers
+            Non-empty, 1-d, finite; SI units. Strings and generators are refused.
+        log : bool, optional
+            Default: True for more than two positive values spaced geometrically.
+
+        Returns
+        -------
+        Axis
+
+        Raises
+        ------
+        TypeError
+            If ``name`` is not a string or ``values`` not a sequence of numbers.
+        ValueError
+            If ``values`` is empty, not 1-d, or holds a non-finite number.
+
+        Examples
+        --------
+        >>> from phaseimpact.continuation import Axis
+        >>> Axis.make("v", [0.5, 1.0, 1.5]).log, Axis.make("v", [0.5, 1.0, 2.0]).log
+        (False, True)
+        >>> Axis.make("v", [])
+        Traceback (most recent call last):
+        ...
+        ValueError: axis v = array([], dtype=float64) is out of range; allowed: a non-empty 1-d array of finite numbers
+        """
         if not isinstance(name, str):
             raise TypeError(f"axis name = {name!r} has the wrong type ({type(name).__name__}); allowed: a string")
         numeric = (values.dtype.kind in "iuf" if isinstance(values, np.ndarray)
@@ -55,7 +108,39 @@ class Axis:
 
 
 def parse_axis(text: str) -> Axis:
-    """``NAME=START:STOP:NUM[:log]`` (or ``NAME=V1,V2,...``) as an :class:`Axis`."""
+    """``NAME=START:STOP:NUM[:log]`` (or ``NAME=V1,V2,...``) as an :class:`Axis`.
+
+    The command line's ``--axis``: ``NUM`` values from ``START`` to ``STOP`` (both included),
+    spaced geometrically with ``:log`` (linearly without it, or with ``:lin``), or the listed
+    values.
+
+    Parameters
+    ----------
+    text : str
+        E.g. ``"kappa=1e9:1e12:50:log"``, ``"v=0.5:13:60"`` or ``"R1=0.005,0.01,0.02"``; SI units.
+
+    Returns
+    -------
+    Axis
+        ``log`` True only for the ``:log`` form.
+
+    Raises
+    ------
+    TypeError
+        If ``text`` is not a string.
+    ValueError
+        For text not of these forms, non-finite ends, ``NUM`` not an integer in
+        ``1..MAX_POINTS``, or ``:log`` with an end <= 0.
+
+    Examples
+    --------
+    >>> from phaseimpact.continuation import parse_axis
+    >>> a = parse_axis("kappa=1e9:1e12:4:log")
+    >>> a.name, a.values.tolist(), a.log
+    ('kappa', [1000000000.0, 10000000000.0, 100000000000.0, 1000000000000.0], True)
+    >>> parse_axis("v=0.5,1,2").values.tolist()
+    [0.5, 1.0, 2.0]
+    """
     if not isinstance(text, str):
         raise TypeError(f"axis = {text!r} has the wrong type ({type(text).__name__}); allowed: a string "
                         "NAME=START:STOP:NUM[:log] or NAME=V1,V2,...")
@@ -96,7 +181,53 @@ def _check_span(name: str, values: np.ndarray, low: float, high: float, unit: st
 class Grid:
     """A grid of named axes over a base case (Parameters or Case), for one law.
 
-    Points are numbered in C order over the axes (the last axis varies fastest).
+    Points are numbered in C order over the axes (the last axis varies fastest). Every axis is
+    checked when the grid is made, before any work: its name must be a parameter the law reads
+    (material and geometry names need a Case base), its values distinct, ``kappa`` within
+    ``[0, KAPPA_MAX]`` and ``v`` within ``V_RANGE``, every corner of the grid a valid case, and
+    the grid at most :data:`MAX_POINTS` points.
+
+    Parameters
+    ----------
+    base : Parameters or Case
+        The case the axes vary.
+    law : ContactLaw
+        The law of every point (:func:`~phaseimpact.model.as_law` makes one from a name).
+    axes : tuple of Axis
+        At least one, with distinct names.
+
+    Attributes
+    ----------
+    base, law, axes
+        As given.
+    shape : tuple of int
+        Number of values of each axis.
+    size : int
+        Number of points.
+    names : tuple of str
+        The axes' names, in order.
+
+    Raises
+    ------
+    TypeError
+        If ``base`` is not Parameters or a Case, or an axis is not an :class:`Axis`.
+    ValueError
+        For an axis the law does not read, a name that is no parameter, repeated names or values,
+        a value out of range, or more than :data:`MAX_POINTS` points.
+
+    Examples
+    --------
+    >>> from phaseimpact import seed_parameters
+    >>> from phaseimpact.continuation import Axis, Grid
+    >>> from phaseimpact.model import as_law
+    >>> axes = (Axis.make("kappa", [1e9, 1e12]), Axis.make("v", [1.0, 2.0, 3.0]))
+    >>> g = Grid(seed_parameters(), as_law("paper"), axes)
+    >>> g.shape, g.size, g.names
+    ((2, 3), 6, ('kappa', 'v'))
+    >>> Grid(seed_parameters(), as_law("abrate"), (Axis.make("kappa", [1e9, 1e12]),))
+    Traceback (most recent call last):
+    ...
+    ValueError: axis 'kappa' is not read by law 'abrate' (its damping comes from no damping): ...
     """
 
     base: Parameters | Case
@@ -151,6 +282,23 @@ class Grid:
                 self.parameters_at({axis.name: value})
 
     def allowed_names(self) -> tuple:
+        """The names an axis of this grid may take: ``kappa``, ``v``, the other numeric
+        :class:`~phaseimpact.Parameters` fields and, on a Case base, every material and geometry
+        quantity (``plate.E``, ``R1``...).
+
+        Returns
+        -------
+        tuple of str
+
+        Examples
+        --------
+        >>> from phaseimpact.case import load_case
+        >>> from phaseimpact.continuation import Axis, Grid
+        >>> from phaseimpact.model import as_law
+        >>> g = Grid(load_case("seed"), as_law("paper"), (Axis.make("plate.E", [7e10, 2.1e11]),))
+        >>> "plate.E" in g.allowed_names(), g.allowed_names()[:2]
+        (True, ('kappa', 'v'))
+        """
         names = ("kappa", "v", *[n for n in _NUMERIC_FIELDS if n not in ("kappa", "v")])
         if isinstance(self.base, Case):
             names += tuple(n for n in QUANTITIES if n not in names)
@@ -158,33 +306,129 @@ class Grid:
 
     @property
     def shape(self) -> tuple:
+        """Number of values of each axis."""
         return tuple(len(a.values) for a in self.axes)
 
     @property
     def size(self) -> int:
+        """Number of points."""
         return int(np.prod(self.shape))
 
     @property
     def names(self) -> tuple:
+        """The axes' names, in order."""
         return tuple(a.name for a in self.axes)
 
     def base_parameters(self) -> Parameters:
+        """The base case's :class:`~phaseimpact.Parameters` (a Case's, derived from its materials).
+
+        Returns
+        -------
+        Parameters
+
+        Examples
+        --------
+        >>> from phaseimpact.case import load_case
+        >>> from phaseimpact.continuation import Axis, Grid
+        >>> from phaseimpact.model import as_law
+        >>> g = Grid(load_case("seed"), as_law("paper"), (Axis.make("v", [1.0, 2.0]),))
+        >>> print(f"{g.base_parameters().M1:.4g} kg")
+        0.2631 kg
+        """
         return self.base.parameters() if isinstance(self.base, Case) else self.base
 
     def parameters_at(self, values: dict) -> Parameters:
-        """Parameters of one point (``values``: axis name -> value)."""
+        """Parameters of one point (``values``: axis name -> value).
+
+        Parameters
+        ----------
+        values : dict
+            ``{axis name: value}`` (SI units); names not given keep the base case's value.
+
+        Returns
+        -------
+        Parameters
+
+        Raises
+        ------
+        ValueError
+            For a value out of its parameter's range.
+
+        Examples
+        --------
+        >>> from phaseimpact import seed_parameters
+        >>> from phaseimpact.continuation import Axis, Grid
+        >>> from phaseimpact.model import as_law
+        >>> g = Grid(seed_parameters(), as_law("paper"), (Axis.make("kappa", [1e9, 1e12]),))
+        >>> g.parameters_at({"kappa": 1e10}).kappa
+        10000000000.0
+        """
         if isinstance(self.base, Case):
             return self.base.parameters(**{k: float(v) for k, v in values.items()})
         return self.base.replace(**{k: float(v) for k, v in values.items()})
 
     def point_values(self, index) -> dict:
-        """Axis values of flat point ``index``."""
+        """Axis values of flat point ``index``.
+
+        Parameters
+        ----------
+        index : int
+            Flat (C order) index, ``0 <= index < size``.
+
+        Returns
+        -------
+        dict
+            ``{axis name: value}``.
+
+        Examples
+        --------
+        >>> from phaseimpact import seed_parameters
+        >>> from phaseimpact.continuation import Axis, Grid
+        >>> from phaseimpact.model import as_law
+        >>> axes = (Axis.make("kappa", [1e9, 1e12]), Axis.make("v", [1.0, 2.0, 3.0]))
+        >>> g = Grid(seed_parameters(), as_law("paper"), axes)
+        >>> g.point_values(4)
+        {'kappa': 1000000000000.0, 'v': 2.0}
+        """
         multi = np.unravel_index(int(index), self.shape)
         return {a.name: float(a.values[i]) for a, i in zip(self.axes, multi, strict=True)}
 
     def batch(self, indices: np.ndarray, t_end: float | None, rtol: float) -> Batch:
         """Packed inputs of the points ``indices`` (flat). ``kappa`` and ``v`` axes are packed as
-        arrays (no per-point objects); other axes re-derive each point's parameters."""
+        arrays (no per-point objects); other axes re-derive each point's parameters.
+
+        Parameters
+        ----------
+        indices : array of int
+            Flat (C order) point indices.
+        t_end : float or None
+            Horizon of every run, s; None: each run's default horizon (until its outcome settles,
+            capped by its scales).
+        rtol : float
+            Integrator tolerance, within :data:`~phaseimpact.integrate.RTOL_RANGE`.
+
+        Returns
+        -------
+        Batch
+            Coefficients, initial states, horizons, tolerances and step caps, one row per point,
+            for :func:`phaseimpact.integrate.api.run_batch`.
+
+        Raises
+        ------
+        ValueError
+            For ``rtol`` out of range.
+
+        Examples
+        --------
+        >>> from phaseimpact import seed_parameters
+        >>> from phaseimpact.continuation import Axis, Grid
+        >>> from phaseimpact.model import as_law
+        >>> axes = (Axis.make("kappa", [1e9, 1e12]), Axis.make("v", [1.0, 2.0, 3.0]))
+        >>> g = Grid(seed_parameters(), as_law("paper"), axes)
+        >>> b = g.batch([0, 1, 5], None, 1e-10)
+        >>> len(b), b.Y0[:, 2].tolist()
+        (3, [1.0, 2.0, 3.0])
+        """
         rtol = check_rtol(rtol)
         indices = np.asarray(indices, dtype=np.int64)
         n = len(indices)

@@ -28,6 +28,7 @@ from .grid import Axis, Grid
 
 __all__ = ["SweepResult", "sweep", "atlas", "ENGINE"]
 
+#: The engine named in every result's settings and archive.
 ENGINE = "phaseimpact driver: DOP853 (scipy tableau) with located events, numba"
 #: Points per chunk: large enough that a chunk's µs-per-point work outweighs its dispatch.
 CHUNK_THREADS, CHUNK_MIN, CHUNK_MAX = 4096, 256, 65536
@@ -58,6 +59,23 @@ class SweepResult(ColumnAccess):
     stick_point, stick_t, stick_delta, stick_dwell : ndarray
         Every stick phase of every point (an indexed ragged array: ``stick_point`` is the
         point's flat index), in the order computed.
+    extras : dict
+        Further results stored with the sweep (e.g. ``boundaries``), archived under ``/extras``.
+
+    Made by :func:`atlas` and :func:`sweep` (or :func:`phaseimpact.archive.load`); a new one (no
+    columns given) has every point not computed. The summary columns are also read as attributes
+    (``result.max_force``).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from phaseimpact import seed_parameters
+    >>> from phaseimpact.continuation import sweep
+    >>> s = sweep(seed_parameters(v=1.0), "paper", np.geomspace(1e9, 1e14, 5))
+    >>> s.shape, s.outcome_names().tolist()
+    ((5,), ['permanent-stick', 'permanent-stick', 'permanent-stick', 'ratchet-escape', 'ratchet-escape'])
+    >>> s.n_stick.tolist()
+    [1, 1, 1, 2, 2]
     """
 
     grid: Grid
@@ -88,13 +106,40 @@ class SweepResult(ColumnAccess):
 
     @property
     def law(self) -> ContactLaw:
+        """The law of every point."""
         return self.grid.law
 
     @property
     def shape(self) -> tuple:
+        """The grid's shape (one length per axis)."""
         return self.grid.shape
 
     def axis(self, name: str) -> np.ndarray:
+        """The values of the axis ``name``.
+
+        Parameters
+        ----------
+        name : str
+            One of ``grid.names``.
+
+        Returns
+        -------
+        ndarray of float
+            The axis values, SI units.
+
+        Raises
+        ------
+        ValueError
+            If the grid has no axis ``name``.
+
+        Examples
+        --------
+        >>> from phaseimpact import seed_parameters
+        >>> from phaseimpact.continuation import atlas
+        >>> a = atlas(seed_parameters(), "paper", {"kappa": [1e9, 1e13], "v": [1.0, 2.0]})
+        >>> a.axis("v").tolist()
+        [1.0, 2.0]
+        """
         for a in self.grid.axes:
             if a.name == name:
                 return a.values
@@ -102,6 +147,7 @@ class SweepResult(ColumnAccess):
 
     @property
     def kappa(self) -> np.ndarray:
+        """The ``kappa`` axis, N s/m^(1+alpha) (``ValueError`` if there is none)."""
         return self.axis("kappa")
 
     @property
@@ -111,6 +157,7 @@ class SweepResult(ColumnAccess):
 
     @property
     def failed(self) -> np.ndarray:
+        """Points computed with a numerical failure (recomputed on resume)."""
         return self.status > drv.SUCCESS
 
     @property
@@ -119,24 +166,106 @@ class SweepResult(ColumnAccess):
         return self.stop_reason == drv.HORIZON
 
     def outcome_indices(self) -> np.ndarray:
-        """Each point's index into :data:`OUTCOME_LABELS` (the outcomes, then "not computed")."""
+        """Each point's index into :data:`OUTCOME_LABELS` (the outcomes, then "not computed").
+
+        Returns
+        -------
+        ndarray of int, shape (size,)
+
+        Examples
+        --------
+        >>> from phaseimpact import seed_parameters
+        >>> from phaseimpact.continuation import sweep
+        >>> sweep(seed_parameters(), "paper", [1e9, 1e13]).outcome_indices().tolist()
+        [1, 2]
+        """
         return np.where(self.outcome < 0, len(drv.OUTCOMES), self.outcome)
 
     def outcome_names(self) -> np.ndarray:
+        """Each point's outcome class (:data:`OUTCOME_LABELS`; "not computed" for a point not computed yet).
+
+        Returns
+        -------
+        ndarray of str (object), shape (size,)
+            In C order over the axes: ``reshape(shape)`` gives the grid.
+
+        Examples
+        --------
+        >>> from phaseimpact import seed_parameters
+        >>> from phaseimpact.continuation import atlas
+        >>> a = atlas(seed_parameters(), "paper", {"kappa": [1e9, 1e13], "v": [1.0, 2.0]})
+        >>> a.outcome_names().reshape(a.shape).tolist()
+        [['permanent-stick', 'permanent-stick'], ['ratchet-escape', 'ratchet-escape']]
+        """
         return np.array(OUTCOME_LABELS, dtype=object)[self.outcome_indices()]
 
     def status_names(self) -> np.ndarray:
+        """Each point's status (:data:`~phaseimpact.integrate.STATUSES`; "not computed" for a
+        point not computed yet).
+
+        Returns
+        -------
+        ndarray of str (object), shape (size,)
+
+        Examples
+        --------
+        >>> from phaseimpact import seed_parameters
+        >>> from phaseimpact.continuation import sweep
+        >>> sweep(seed_parameters(), "paper", [1e9, 1e13]).status_names().tolist()
+        ['success', 'success']
+        """
         names = np.array(drv.STATUSES + ("not computed",), dtype=object)
         return names[np.where(self.status < 0, len(drv.STATUSES), self.status)]
 
     def sticks_of(self, index: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Stick times, depths and dwells of flat point ``index``, in time order."""
+        """Stick times, depths and dwells of flat point ``index``, in time order.
+
+        Parameters
+        ----------
+        index : int
+            Flat (C order) point index.
+
+        Returns
+        -------
+        t, delta, dwell : ndarray
+            When each stick phase began (s), its indentation ``delta*`` (m) and its dwell (s; inf
+            for a permanent stick); empty for a point without stick phases or not computed.
+
+        Examples
+        --------
+        >>> from phaseimpact import seed_parameters
+        >>> from phaseimpact.continuation import sweep
+        >>> t, delta, dwell = sweep(seed_parameters(), "paper", [1e9, 1e13]).sticks_of(0)
+        >>> len(t), dwell.tolist()
+        (1, [inf])
+        """
         keep = self.stick_point == index
         order = np.argsort(self.stick_t[keep], kind="stable")
         return self.stick_t[keep][order], self.stick_delta[keep][order], self.stick_dwell[keep][order]
 
     def store(self, indices: np.ndarray, columns) -> None:
-        """Put a chunk's :class:`~phaseimpact.integrate.Columns` at flat ``indices``."""
+        """Put a chunk's :class:`~phaseimpact.integrate.Columns` at flat ``indices``.
+
+        A point stored again (a recomputed failure) loses its old stick phases.
+
+        Parameters
+        ----------
+        indices : array of int
+            Flat (C order) indices of the chunk's points.
+        columns : Columns
+            Their runs, in the same order (:func:`~phaseimpact.simulate_many`).
+
+        Examples
+        --------
+        >>> from phaseimpact import seed_parameters, simulate_many
+        >>> from phaseimpact.continuation import Axis, Grid, SweepResult
+        >>> from phaseimpact.model import as_law
+        >>> grid = Grid(seed_parameters(), as_law("paper"), (Axis.make("kappa", [1e9, 1e12, 1e13]),))
+        >>> r = SweepResult(grid, None, {"rtol": 1e-10})
+        >>> r.store([0, 2], simulate_many([grid.parameters_at({"kappa": k}) for k in (1e9, 1e13)], "paper"))
+        >>> r.outcome_names().tolist()
+        ['permanent-stick', 'not computed', 'ratchet-escape']
+        """
         indices = np.asarray(indices, dtype=np.int64)
         if np.any(self.status[indices] >= 0):  # a recomputed (failed) point replaces its old stick phases
             keep = ~np.isin(self.stick_point, indices)
@@ -152,7 +281,23 @@ class SweepResult(ColumnAccess):
             setattr(self, name, _append(getattr(self, name), part))
 
     def summary(self) -> dict:
-        """Counts of outcomes and failures, for people."""
+        """Counts of outcomes and failures, for people.
+
+        Returns
+        -------
+        dict
+            ``{"points", "computed", "failed", "cut_by_horizon", "outcomes": {name: count}}``;
+            outcome classes in alphabetical order, only those present.
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> from phaseimpact import seed_parameters
+        >>> from phaseimpact.continuation import sweep
+        >>> sweep(seed_parameters(), "paper", np.geomspace(1e9, 1e14, 5)).summary()
+        {'points': 5, 'computed': 5, 'failed': 0, 'cut_by_horizon': 0,
+         'outcomes': {'permanent-stick': 3, 'ratchet-escape': 2}}
+        """
         counts = np.bincount(self.outcome_indices(), minlength=len(OUTCOME_LABELS))
         return {"points": int(self.grid.size), "computed": int(np.count_nonzero(self.status >= 0)),
                 "failed": int(np.count_nonzero(self.failed)), "cut_by_horizon": int(np.count_nonzero(self.cut)),
@@ -210,25 +355,72 @@ def atlas(base: Parameters | Case, law: ContactLaw | str, axes, *, t_end: float 
           on_chunk: Callable[[SweepResult], None] | None = None) -> SweepResult:
     """Evaluate every point of a grid of named parameters (an atlas).
 
+    Every argument and every axis (:class:`~phaseimpact.continuation.grid.Grid`) is checked before
+    any work. Each point runs until its outcome settles (or to ``t_end``) on the compiled driver,
+    chunk by chunk; a point whose run fails numerically is stored with its status (never raised)
+    and recomputed when the result is completed through ``previous``.
+
     Parameters
     ----------
     base : Parameters or Case
         The case the axes vary (a :class:`~phaseimpact.case.Case` allows material and geometry
         axes such as ``plate.E`` or ``R1``).
     law : ContactLaw or str
+        The law of every point, or its name.
     axes : sequence of Axis, or dict name -> values
-        E.g. ``{"kappa": np.geomspace(1e10, 1e14, 400), "v": np.linspace(0.5, 13, 300)}``.
+        E.g. ``{"kappa": np.geomspace(1e10, 1e14, 400), "v": np.linspace(0.5, 13, 300)}``
+        (``kappa`` in N s/m^(1+alpha), ``v`` in m/s); at most ``MAX_POINTS`` points in all.
     t_end : float, optional
         Horizon of every run, s; default: until the outcome settles (capped by the case's scales).
-    rtol : float
-        Integrator tolerance.
-    n_jobs, backend, scheduler
+    rtol : float, default 1e-10
+        Integrator tolerance, within :data:`~phaseimpact.integrate.RTOL_RANGE`.
+    n_jobs : int, default 1
+        Workers: an integer from 1 to 4 times the CPU count, or -1 for all cores.
+    backend : {"threads", "loky", "dask"}, default "threads"
         Threads of this process (``threads``), joblib processes (``loky``) or a Dask cluster
         (``dask``, at ``scheduler`` or a local one).
+    scheduler : str, optional
+        Address of a Dask scheduler (``dask`` only).
+    progress : bool, default False
+        Draw a progress bar on stderr.
     previous : SweepResult, optional
-        A partial result of the same grid to complete.
+        A partial result of the same grid (axes, law, ``t_end`` and ``rtol``) to complete: its
+        points not computed or failed are run, and it is filled in place and returned.
     on_chunk : callable, optional
-        Called with the partial result after each chunk (checkpoints).
+        Called with the partial result after each chunk (checkpoints, e.g.
+        :class:`phaseimpact.archive.Checkpoint`).
+
+    Returns
+    -------
+    SweepResult
+        Every point's status, outcome, summary columns and stick phases.
+
+    Raises
+    ------
+    TypeError
+        For ``axes`` not a dict or a list of Axis, ``base`` not Parameters or a Case, ``previous``
+        not a SweepResult, or ``on_chunk`` not callable.
+    ValueError
+        For an axis out of range (:class:`~phaseimpact.continuation.grid.Grid`), ``t_end``,
+        ``rtol``, ``n_jobs``, ``backend``, ``scheduler`` or ``progress`` out of range, or a
+        ``previous`` computed for other work.
+    KeyboardInterrupt
+        Ctrl-C or SIGTERM; the chunks stored so far stay in the result (and its checkpoint).
+
+    Examples
+    --------
+    >>> from phaseimpact import seed_parameters
+    >>> from phaseimpact.continuation import atlas
+    >>> a = atlas(seed_parameters(), "paper", {"kappa": [1e11, 1e12, 1e13], "v": [0.5, 2.0]})
+    >>> a.shape, a.summary()["outcomes"]
+    ((3, 2), {'permanent-stick': 3, 'ratchet-escape': 3})
+
+    Material and geometry axes need a case:
+
+    >>> from phaseimpact.case import load_case
+    >>> a = atlas(load_case("seed"), "paper", {"plate.E": [7e10, 2.1e11], "kappa": [1e9, 1e13]})
+    >>> a.outcome_names().reshape(a.shape).tolist()
+    [['permanent-stick', 'ratchet-escape'], ['permanent-stick', 'ratchet-escape']]
     """
     law = as_law(law)
     if isinstance(axes, dict):
@@ -273,5 +465,44 @@ def atlas(base: Parameters | Case, law: ContactLaw | str, axes, *, t_end: float 
 
 def sweep(params: Parameters | Case, law: ContactLaw | str, kappas, **options) -> SweepResult:
     """:func:`atlas` over ``kappa`` alone (N s/m^(1+alpha)), e.g. ``np.geomspace(1e8, 1e13, 2000)``:
-    distinct numbers in ``[0, KAPPA_MAX]``."""
+    distinct numbers in ``[0, KAPPA_MAX]``.
+
+    Parameters
+    ----------
+    params : Parameters or Case
+        The base case.
+    law : ContactLaw or str
+        A law that reads ``kappa`` (``paper``, ``hunt-crossley``...).
+    kappas : sequence or ndarray of float
+        The damping values, N s/m^(1+alpha) (N s/m^2.5 for alpha = 3/2).
+    **options
+        ``t_end``, ``rtol``, ``n_jobs``, ``backend``, ``scheduler``, ``progress``, ``previous``,
+        ``on_chunk``: as for :func:`atlas`.
+
+    Returns
+    -------
+    SweepResult
+        One axis, ``kappa``.
+
+    Raises
+    ------
+    TypeError, ValueError
+        As for :func:`atlas`; ``ValueError`` also for a law that does not read ``kappa``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from phaseimpact import seed_parameters
+    >>> from phaseimpact.continuation import sweep
+    >>> s = sweep(seed_parameters(v=1.0), "paper", np.geomspace(1e9, 1e14, 5))
+    >>> s.summary()["outcomes"], int(s.failed.sum())
+    ({'permanent-stick': 3, 'ratchet-escape': 2}, 0)
+
+    A partial result is completed through ``previous`` (its points already done are kept):
+
+    >>> from phaseimpact.continuation import sweep
+    >>> part = sweep(seed_parameters(), "paper", [1e9, 1e13])
+    >>> sweep(seed_parameters(), "paper", [1e9, 1e13], previous=part) is part
+    True
+    """
     return atlas(params, law, [Axis.make("kappa", kappas)], **options)

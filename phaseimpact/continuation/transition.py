@@ -23,7 +23,7 @@ import numpy as np
 
 from ..integrate import scales, simulate
 from ..integrate.events import EVENT_KINDS
-from ..model.laws import ContactLaw, as_law
+from ..model.laws import REGISTRY, ContactLaw, as_law
 from ..parameters import KAPPA_MAX, Parameters, is_number
 from .confirm import confirmed_count, stick_sequence_violation, tighter
 
@@ -51,7 +51,27 @@ MAX_EXTREMA = 64
 
 
 class SamplingWarning(UserWarning):
-    """A grazing search sampled more coarsely than the transitions it can resolve: some may be missed."""
+    """A grazing search sampled more coarsely than the transitions it can resolve: some may be missed.
+
+    Issued by :func:`grazing_transitions` for fewer than :data:`WARN_SAMPLES_PER_DECADE` samples
+    per decade of kappa, for runs with more than :data:`MAX_EXTREMA` extrema of ``delta``, and
+    for two grazing values closer than two samples.
+
+    Examples
+    --------
+    24 samples over five decades miss a narrow window that 80 resolve:
+
+    >>> import warnings
+    >>> from phaseimpact import seed_parameters
+    >>> from phaseimpact.continuation.transition import grazing_transitions
+    >>> with warnings.catch_warnings(record=True) as caught:
+    ...     warnings.simplefilter("always")
+    ...     coarse = grazing_transitions(seed_parameters(), "hunt-crossley", 1e8, 1e13, num=24)
+    >>> [w.category.__name__ for w in caught], len(coarse)
+    (['SamplingWarning'], 3)
+    >>> len(grazing_transitions(seed_parameters(), "hunt-crossley", 1e8, 1e13, num=80))
+    4
+    """
 
 
 def check_params(params) -> Parameters:
@@ -62,7 +82,36 @@ def check_params(params) -> Parameters:
 
 
 def check_kappa_range(kappa_min, kappa_max, names=("kappa_min", "kappa_max")) -> tuple[float, float]:
-    """``(kappa_min, kappa_max)`` as floats with ``0 < kappa_min < kappa_max <= KAPPA_MAX``."""
+    """``(kappa_min, kappa_max)`` as floats with ``0 < kappa_min < kappa_max <= KAPPA_MAX``.
+
+    Parameters
+    ----------
+    kappa_min, kappa_max : float
+        Ends of a search range of ``kappa``, N s/m^(1+alpha).
+    names : pair of str, default ("kappa_min", "kappa_max")
+        How the message names them (the command line's option names).
+
+    Returns
+    -------
+    tuple of float
+        ``(kappa_min, kappa_max)``.
+
+    Raises
+    ------
+    ValueError
+        For an end that is not a finite number in ``(0, KAPPA_MAX]`` (1e18), or ends in the
+        wrong order.
+
+    Examples
+    --------
+    >>> from phaseimpact.continuation.transition import check_kappa_range
+    >>> check_kappa_range(1e9, 1e13)
+    (1000000000.0, 10000000000000.0)
+    >>> check_kappa_range(1e9, 1e8)
+    Traceback (most recent call last):
+    ...
+    ValueError: kappa_min = 1000000000.0, kappa_max = 100000000.0 are out of range; allowed: kappa_min < kappa_max
+    """
     for name, value in zip(names, (kappa_min, kappa_max), strict=True):
         if not (is_number(value) and math.isfinite(value) and 0 < value <= KAPPA_MAX):
             raise ValueError(f"{name} = {value!r} is out of range; allowed: 0 < {name} <= {KAPPA_MAX:g} "
@@ -75,7 +124,38 @@ def check_kappa_range(kappa_min, kappa_max, names=("kappa_min", "kappa_max")) ->
 
 def check_samples(num, kappa_min: float, kappa_max: float, names=("kappa_min", "kappa_max", "num")) -> int:
     """The sample count of a grazing search over ``[kappa_min, kappa_max]``: an integer in
-    :data:`SAMPLES_RANGE`, at least :data:`MIN_SAMPLES_PER_DECADE` per decade of kappa."""
+    :data:`SAMPLES_RANGE`, at least :data:`MIN_SAMPLES_PER_DECADE` per decade of kappa.
+
+    Parameters
+    ----------
+    num : int
+        Samples of the log grid of kappa (8 to 10000).
+    kappa_min, kappa_max : float
+        The search range, N s/m^(1+alpha) (checked by :func:`check_kappa_range`).
+    names : triple of str, default ("kappa_min", "kappa_max", "num")
+        How the message names the three.
+
+    Returns
+    -------
+    int
+        ``num``.
+
+    Raises
+    ------
+    ValueError
+        For ``num`` not an integer in :data:`SAMPLES_RANGE`, or too few per decade (the message
+        gives the count or the span that would do).
+
+    Examples
+    --------
+    >>> from phaseimpact.continuation.transition import check_samples
+    >>> check_samples(96, 1e9, 1e13)
+    96
+    >>> check_samples(8, 1e8, 1e13)
+    Traceback (most recent call last):
+    ...
+    ValueError: kappa_min = 1e+08, kappa_max = 1e+13 span 5 decades: 8 samples are 1.6 per decade, ...
+    """
     lo, hi = SAMPLES_RANGE
     if not (isinstance(num, numbers.Integral) and not isinstance(num, bool) and lo <= num <= hi):
         raise ValueError(f"{names[2]} = {num!r} is out of range; allowed: an integer {lo} <= {names[2]} <= {hi}")
@@ -97,7 +177,31 @@ def _default_range(params: Parameters) -> tuple[float, float]:
 
 def closed_form_kappa_c(params: Parameters) -> float | None:
     """``kappa_c`` of docs/physics.md §5's closed form (two-body Hunt-Crossley approach, momentum
-    conserved during the contact, stuck pair on the springs); None without a plate."""
+    conserved during the contact, stuck pair on the springs); None without a plate.
+
+    An estimate (within a few tenths of a percent for the seed's case) that seeds the bracket of
+    :func:`critical_damping`.
+
+    Parameters
+    ----------
+    params : Parameters
+        The case (its ``kappa`` is not read).
+
+    Returns
+    -------
+    float or None
+        N s/m^(1+alpha); None for a rigid or free target, a plate without bending stiffness, or
+        no root for damping numbers ``kappa v / K`` in ``A_RANGE`` (1e-8 to 1e8).
+
+    Examples
+    --------
+    >>> from phaseimpact import seed_parameters
+    >>> from phaseimpact.continuation import closed_form_kappa_c
+    >>> print(f"{closed_form_kappa_c(seed_parameters(v=1.0)):.4g} N s/m^2.5")
+    1.497e+12 N s/m^2.5
+    >>> print(closed_form_kappa_c(seed_parameters(target="rigid")))
+    None
+    """
     from scipy.optimize import brentq  # imported where used: 0.5 s at start-up
     if params.target != "plate" or params.Kb <= 0:
         return None
@@ -105,9 +209,13 @@ def closed_form_kappa_c(params: Parameters) -> float | None:
     m, K, alpha, v = params.reduced_mass, params.K, params.alpha, params.v
     V = params.M1 * v / M
     E = 0.5 * M * V * V
-    X2 = 2 * E / params.Kb if params.Km == 0 else (-params.Kb + math.sqrt(params.Kb**2 + 4 * params.Km * E)) / params.Km
+    # the turning point of Kb X^2/2 + Km X^4/4 = E, written without the cancellation of
+    # (-Kb + sqrt(Kb^2 + 4 Km E)) / Km, which gave X = 0 for a grain's tiny energy (and a division by 0)
+    X2 = 4 * E / (params.Kb + math.sqrt(params.Kb**2 + 4 * params.Km * E))
     X = math.sqrt(X2)
     required = params.M1 / M * (params.Kb * X + params.Km * X**3)
+    if required <= 0:
+        return None
 
     def gap(log_a):
         a = math.exp(log_a)
@@ -123,13 +231,59 @@ def closed_form_kappa_c(params: Parameters) -> float | None:
 
 
 class RunFailed(RuntimeError):
-    """A run needed by a search ended in a numerical failure (its status and message)."""
+    """A run needed by a search ended in a numerical failure (its status and message).
+
+    A search never reads a failed run as a value: :func:`first_stick_margin`,
+    :func:`delta_extremum`, :func:`grazing_transitions`, :func:`transitions` and
+    :func:`~phaseimpact.continuation.critical_curve` raise it, naming the run's ``kappa``;
+    :func:`critical_damping` reports it as status ``failed`` instead.
+
+    Examples
+    --------
+    >>> from phaseimpact.continuation.transition import RunFailed
+    >>> try:
+    ...     raise RunFailed("kappa = 1e+12: step-size-collapse: ...")
+    ... except RuntimeError as error:
+    ...     print(type(error).__name__, error)
+    RunFailed kappa = 1e+12: step-size-collapse: ...
+    """
 
 
 def first_stick_margin(params: Parameters, law: ContactLaw | str = "paper", *, rtol: float = 1e-10) -> float:
     """Margin of the first stick (``>= 0``: it never breaks); -inf if the run never sticks.
 
-    Raises :class:`RunFailed` if the run fails numerically (a search must not take that as a value).
+    ``1 - M1/M S(A) / (K delta*^alpha)`` of the first stick phase (docs/physics.md §5), from a run
+    that stops there: a smooth function of ``kappa`` whose root is ``kappa_c``, found without any
+    horizon.
+
+    Parameters
+    ----------
+    params : Parameters
+        The case, with its ``kappa`` (N s/m^(1+alpha)).
+    law : ContactLaw or str, default "paper"
+        ``paper`` or another Filippov law.
+    rtol : float, default 1e-10
+        Integrator tolerance, within :data:`~phaseimpact.integrate.RTOL_RANGE`.
+
+    Returns
+    -------
+    float
+        Dimensionless margin; -inf when the run never sticks.
+
+    Raises
+    ------
+    RunFailed
+        If the run fails numerically (a search must not take that as a value).
+    ValueError
+        For an argument :func:`~phaseimpact.simulate` refuses.
+
+    Examples
+    --------
+    >>> from phaseimpact import seed_parameters
+    >>> from phaseimpact.continuation import first_stick_margin
+    >>> p = seed_parameters(v=1.0)
+    >>> print(f"{first_stick_margin(p.replace(kappa=1e12)):.4f} {first_stick_margin(p.replace(kappa=2e12)):.4f}")
+    0.2046 -0.1795
     """
     trajectory = simulate(params, law, None, rtol=rtol, stop_on="stick")
     if not trajectory.ok:
@@ -142,14 +296,28 @@ def first_stick_margin(params: Parameters, law: ContactLaw | str = "paper", *, r
 class CriticalDamping:
     """The critical damping of ``paper`` at one case (docs/physics.md §5).
 
+    What :func:`critical_damping` found.
+
     Attributes
     ----------
+    law, contact : str
+        The law's name and its reading of ``|delta|^alpha``.
+    v : float
+        Impact speed of the case, m/s.
     kappa_c : float or None
         Root of the first stick's margin, N s/m^(1+alpha); None when not found.
+    rtol : float
+        Relative tolerance asked of ``kappa_c``.
     closed_form : float or None
         docs/physics.md §5's closed-form estimate.
+    bracket : tuple of float
+        The final bracket of the root (or the search range when none was found), N s/m^(1+alpha).
     margins : tuple
         Margin at the search range's ends (or at the final bracket).
+    message : str
+        The result in words (counts either side, accuracy, why unconfirmed or not found).
+    evaluations : int
+        Runs the search made.
     kappa_c_accuracy : float or None
         Estimated relative error of ``kappa_c``: the final bracket's width plus its change when the
         root is solved again at a tighter integrator tolerance (:func:`.confirm.tighter`).
@@ -166,8 +334,18 @@ class CriticalDamping:
         None where the count is not confirmed (:func:`.confirm.confirmed_count`, ``reason`` says why).
     classification : str or None
         ``adding-sliding`` with :attr:`exponents` when measured.
+    exponents : dict or None
+        :func:`adding_sliding_exponents`, when asked for.
     status : {"success", "not-found", "unconfirmed", "failed"}
         ``failed``: a run of the search failed numerically (the message says which).
+
+    Examples
+    --------
+    >>> from phaseimpact import seed_parameters
+    >>> from phaseimpact.continuation import critical_damping
+    >>> c = critical_damping(seed_parameters(v=1.0), "paper")
+    >>> c.status, c.classification, c.kappa_2
+    ('success', 'adding-sliding', None)
     """
 
     law: str
@@ -191,6 +369,20 @@ class CriticalDamping:
     exponents: dict | None = None
 
     def as_dict(self) -> dict:
+        """The fields as a plain dict (for JSON).
+
+        Returns
+        -------
+        dict
+            ``{field: value}`` in the order of the fields.
+
+        Examples
+        --------
+        >>> from phaseimpact import seed_parameters
+        >>> from phaseimpact.continuation import critical_damping
+        >>> list(critical_damping(seed_parameters(), "paper").as_dict())[:4]
+        ['law', 'contact', 'v', 'kappa_c']
+        """
         return asdict(self)
 
 
@@ -204,12 +396,55 @@ def critical_damping(params: Parameters, law: ContactLaw | str = "paper", *, kap
     method narrows it to ``rtol`` (relative). Counts either side confirm it: one permanent
     stick just below, two or more stick phases just above. No root in the range gives status
     ``not-found``, ``kappa_c`` None and the margins at both ends in the message.
+
+    Parameters
+    ----------
+    params : Parameters
+        The case (its own ``kappa`` is not read).
+    law : ContactLaw or str, default "paper"
+        ``paper`` or another Filippov law.
+    kappa_min, kappa_max : float, optional
+        Search range, N s/m^(1+alpha), ``0 < kappa_min < kappa_max <= 1e18``; an end not given
+        comes from the damping numbers above.
+    rtol : float, default 1e-10
+        Relative tolerance of ``kappa_c``, ``1e-14 <= rtol <= 1e-2``.
+    integrator_rtol : float, default 1e-10
+        Tolerance of every run, within :data:`~phaseimpact.integrate.RTOL_RANGE`.
+    with_kappa_2 : bool, default False
+        Also locate ``kappa_2`` and sample the staircase (:func:`locate_kappa_2`).
+    with_exponents : bool, default False
+        Also measure the local exponents of the adding-sliding (:func:`adding_sliding_exponents`).
+
+    Returns
+    -------
+    CriticalDamping
+        ``status`` ``success`` only when the counts either side (and, with ``kappa_2``, every
+        count) are confirmed; ``failed`` when a run of the search failed numerically.
+
+    Raises
+    ------
+    TypeError
+        If ``params`` is not :class:`~phaseimpact.Parameters`.
+    ValueError
+        For a law that is not a Filippov law (unilateral laws have grazing transitions:
+        :func:`transitions`), ``rtol`` or the search range out of range.
+
+    Examples
+    --------
+    >>> from phaseimpact import seed_parameters
+    >>> from phaseimpact.continuation import critical_damping
+    >>> c = critical_damping(seed_parameters(v=1.0), "paper")
+    >>> print(f"{c.kappa_c:.6g} N s/m^2.5 ({c.status}), closed form {c.closed_form:.4g}")
+    1.49942e+12 N s/m^2.5 (success), closed form 1.497e+12
+    >>> critical_damping(seed_parameters(v=1.0), "paper", kappa_min=1e8, kappa_max=1e10).status
+    'not-found'
     """
     check_params(params)
     law = as_law(law)
     if not law.is_filippov:
-        raise ValueError(f"law = {law.name!r} is out of range for the critical damping; allowed: paper "
-                         "(unilateral laws have grazing transitions: use transitions())")
+        allowed = ", ".join(name for name, entry in REGISTRY.items() if entry.filippov)
+        raise ValueError(f"law = {law.name!r} is out of range for the critical damping; allowed: a Filippov law "
+                         f"({allowed}; unilateral laws have grazing transitions: use transitions())")
     check_rtol_of_kappa(rtol)
     kappa_min, kappa_max = default_kappa_range(params, kappa_min, kappa_max)
     closed = closed_form_kappa_c(params)
@@ -364,14 +599,28 @@ class Kappa2:
     Attributes
     ----------
     kappa_2 : float or None
+        Smallest ``kappa`` from which the run makes exactly 2 stick phases, N s/m^(1+alpha); None
+        when no bracket was found.
     accuracy : float or None
         Relative width of the final bracket, when both its ends are confirmed.
     n_below : int or None
         The confirmed count at the bracket's lower end (just below ``kappa_2``).
     staircase : list of dict
+        ``{"kappa", "relative", "n_stick", "t_run", "cut", "confirmed", "reason"}`` in increasing
+        ``kappa`` (as :attr:`CriticalDamping.n_staircase`).
     evaluations : int
+        Runs made.
     reason : str
         Why the bracket is not confirmed ("" when it is).
+
+    Examples
+    --------
+    >>> from phaseimpact import seed_parameters
+    >>> from phaseimpact.continuation import critical_damping, locate_kappa_2
+    >>> p = seed_parameters(v=1.0)
+    >>> k2 = locate_kappa_2(p, "paper", critical_damping(p, "paper").kappa_c, samples=0)
+    >>> print(f"{k2.kappa_2:.6g}", k2.n_below, k2.staircase, repr(k2.reason))
+    1.4998e+12 4 [] ''
     """
 
     kappa_2: float | None
@@ -391,7 +640,42 @@ def locate_kappa_2(params: Parameters, law: ContactLaw | str, kappa_c: float, *,
     confirmed, stopping at the first run the horizon cuts (closer to ``kappa_c`` the escape only
     takes longer).
 
-    Returns a :class:`Kappa2`.
+    Parameters
+    ----------
+    params : Parameters
+        The case (its own ``kappa`` is not read).
+    law : ContactLaw or str
+        ``paper`` or another Filippov law.
+    kappa_c : float
+        The critical damping (:func:`critical_damping`), N s/m^(1+alpha).
+    rtol : float, default 1e-10
+        Relative width of the final bracket of ``kappa_2`` (not checked here).
+    integrator_rtol : float, default 1e-10
+        Tolerance of every run, within :data:`~phaseimpact.integrate.RTOL_RANGE`.
+    samples : int, default 24
+        Points of the staircase (0: none).
+
+    Returns
+    -------
+    Kappa2
+        ``kappa_2`` None with a ``reason`` when no ``kappa`` up to ``kappa_c (1 + 1e3)`` gives
+        ``N = 2``, or ``N = 2`` holds down to ``kappa_c (1 + 1e-12)``.
+
+    Raises
+    ------
+    ValueError
+        For an argument :func:`~phaseimpact.simulate` refuses.
+
+    Examples
+    --------
+    >>> from phaseimpact import seed_parameters
+    >>> from phaseimpact.continuation import critical_damping, locate_kappa_2
+    >>> p = seed_parameters(v=1.0)
+    >>> k2 = locate_kappa_2(p, "paper", critical_damping(p, "paper").kappa_c, samples=3)
+    >>> print(f"kappa_2 = {k2.kappa_2:.6g} N s/m^2.5, {k2.n_below} stick phases just below")
+    kappa_2 = 1.4998e+12 N s/m^2.5, 4 stick phases just below
+    >>> [step["n_stick"] for step in k2.staircase]
+    [3358, 126, 2]
     """
     law = as_law(law)
     evaluations = 0
@@ -474,7 +758,38 @@ def adding_sliding_exponents(params: Parameters, law: ContactLaw | str, kappa_c:
                              eps=(1e-7, 3e-7, 1e-6, 3e-6, 1e-5), integrator_rtol: float = 1e-12) -> dict:
     """Local exponents of the adding-sliding at ``kappa_c``: the first slip's largest speed
     ``~ eps^(3/2)`` and the offset between the first two stick depths ``~ eps^2``
-    (``eps = kappa/kappa_c - 1``), fitted on log-log over ``eps``."""
+    (``eps = kappa/kappa_c - 1``), fitted on log-log over ``eps``.
+
+    Parameters
+    ----------
+    params : Parameters
+        The case (its own ``kappa`` is not read).
+    law : ContactLaw or str
+        ``paper`` or another Filippov law.
+    kappa_c : float
+        The critical damping (:func:`critical_damping`), N s/m^(1+alpha).
+    eps : sequence of float, default (1e-7, 3e-7, 1e-6, 3e-6, 1e-5)
+        Relative offsets above ``kappa_c`` (> 0).
+    integrator_rtol : float, default 1e-12
+        Tolerance of the runs, within :data:`~phaseimpact.integrate.RTOL_RANGE`.
+
+    Returns
+    -------
+    dict
+        ``eps``; ``slip_speed`` (m/s) and ``stick_offset`` (m) per ``eps`` (NaN where the run made
+        fewer than two stick phases); ``slip_speed_exponent`` and ``stick_offset_exponent`` (the
+        fitted slopes, None with fewer than two usable points) with their ``..._expected`` (1.5,
+        2.0); ``fit_range``.
+
+    Examples
+    --------
+    >>> from phaseimpact import seed_parameters
+    >>> from phaseimpact.continuation import adding_sliding_exponents, critical_damping
+    >>> p = seed_parameters(v=1.0)
+    >>> e = adding_sliding_exponents(p, "paper", critical_damping(p, "paper").kappa_c)
+    >>> print(f"{e['slip_speed_exponent']:.1f} {e['stick_offset_exponent']:.1f}")
+    1.5 2.0
+    """
     law = as_law(law)
     speeds, offsets = [], []
     for e in eps:
@@ -515,6 +830,38 @@ def delta_extremum(params: Parameters, law: ContactLaw | str, j: int, *, rtol: f
     ``alpha > 1``), so each extremum is a smooth function of ``kappa`` across zero: a maximum
     crossing zero from below is a new contact just touching, a minimum crossing zero from above a
     flight phase just vanishing. Its roots are the grazing values (docs/physics.md §5).
+
+    Parameters
+    ----------
+    params : Parameters
+        The case, with its ``kappa`` (N s/m^(1+alpha)).
+    law : ContactLaw or str
+        A unilateral law.
+    j : int
+        Which extremum, from 1 (the first is the first contact's deepest indentation).
+    rtol : float, default 1e-10
+        Integrator tolerance, within :data:`~phaseimpact.integrate.RTOL_RANGE`.
+
+    Returns
+    -------
+    float
+        ``delta`` (m) at the extremum; ``-inf`` when the run (50 of the case's slowest periods)
+        ends first.
+
+    Raises
+    ------
+    RunFailed
+        If the run fails numerically.
+    ValueError
+        For an argument :func:`~phaseimpact.simulate` refuses (``j`` < 1 among them).
+
+    Examples
+    --------
+    >>> from phaseimpact import seed_parameters
+    >>> from phaseimpact.continuation import delta_extremum
+    >>> p = seed_parameters(v=1.0, kappa=1e9)
+    >>> print(f"{delta_extremum(p, 'hunt-crossley', 1):.4g} {delta_extremum(p, 'hunt-crossley', 2):.4g}")
+    3.629e-05 -0.0001097
     """
     # no stop when out of reach: the extrema go on (below zero), so each stays defined across
     # the kappa where the projectile stops getting out of reach
@@ -542,7 +889,34 @@ def _extrema_horizon(params: Parameters) -> float:
 
 def extrema(params: Parameters, law: ContactLaw | str, *, rtol: float = 1e-10) -> np.ndarray:
     """``delta`` at every extremum of the trajectory until its outcome settles, and the next two
-    after the projectile is out of reach (so that a grazing return is seen from both sides), m."""
+    after the projectile is out of reach (so that a grazing return is seen from both sides), m.
+
+    Parameters
+    ----------
+    params : Parameters
+        The case, with its ``kappa`` (N s/m^(1+alpha)).
+    law : ContactLaw or str
+        A unilateral law.
+    rtol : float, default 1e-10
+        Integrator tolerance, within :data:`~phaseimpact.integrate.RTOL_RANGE`.
+
+    Returns
+    -------
+    ndarray of float
+        ``delta`` at each extremum in time order, m (positive: in contact).
+
+    Raises
+    ------
+    RunFailed
+        If a run fails numerically.
+
+    Examples
+    --------
+    >>> from phaseimpact import seed_parameters
+    >>> from phaseimpact.continuation.transition import extrema
+    >>> [f"{x:.3g}" for x in extrema(seed_parameters(v=1.0, kappa=1e9), "hunt-crossley")]
+    ['3.63e-05', '-0.00011', '3.12e-05']
+    """
     trajectory = _check_ok(simulate(params, law, None, rtol=rtol))
     y = trajectory.event_y[trajectory.event_kind == _REVERSAL]
     values = list(y[:, 0] - y[:, 1])
@@ -561,7 +935,29 @@ def contact_count(params: Parameters, law: ContactLaw | str, *, rtol: float = 1e
 
 @dataclass(frozen=True)
 class Transition:
-    """A change of the long-time count at ``kappa``: stick phases (``paper``) or contacts."""
+    """A change of the long-time count at ``kappa``: stick phases (``paper``) or contacts.
+
+    Attributes
+    ----------
+    kind : {"adding-sliding", "staircase-end", "grazing"}
+        ``adding-sliding`` at ``kappa_c`` and ``staircase-end`` at ``kappa_2`` (``paper``);
+        ``grazing`` for a unilateral law.
+    kappa : float
+        Where, N s/m^(1+alpha).
+    count_below, count_above : int or None
+        The count just below and just above (None: not confirmed, or unbounded above
+        ``kappa_c``).
+    extremum : int or None
+        Grazing: which extremum of ``delta`` touches zero.
+
+    Examples
+    --------
+    >>> from phaseimpact import seed_parameters
+    >>> from phaseimpact.continuation import transitions
+    >>> first = transitions(seed_parameters(), "hunt-crossley", 1e8, 1e13, num=80)[0]
+    >>> print(first.kind, f"{first.kappa:.4g}", first.count_below, first.count_above, first.extremum)
+    grazing 3.577e+10 2 3 5
+    """
 
     kind: str
     kappa: float
@@ -570,6 +966,19 @@ class Transition:
     extremum: int | None = None  # grazing: which extremum of delta touches zero
 
     def as_dict(self) -> dict:
+        """The fields as a plain dict (for JSON).
+
+        Returns
+        -------
+        dict
+            ``{"kind", "kappa", "count_below", "count_above", "extremum"}``.
+
+        Examples
+        --------
+        >>> from phaseimpact.continuation import Transition
+        >>> Transition("adding-sliding", 1.5e12, 1, None).as_dict()
+        {'kind': 'adding-sliding', 'kappa': 1500000000000.0, 'count_below': 1, 'count_above': None, 'extremum': None}
+        """
         return asdict(self)
 
 
@@ -585,6 +994,57 @@ def grazing_transitions(params: Parameters, law: ContactLaw | str, kappa_min: fl
     (relative): :func:`delta_extremum` is the smooth defining function. A :class:`SamplingWarning`
     says when the grid is coarser than what it can resolve; :class:`RunFailed` (naming the kappa)
     when a run fails or the defining function does not bracket a root the samples showed.
+
+    Parameters
+    ----------
+    params : Parameters
+        The case (its own ``kappa`` is not read).
+    law : ContactLaw or str
+        A unilateral law (``abrate`` does not read ``kappa``: every sample is the same; the
+        Hunt-Crossley family, or ``paper`` with ``contact="unilateral"``).
+    kappa_min, kappa_max : float
+        The search range, N s/m^(1+alpha), ``0 < kappa_min < kappa_max <= 1e18``.
+    num : int, default 96
+        Samples of the log grid of kappa: 8 to 10000, at least 4 per decade (16 per decade or
+        more give no warning).
+    rtol : float, default 1e-9
+        Relative tolerance of each grazing value, ``1e-14 <= rtol <= 1e-2``.
+    integrator_rtol : float, default 1e-10
+        Tolerance of every run, within :data:`~phaseimpact.integrate.RTOL_RANGE`.
+    progress : bool, default False
+        Draw a progress bar on stderr while sampling.
+
+    Returns
+    -------
+    list of Transition
+        In increasing ``kappa``, each with the contact counts just below and above and the
+        extremum that grazes.
+
+    Raises
+    ------
+    TypeError
+        If ``params`` is not :class:`~phaseimpact.Parameters`.
+    ValueError
+        For ``paper`` in its printed reading (no flight phase), or the range, ``num`` or ``rtol``
+        out of range.
+    RunFailed
+        When a run fails numerically, or a root the samples showed cannot be bracketed.
+
+    Warns
+    -----
+    SamplingWarning
+        When the grid is coarser than the transitions it can resolve.
+
+    Examples
+    --------
+    >>> from phaseimpact import seed_parameters
+    >>> from phaseimpact.continuation import grazing_transitions
+    >>> for t in grazing_transitions(seed_parameters(v=1.0), "hunt-crossley", 1e8, 1e13, num=80):
+    ...     print(f"{t.kappa:.4g}: {t.count_below} -> {t.count_above} contacts")
+    3.577e+10: 2 -> 3 contacts
+    4.478e+10: 3 -> 2 contacts
+    9.125e+10: 2 -> 1 contacts
+    5.955e+12: 1 -> 2 contacts
     """
     from scipy.optimize import minimize_scalar  # imported where used: 0.5 s at start-up
     from tqdm.auto import tqdm
@@ -697,12 +1157,46 @@ def transitions(params: Parameters, law: ContactLaw | str, kappa_min: float, kap
     unilateral laws: every grazing value (contacts before the projectile is out of reach), by
     :func:`grazing_transitions` with ``num`` samples (``progress``: a bar on stderr).
 
+    Parameters
+    ----------
+    params : Parameters
+        The case (its own ``kappa`` is not read).
+    law : ContactLaw or str
+        A law that reads ``kappa``.
+    kappa_min, kappa_max : float
+        The range, N s/m^(1+alpha), ``0 < kappa_min < kappa_max <= 1e18``.
+    rtol : float, default 1e-9
+        Relative tolerance of each located value, ``1e-14 <= rtol <= 1e-2``.
+    integrator_rtol : float, default 1e-10
+        Tolerance of every run, within :data:`~phaseimpact.integrate.RTOL_RANGE`.
+    num : int, default 96
+        Samples of a grazing search (unilateral laws; see :func:`grazing_transitions`).
+    progress : bool, default False
+        Draw a progress bar on stderr (grazing search).
+
+    Returns
+    -------
+    list of Transition
+        In increasing ``kappa``. ``paper``: ``adding-sliding`` (``count_above`` None) and, if
+        ``kappa_2 <= kappa_max``, ``staircase-end`` (``count_below`` None when not confirmed).
+
     Raises
     ------
+    TypeError
+        If ``params`` is not :class:`~phaseimpact.Parameters`.
     ValueError
         For a law that does not read ``kappa`` or any argument out of range.
     RunFailed
         When a run of the search fails numerically, naming the kappa.
+
+    Examples
+    --------
+    >>> from phaseimpact import seed_parameters
+    >>> from phaseimpact.continuation import transitions
+    >>> for t in transitions(seed_parameters(v=1.0), "paper", 1e9, 1e14):
+    ...     print(t.kind, f"{t.kappa:.6g}", t.count_below, t.count_above)
+    adding-sliding 1.49942e+12 1 None
+    staircase-end 1.4998e+12 4 2
     """
     check_params(params)
     law = as_law(law)

@@ -26,6 +26,8 @@ from .result import Columns, Trajectory
 
 __all__ = ["simulate", "simulate_many", "Scales", "scales", "INTEGRATORS", "RTOL_RANGE"]
 
+#: The integrators :func:`simulate` accepts: ``exact`` (event-driven DOP853, Radau IIA for stiff
+#: phases) and ``rk4`` (the seed's fixed-step RK4 on eq. 8 read literally).
 INTEGRATORS = ("exact", "rk4")
 #: Allowed integrator tolerances: tighter than 1e-13 is below rounding; looser than 1e-3 can
 #: change an outcome class (a stick missed), which no allowed setting may do.
@@ -86,6 +88,8 @@ def check_rtol(rtol) -> float:
 class Scales:
     """A case's own scales (DESIGN principle 5; docs/physics.md §4).
 
+    Made by :func:`scales`; horizons, tolerances and step caps of every run derive from them.
+
     Attributes
     ----------
     indentation : float
@@ -99,6 +103,15 @@ class Scales:
     max_step : float
         Largest step the driver takes: an eighth of the target's small-amplitude period
         (:attr:`plate_period`), inf without springs, s.
+
+    Examples
+    --------
+    >>> from phaseimpact import scales, seed_parameters
+    >>> s = scales(seed_parameters(v=1.0))
+    >>> print(f"{s.indentation:.4g} m, {s.contact_time:.4g} s, {s.plate_period:.4g} s")
+    3.669e-05 m, 0.000108 s, 0.001004 s
+    >>> s.horizon == 1e4 * s.plate_period
+    True
     """
 
     indentation: float
@@ -115,7 +128,35 @@ def hertz_contact_time(alpha: float, indentation, v):
 
 
 def scales(params: Parameters) -> Scales:
-    """The time and length scales of ``params``."""
+    """The time and length scales of ``params`` (docs/physics.md §4).
+
+    The Hertz indentation and contact time of the undamped impact of the reduced mass, the
+    target's small-amplitude period, the default horizon (:data:`HORIZON_CAP_PERIODS` of the
+    slowest of these periods) and the driver's largest step. Cached per case.
+
+    Parameters
+    ----------
+    params : Parameters
+        The case (e.g. :func:`~phaseimpact.seed_parameters`).
+
+    Returns
+    -------
+    Scales
+        Lengths in m, times in s; ``plate_period`` and ``max_step`` are inf without springs.
+
+    Raises
+    ------
+    TypeError
+        If ``params`` is not :class:`~phaseimpact.Parameters`.
+
+    Examples
+    --------
+    >>> from phaseimpact import scales, seed_parameters
+    >>> print(f"{scales(seed_parameters(v=1.0)).contact_time:.4g} s")
+    0.000108 s
+    >>> scales(seed_parameters(target="rigid")).plate_period
+    inf
+    """
     if type(params) is not Parameters:  # the common case without the check's formatting
         check_params(params)
     return _scales(params)
@@ -230,34 +271,87 @@ def simulate(params: Parameters, law: ContactLaw | str = "paper", t_end: float |
              initial=None, stop_on=None, max_steps: int = MAX_STEPS, stiff: bool = True) -> Trajectory:
     """Integrate one impact from seed eq. 6 (``x1dot = v`` at ``x1 = x2 = 0``) or ``initial``.
 
+    Every argument is checked before any work. The run goes on the one compiled driver:
+    contact, separation, stick and slip are located on the step's dense output and the
+    integration restarts at the root; the outcome class is read from the run (docs/physics.md §5).
+
     Parameters
     ----------
     params : Parameters
-    law : ContactLaw or str
-        A law of :data:`phaseimpact.model.LAWS` with its options.
+        The case: masses, stiffnesses, ``kappa`` (N s/m^(1+alpha), N s/m^2.5 for alpha = 3/2) and
+        the impact speed ``v`` (m/s).
+    law : ContactLaw or str, default "paper"
+        A law of :data:`phaseimpact.model.LAWS` with its options, or its name.
     t_end : float, optional
-        Horizon, s. Default: run until the outcome settles (permanent stick, escape, projectile
-        out of reach), capped at :attr:`Scales.horizon`; :attr:`Trajectory.cut` says when the
-        cap ended it.
-    integrator : {"exact", "rk4"}
+        Horizon, s: a finite number of at least ``1e-13`` contact times. Default: run until the
+        outcome settles (permanent stick, escape, projectile out of reach), capped at
+        :attr:`Scales.horizon`; :attr:`Trajectory.cut` says when the cap ended it.
+    integrator : {"exact", "rk4"}, default "exact"
         ``exact``: event-driven DOP853, stick and slip resolved exactly. ``rk4``: the seed's
         classic fixed-step RK4 on eq. 8 read literally (``step`` s, default a thousandth of the
         contact time), keeping every ``every``-th step.
-    save : "summary", "steps" or array of times
-        What to keep: a sweep point needs only the summary; a figure the steps or a time grid.
+    save : "summary", "steps" or array of times, default "summary"
+        What to keep: a sweep point needs only the summary; a figure the steps or a time grid
+        (s, finite, strictly increasing, within ``[0, t_end]``).
     stop_when_settled : bool, optional
         Stop once nothing can change any more; default True when ``t_end`` is None or for a
         summary.
-    rtol, atol : float
-        Tolerances; ``atol`` defaults to ``rtol`` times the state scales.
+    rtol : float, default 1e-10
+        Relative tolerance, within :data:`RTOL_RANGE` (1e-13 to 1e-3).
+    atol : float, optional
+        Absolute tolerance (> 0) of every state component; default ``rtol`` times the state
+        scales (Hertz indentation, impact speed, impact energy, contact time).
+    step : float, optional
+        ``rk4`` only: the fixed step, s (> 0).
+    every : int, default 1
+        ``rk4`` only: keep every ``every``-th step (>= 1).
     initial : 4 numbers, optional
-        ``(x1, x2, x1dot, x2dot)`` to start from instead of eq. 6.
+        ``(x1, x2, x1dot, x2dot)`` (m, m, m/s, m/s) to start from instead of eq. 6.
     stop_on : str or (str, int), optional
-        Stop at the n-th event of a kind (``"stick"``, ``("stick", 2)``).
-    stiff : bool
+        Stop at the n-th event of a kind of :data:`~phaseimpact.integrate.EVENT_KINDS`
+        (``"stick"``, ``("stick", 2)``).
+    max_steps : int, default 50_000_000
+        Step limit (>= 1); a run that reaches it ends with status ``too-many-steps``.
+    stiff : bool, default True
         ``exact`` only: a phase whose DOP853 steps stay at their stability limit (a creep held by
         a strong damper) goes on with Radau IIA (order 5, :mod:`.radau5`); False keeps DOP853
         throughout (for comparisons).
+
+    Returns
+    -------
+    Trajectory
+        Samples (per ``save``), the event log, the summary, ``status`` (numerical health),
+        ``stop_reason`` and ``outcome``. A numerical failure is reported in ``status``, not raised.
+
+    Raises
+    ------
+    TypeError
+        If ``params`` is not :class:`~phaseimpact.Parameters`.
+    ValueError
+        For an unknown law or integrator, or any of ``t_end``, ``save``, ``rtol``, ``atol``,
+        ``step``, ``every``, ``initial``, ``stop_on``, ``stop_when_settled``, ``max_steps`` or
+        ``stiff`` out of range (``rk4``: also a ``step`` that needs more than ``max_steps`` steps,
+        or a law that keeps a memory of the contact); the message names the argument, its value
+        and the allowed range.
+    KeyboardInterrupt
+        Ctrl-C or SIGTERM during the run (the compiled driver stops within a second).
+
+    Examples
+    --------
+    >>> from phaseimpact import seed_parameters, simulate
+    >>> tr = simulate(seed_parameters(v=1.0, kappa=3e9), "paper")
+    >>> tr.status, tr.outcome, tr.n_stick
+    ('success', 'permanent-stick', 1)
+    >>> print(f"{tr.max_force:.4g} N")
+    4629 N
+
+    A fixed horizon with the steps kept (for a figure), and the seed's RK4:
+
+    >>> tr = simulate(seed_parameters(v=1.0, kappa=3e9), "paper", 2e-3, save="steps")
+    >>> tr.y.shape[1], tr.stop_reason, tr.cut
+    (5, 'horizon', True)
+    >>> simulate(seed_parameters(), "abrate", 2e-4, integrator="rk4").integrator
+    'rk4[step=1.08e-07]'
     """
     law = as_law(law)
     check_params(params)
@@ -276,6 +370,9 @@ def simulate(params: Parameters, law: ContactLaw | str = "paper", t_end: float |
     y0 = seed_state.copy() if initial is None else _initial(params, initial)
     rk4_step = 0.0
     if integrator == "rk4":
+        if law.entry.memory:  # its memory is updated at located events, which the fixed-step run has not
+            raise ValueError(f"integrator = 'rk4' is out of range for law {law.name!r} (it keeps a memory of the "
+                             "contact); allowed: 'exact'")
         rk4_step = s.contact_time / 1000 if step is None else check_real("step", step, "a number > 0", lambda x: x > 0)
         if not (isinstance(every, numbers.Integral) and every >= 1):
             raise ValueError(f"every = {every!r} is out of range; allowed: an integer >= 1")
@@ -417,6 +514,52 @@ def simulate_many(params_seq, law: ContactLaw | str = "paper", t_end: float | No
 
     Same driver and arguments as :func:`simulate`; runs go in ``n_threads`` threads inside this
     process and the result is bit-identical for any thread count.
+
+    Parameters
+    ----------
+    params_seq : sequence of Parameters
+        One case per run (non-empty), all integrated with ``law``.
+    law : ContactLaw or str, default "paper"
+        A law of :data:`phaseimpact.model.LAWS` with its options, or its name.
+    t_end : float, optional
+        Horizon of every run, s (> 0, and at least ``1e-13`` contact times of each case); default:
+        each run until its outcome settles, capped at its :attr:`Scales.horizon`.
+    rtol : float, default 1e-10
+        Relative tolerance, within :data:`RTOL_RANGE`; absolute tolerances from each case's scales.
+    stop_when_settled : bool, default True
+        Stop each run once nothing can change any more.
+    stop_on : str or (str, int), optional
+        Stop each run at the n-th event of a kind, as for :func:`simulate`.
+    initial : 4 numbers, optional
+        ``(x1, x2, x1dot, x2dot)`` (m, m, m/s, m/s) of every run instead of seed eq. 6.
+    n_threads : int, default 1
+        Threads of this process (>= 1); the compiled driver releases the GIL.
+    stiff : bool, default True
+        Radau IIA for stiff phases, as for :func:`simulate`.
+
+    Returns
+    -------
+    Columns
+        One entry per run, in the order of ``params_seq``: codes of status, outcome and stop
+        reason, the summary columns and the stick phases (a ragged array).
+
+    Raises
+    ------
+    TypeError
+        If ``params_seq`` is not a sequence of :class:`~phaseimpact.Parameters`.
+    ValueError
+        For an empty ``params_seq``, an unknown law, or any argument out of range (named in the
+        message).
+
+    Examples
+    --------
+    >>> from phaseimpact import seed_parameters, simulate_many
+    >>> base = seed_parameters(v=1.0)
+    >>> c = simulate_many([base.replace(kappa=k) for k in (1e9, 1e12, 1e13)], "paper")
+    >>> len(c), list(c.outcome_names())
+    (3, ['permanent-stick', 'permanent-stick', 'ratchet-escape'])
+    >>> c.n_stick.tolist()
+    [1, 1, 2]
     """
     law = as_law(law)
     rtol = check_rtol(rtol)

@@ -888,7 +888,7 @@ def _run_rk4(code, c, y0, t_end, save_kind, times, max_steps, rk4_step, rk4_ever
     return summary, ev[:n_ev], smp[:n_s], y
 
 
-@allocating(python=True)
+@allocating(python=True, nogil=True)  # runs side by side in threads (phaseimpact.train's orbit diagrams)
 def run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count, save_kind, times,
         max_steps, max_events, rk4_step, rk4_every, stiff_after):
     """Integrate one trajectory. See :func:`phaseimpact.integrate.simulate` for the meaning.
@@ -902,6 +902,7 @@ def run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count,
     """
     if rk4_step > 0:
         return _run_rk4(code, c, y0, t_end, save_kind, times, max_steps, rk4_step, rk4_every)
+    c = c.copy()  # the run's own: a law's memory is written into it (model.laws.remember)
     y = y0.copy()
     t = 0.0
     mode = initial_mode(code, c, y)

@@ -31,9 +31,11 @@ from ..model.laws import (
     GUARD_ENERGY_FACTOR,  # noqa: F401 (re-exported)
     RUNAWAY_ENERGY_FACTOR,  # noqa: F401 (re-exported)
     STUCK,
-    force_partials,
+    has_memory,
     is_filippov,
     is_unilateral,
+    partials_of,
+    remember,
     stick_bound,
 )
 from ..model.rhs import (
@@ -97,7 +99,7 @@ def event_value(code, c, y, f, force, mode, energy_limit, column):
         if force == 0.0 and is_unilateral(code):
             return -1.0
         deltadot = y[V1] - y[V2]
-        p_delta, p_rate = force_partials(code, y[X1] - y[X2], deltadot, mode, c[K_], c[DAMP_], c[ALPHA_])
+        p_delta, p_rate = partials_of(code, c, y[X1] - y[X2], deltadot, mode)
         return p_delta * deltadot + p_rate * (f[V1] - f[V2])
     # REACH
     if not stuck and is_unilateral(code) and c[SPRINGS_] > 0 and y[X1] - y[X2] < 0 and y[V1] < 0:
@@ -151,8 +153,8 @@ def restarts(code, column, mode, settle):
     """Whether an event of ``column`` changes the phase (restart) rather than being recorded."""
     if column == FORCE_RATE:
         return False
-    if column == DELTADOT:
-        return is_filippov(code) and mode != 2
+    if column == DELTADOT:  # a law with memory goes on from an extremum on its updated branch
+        return (is_filippov(code) and mode != 2) or has_memory(code)
     if column == REACH:
         return settle
     return True
@@ -191,12 +193,17 @@ def transition(code, c, column, y, mode, settle):
         y[X1] = y[X2]  # the event is delta = 0: remove the root finder's residue
         deltadot = y[V1] - y[V2]
         kind = CONTACT if deltadot > 0 else SEPARATION
-        if is_filippov(code) and mode != STUCK and deltadot != 0:
+        if (is_filippov(code) or has_memory(code)) and mode != STUCK and deltadot != 0:
             mode = 1 if deltadot > 0 else -1
         if kind == SEPARATION and is_unilateral(code) and c[SPRINGS_] == 0 and settle:
             action = STOP_SETTLED  # a wall or a free target never meets the projectile again
         return kind, mode, action
     if column == DELTADOT:
+        if has_memory(code):
+            # the mode is the sign of deltadot: the run goes on the other way, on the branch the
+            # extremum leaves (a new largest indentation updates the memory)
+            remember(code, c, y[X1] - y[X2])
+            return REVERSAL, -mode, action
         if not is_filippov(code) or mode == 2:
             return REVERSAL, mode, action
         if is_unilateral(code) and y[X1] - y[X2] <= 0:

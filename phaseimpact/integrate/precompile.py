@@ -217,7 +217,7 @@ def warmup() -> dict:
     info = cache_info()
     start = time.perf_counter()
     before = driver.run.stats.cache_misses.copy(), driver.run_block.stats.cache_misses.copy()
-    p = seed_parameters(v=1.0, kappa=3e9)
+    p = seed_parameters(v=1.0, kappa=3e9, limiting_pressure=2e9)  # p_y: read by the plastic law only
     stiff = p.replace(kappa=1e14, v=5.0)  # the stiff (Radau) path
     for law in law_variants():
         simulate(p, law, 2e-3)

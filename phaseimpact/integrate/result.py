@@ -16,13 +16,20 @@ from .events import EVENT_KINDS
 
 __all__ = ["Event", "Trajectory", "Columns", "STATUSES", "OUTCOMES", "EVENT_KINDS", "run_message"]
 
+#: Numerical health of a run: ``success`` or how it failed (``step-size-collapse``, ``too-many-steps``,
+#: ``non-finite``, ``interrupted``).
 STATUSES = d.STATUSES
+#: Outcome classes of a run (docs/physics.md §5): ``failed``, ``permanent-stick``, ``ratchet-escape``,
+#: ``rebound``, ``runaway``, ``bounded``, ``unsettled``.
 OUTCOMES = d.OUTCOMES
 
 
 @dataclass(frozen=True)
 class Event:
     """Something that happened along a trajectory.
+
+    The driver locates each event on the step's dense output; :attr:`Trajectory.events` gives
+    them in time order.
 
     Attributes
     ----------
@@ -38,6 +45,16 @@ class Event:
         Contact force at ``t``, N.
     mode : int
         Mode after the event (``paper``: +-1 slipping, 0 stuck).
+
+    Examples
+    --------
+    >>> from phaseimpact import seed_parameters, simulate
+    >>> tr = simulate(seed_parameters(v=1.0, kappa=3e9), "paper")
+    >>> [e.kind for e in tr.events]
+    ['contact', 'force-peak', 'stick']
+    >>> stick = tr.events[-1]
+    >>> print(f"t = {stick.t:.4g} s, delta = {stick.delta:.4g} m, mode {stick.mode}")
+    t = 5.299e-05 s, delta = 3.547e-05 m, mode 0
     """
 
     kind: str
@@ -48,10 +65,12 @@ class Event:
 
     @property
     def delta(self) -> float:
+        """Indentation ``x1 - x2`` at the event, m."""
         return float(self.state[X1] - self.state[X2])
 
     @property
     def deltadot(self) -> float:
+        """Relative velocity ``x1dot - x2dot`` at the event, m/s."""
         return float(self.state[V1] - self.state[V2])
 
 
@@ -60,7 +79,34 @@ def _optional(x) -> float | None:
 
 
 def run_message(status: str, reason: str, t_stop: float, outcome: str) -> str:
-    """A sentence on how a run ended."""
+    """A sentence on how a run ended (:attr:`Trajectory.message`).
+
+    A numerical failure is named first; else why the run stopped.
+
+    Parameters
+    ----------
+    status : str
+        One of :data:`STATUSES`.
+    reason : str
+        The stop reason: ``horizon``, ``settled``, ``runaway``, ``asked`` or ``failed``.
+    t_stop : float
+        Where the run stopped, s.
+    outcome : str
+        One of :data:`OUTCOMES`.
+
+    Returns
+    -------
+    str
+        One sentence, without a final full stop.
+
+    Examples
+    --------
+    >>> from phaseimpact.integrate.result import run_message
+    >>> run_message("success", "settled", 5.3e-5, "permanent-stick")
+    'outcome settled at t = 5.3e-05 s (permanent-stick)'
+    >>> run_message("success", "horizon", 2e-3, "bounded")
+    'the horizon t_end = 0.002 s ended the run before the outcome settled'
+    """
     if status == "step-size-collapse":
         return f"the step size collapsed at t = {t_stop:.6g} s (stiffness or a discontinuity the events miss)"
     if status == "too-many-steps":
@@ -80,7 +126,11 @@ def run_message(status: str, reason: str, t_stop: float, outcome: str) -> str:
 
 @dataclass(eq=False)  # not frozen: a frozen dataclass's __init__ costs a microsecond per run
 class Trajectory:
-    """One trajectory of the impact model.
+    """One trajectory of the impact model, as :func:`~phaseimpact.simulate` returns it.
+
+    The samples (if kept), the event log and the summary vector of one run; the summary
+    quantities are read through properties (``max_force``, ``n_stick``, ``t_run``...), undefined
+    ones as None.
 
     Attributes
     ----------
@@ -105,9 +155,20 @@ class Trajectory:
     outcome : str
         One of :data:`OUTCOMES` (docs/physics.md §5).
     message : str
+        A sentence on how the run ended (:func:`run_message`).
     summary : ndarray
         The summary vector (see :mod:`.driver`, ``S_*``); read it through the properties.
     integrator : str
+        The integrator and its settings, e.g. ``exact[DOP853+Radau5, rtol=1e-10]``.
+
+    Examples
+    --------
+    >>> from phaseimpact import seed_parameters, simulate
+    >>> tr = simulate(seed_parameters(v=1.0, kappa=2e12), "paper")
+    >>> tr.ok, tr.outcome, tr.n_stick, tr.n_contacts
+    (True, 'ratchet-escape', 2, 1)
+    >>> print(f"escape at t_run = {tr.t_run:.3g} s")
+    escape at t_run = 0.000965 s
     """
 
     samples: np.ndarray = field(repr=False)
@@ -125,38 +186,47 @@ class Trajectory:
 
     @property
     def t(self) -> np.ndarray:
+        """Sample times, s (empty for a summary run)."""
         return self.samples[:, d.SMP_T]
 
     @property
     def y(self) -> np.ndarray:
+        """Sampled states ``(x1, x2, x1dot, x2dot, W)``, shape ``(n, 5)``: m, m, m/s, m/s, J."""
         return self.samples[:, d.SMP_Y:d.SMP_Y + 5]
 
     @property
     def force(self) -> np.ndarray:
+        """Contact force at the samples, N."""
         return self.samples[:, d.SMP_FORCE]
 
     @cached_property
     def mode(self) -> np.ndarray:
+        """Mode at the samples (``paper``: +-1 slipping, 0 stuck)."""
         return self.samples[:, d.SMP_MODE].astype(np.int64)
 
     @property
     def event_t(self) -> np.ndarray:
+        """Event times, s."""
         return self.event_log[:, d.EV_T]
 
     @cached_property
     def event_kind(self) -> np.ndarray:
+        """Event kinds as indices into :data:`EVENT_KINDS`."""
         return self.event_log[:, d.EV_KIND].astype(np.int64)
 
     @cached_property
     def event_mode(self) -> np.ndarray:
+        """Mode after each event."""
         return self.event_log[:, d.EV_MODE].astype(np.int64)
 
     @property
     def event_y(self) -> np.ndarray:
+        """States ``(x1, x2, x1dot, x2dot, W)`` at the events, shape ``(n_events, 5)``."""
         return self.event_log[:, d.EV_Y:d.EV_Y + 5]
 
     @property
     def event_force(self) -> np.ndarray:
+        """Contact force at the events, N."""
         return self.event_log[:, d.EV_FORCE]
 
     @property
@@ -166,14 +236,17 @@ class Trajectory:
 
     @property
     def ok(self) -> bool:
+        """The run ended without a numerical failure (status ``success``)."""
         return self.status == "success"
 
     @property
     def t_stop(self) -> float:
+        """Where the run stopped, s."""
         return float(self.summary[d.S_T_STOP])
 
     @property
     def final_mode(self) -> int:
+        """Mode at the end of the run (``paper``: +-1 slipping, 0 stuck)."""
         return int(self.summary[d.S_MODE])
 
     @property
@@ -188,10 +261,12 @@ class Trajectory:
 
     @property
     def max_force(self) -> float:
+        """Largest contact force of the run, N."""
         return float(self.summary[d.S_MAX_FORCE])
 
     @property
     def max_indentation(self) -> float:
+        """Largest indentation ``delta = x1 - x2`` of the run, m."""
         return float(self.summary[d.S_MAX_INDENTATION])
 
     @property
@@ -221,6 +296,7 @@ class Trajectory:
 
     @property
     def n_contacts(self) -> int:
+        """Number of contacts (a lower bound if :attr:`cut`)."""
         return int(self.summary[d.S_N_CONTACTS])
 
     @property
@@ -235,18 +311,22 @@ class Trajectory:
 
     @property
     def nfev(self) -> int:
+        """Right-hand side evaluations."""
         return int(self.summary[d.S_NFEV])
 
     @property
     def nsteps(self) -> int:
+        """Integrator steps."""
         return int(self.summary[d.S_NSTEPS])
 
     @property
     def x1(self):
+        """Projectile displacement at the samples, m."""
         return self.y[:, X1]
 
     @property
     def x2(self):
+        """Target displacement at the samples, m."""
         return self.y[:, X2]
 
     @property
@@ -267,11 +347,51 @@ class Trajectory:
                          strict=True))
 
     def events_of(self, *kinds) -> list[Event]:
+        """The events of the given kinds, in time order.
+
+        Parameters
+        ----------
+        *kinds : str
+            Kinds of :data:`EVENT_KINDS` (``"contact"``, ``"stick"``...).
+
+        Returns
+        -------
+        list of Event
+
+        Raises
+        ------
+        ValueError
+            For a kind not in :data:`EVENT_KINDS`.
+
+        Examples
+        --------
+        >>> from phaseimpact import seed_parameters, simulate
+        >>> tr = simulate(seed_parameters(v=1.0, kappa=1e9), "abrate")
+        >>> len(tr.events_of("contact")), len(tr.events_of("contact", "separation"))
+        (2, 4)
+        """
         codes = [EVENT_KINDS.index(k) for k in kinds]
         return [e for e, k in zip(self.events, self.event_kind, strict=True) if k in codes]
 
     def stick_points(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Stick phases: times (s), ``delta*`` (m) and dwell (s; inf for a permanent stick)."""
+        """Stick phases: times (s), ``delta*`` (m) and dwell (s; inf for a permanent stick).
+
+        Read from the event log, so a summary run has them too; the last phase of a run the
+        horizon cut dwells until :attr:`t_stop`.
+
+        Returns
+        -------
+        t, delta, dwell : ndarray, shape (n_stick,)
+            When each stick phase began (s), the indentation it holds (m) and how long it lasted
+            (s; inf for a permanent stick).
+
+        Examples
+        --------
+        >>> from phaseimpact import seed_parameters, simulate
+        >>> t, delta, dwell = simulate(seed_parameters(v=1.0, kappa=3e9), "paper").stick_points()
+        >>> print(f"{t[0]:.4g} s, {delta[0]:.4g} m, {dwell[0]}")
+        5.299e-05 s, 3.547e-05 m, inf
+        """
         n = int(np.count_nonzero(self.event_kind == EVENT_KINDS.index("stick")))
         out = np.empty((3, n))
         d.stick_points(self.event_log, self.t_stop, self.outcome == "permanent-stick", out[0], out[1], out[2])
@@ -311,15 +431,31 @@ class ColumnAccess:
 class Columns(ColumnAccess):
     """Many runs as a struct of arrays (one entry per run); NaN where a quantity is undefined.
 
+    Made by :func:`~phaseimpact.simulate_many`; the summary columns are read as attributes
+    (``columns.max_force``) from :attr:`values`.
+
     Attributes
     ----------
     status, outcome, stop_reason : ndarray of int8
         Codes into :data:`STATUSES`, :data:`OUTCOMES`, ``STOP_REASONS``.
+    values : dict of ndarray
+        The summary columns by name.
     t_stop, max_force, ... : ndarray
         See :data:`SUMMARY_COLUMNS` for names and units.
     stick_count : ndarray of int64
         Stick phases per run; their times, depths and dwells are the ragged arrays
         ``stick_t``, ``stick_delta``, ``stick_dwell`` in run order (CF contiguous ragged array).
+    cut, failed : ndarray of bool
+        Runs ended by the horizon before their outcome settled; runs with a numerical failure.
+
+    Examples
+    --------
+    >>> from phaseimpact import seed_parameters, simulate_many
+    >>> c = simulate_many([seed_parameters(kappa=k) for k in (1e9, 1e13)], "paper")
+    >>> len(c), c.stick_count.tolist(), int(c.failed.sum())
+    (2, [1, 2], 0)
+    >>> print(f"{c.max_force[0]:.4g} N")
+    4760 N
     """
 
     status: np.ndarray
@@ -341,22 +477,92 @@ class Columns(ColumnAccess):
 
     @property
     def failed(self) -> np.ndarray:
+        """Runs whose status is not ``success``."""
         return self.status != d.SUCCESS
 
     def status_names(self) -> np.ndarray:
+        """Each run's status as its name in :data:`STATUSES`.
+
+        Returns
+        -------
+        ndarray of str (object), shape (n,)
+
+        Examples
+        --------
+        >>> from phaseimpact import seed_parameters, simulate_many
+        >>> simulate_many([seed_parameters(kappa=1e9)], "paper").status_names().tolist()
+        ['success']
+        """
         return np.array(STATUSES, dtype=object)[self.status]
 
     def outcome_names(self) -> np.ndarray:
+        """Each run's outcome as its name in :data:`OUTCOMES`.
+
+        Returns
+        -------
+        ndarray of str (object), shape (n,)
+
+        Examples
+        --------
+        >>> from phaseimpact import seed_parameters, simulate_many
+        >>> simulate_many([seed_parameters(kappa=k) for k in (1e9, 1e13)], "paper").outcome_names().tolist()
+        ['permanent-stick', 'ratchet-escape']
+        """
         return np.array(OUTCOMES, dtype=object)[self.outcome]
 
     def sticks_of(self, i: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Stick times, depths and dwells of run ``i``."""
+        """Stick times, depths and dwells of run ``i``.
+
+        Parameters
+        ----------
+        i : int
+            Index of the run, ``0 <= i < len(self)``.
+
+        Returns
+        -------
+        t, delta, dwell : ndarray
+            When each stick phase of the run began (s), its indentation (m) and its dwell (s; inf
+            for a permanent stick), in time order.
+
+        Examples
+        --------
+        >>> from phaseimpact import seed_parameters, simulate_many
+        >>> c = simulate_many([seed_parameters(kappa=k) for k in (1e9, 1e13)], "paper")
+        >>> t, delta, dwell = c.sticks_of(1)
+        >>> len(t), bool(dwell[-1] == float("inf"))
+        (2, False)
+        """
         start = int(self.stick_count[:i].sum())
         stop = start + int(self.stick_count[i])
         return self.stick_t[start:stop], self.stick_delta[start:stop], self.stick_dwell[start:stop]
 
     @classmethod
     def from_summary(cls, summary: np.ndarray, stick_count, stick_t, stick_delta, stick_dwell) -> Columns:
+        """Columns from the driver's summary vectors and the stick phases of each run.
+
+        Parameters
+        ----------
+        summary : ndarray, shape (n, N_SUMMARY)
+            One summary vector per run (:mod:`.driver`, ``S_*``).
+        stick_count : array of int, shape (n,)
+            Stick phases per run.
+        stick_t, stick_delta, stick_dwell : ndarray, shape (stick_count.sum(),)
+            Their times (s), depths (m) and dwells (s), in run order.
+
+        Returns
+        -------
+        Columns
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> from phaseimpact import Columns, seed_parameters, simulate
+        >>> tr = simulate(seed_parameters(kappa=3e9), "paper")
+        >>> t, delta, dwell = tr.stick_points()
+        >>> c = Columns.from_summary(tr.summary[None, :], [len(t)], t, delta, dwell)
+        >>> c.outcome_names().tolist(), c.n_stick.tolist()
+        (['permanent-stick'], [1])
+        """
         values = {name: summary[:, index].astype(dtype) for name, index, dtype, _ in SUMMARY_COLUMNS}
         return cls(summary[:, d.S_STATUS].astype(np.int8), summary[:, d.S_OUTCOME].astype(np.int8),
                    summary[:, d.S_REASON].astype(np.int8), values, np.asarray(stick_count, dtype=np.int64),

@@ -71,7 +71,7 @@ from ..parameters import Parameters, is_number, require, require_choice
 __all__ = [
     "LawEntry", "REGISTRY", "LAWS", "CONTACT_READINGS", "ContactLaw", "as_law", "law_variants", "register",
     "contact_force", "force_partials", "contact_potential", "stick_bound", "hertz_power", "is_filippov",
-    "is_unilateral",
+    "is_unilateral", "has_memory", "remember", "force_of", "partials_of", "potential_of",
     "STUCK", "PLAIN", "RUNAWAY_ENERGY_FACTOR", "GUARD_ENERGY_FACTOR",
 ]
 
@@ -80,7 +80,7 @@ __all__ = [
 # law, the bits above FORM the address of its compiled function (phaseimpact.model.userlaw).
 FILIPPOV, UNILATERAL, CLAMP = 1, 2, 4
 FORM_SHIFT, FORM_MASK, ADDRESS_SHIFT = 3, 7, 6
-ELASTIC, HUNT_CROSSLEY, PAPER, KUWABARA_KONO, NATIVE = 0, 1, 2, 3, 7
+ELASTIC, HUNT_CROSSLEY, PAPER, KUWABARA_KONO, THORNTON, NATIVE = 0, 1, 2, 3, 4, 7
 # What a user law's compiled function returns (its first argument).
 FORCE, D_DELTA, D_RATE, POTENTIAL = 0, 1, 2, 3
 STUCK, PLAIN = 0, 2
@@ -95,6 +95,16 @@ OPTIONS = ("bilateral", "clamp", "contact")
 #: through numerical trouble, so it gets a wide guard instead: the run reaches its rebound.
 RUNAWAY_ENERGY_FACTOR = 2.0
 GUARD_ENERGY_FACTOR = 100.0
+
+
+# The packed coefficients of one run (:func:`phaseimpact.model.rhs.pack`): the model's parameters,
+# the law's own coefficients (LAW_, N_LAW of them) and its memory (MEMORY_, N_MEMORY slots: what a
+# law keeps over a run, e.g. Thornton's largest indentation; 0 at the start, updated only by
+# :func:`remember`, in the run's own copy).
+M1_, M2_, K_, KB_, KM_, DAMP_, ALPHA_, SPRINGS_, RIGID_, GUARD_ = range(10)
+LAW_, N_LAW = 10, 2
+MEMORY_, N_MEMORY = LAW_ + N_LAW, 3
+N_COEF = MEMORY_ + N_MEMORY
 
 
 def make_code(form: int, flags: int, address: int = 0) -> int:
@@ -252,6 +262,96 @@ def contact_potential(code, delta, K, alpha):
     return K * ad * hertz_power(ad, alpha) / (alpha + 1.0)
 
 
+@kernel(python=True, inline="always")
+def has_memory(code):
+    """Whether the law keeps state over a run (:attr:`LawEntry.memory`; Thornton's form)."""
+    return (code >> FORM_SHIFT) & FORM_MASK == THORNTON
+
+
+@kernel
+def _thornton_yield(c):
+    """``(E*, delta_y, F_y)``: the contact modulus ``3 K / (4 sqrt(R))`` and the indentation and force
+    where the Hertz peak pressure reaches the limiting pressure ``p_y`` (Thornton 1997, eq. 4-6)."""
+    K, p_y, R = c[K_], c[LAW_], c[LAW_ + 1]
+    e_star = 0.75 * K / math.sqrt(R)
+    delta_y = R * (0.5 * math.pi * p_y / e_star) ** 2
+    return e_star, delta_y, K * delta_y * math.sqrt(delta_y)
+
+
+@kernel
+def _thornton(c, delta):
+    """Thornton's force and its stiffness dP/ddelta at ``delta > 0``: on the unloading curve
+    below the largest indentation so far (memory), else Hertz loading up to ``delta_y`` and a
+    linear rise at the limiting pressure beyond (``dP = pi p_y R ddelta``)."""
+    if delta < c[MEMORY_]:
+        depth = delta - c[MEMORY_ + 2]
+        if depth <= 0:
+            return 0.0, 0.0
+        root = math.sqrt(depth)
+        return c[MEMORY_ + 1] * depth * root, 1.5 * c[MEMORY_ + 1] * root
+    _, delta_y, f_y = _thornton_yield(c)
+    if delta <= delta_y:
+        root = math.sqrt(delta)
+        return c[K_] * delta * root, 1.5 * c[K_] * root
+    slope = math.pi * c[LAW_] * c[LAW_ + 1]
+    return f_y + slope * (delta - delta_y), slope
+
+
+@kernel(python=True)
+def remember(code, c, delta):
+    """A law's memory update at an extremum ``delta`` of the indentation (event ``REVERSAL``), in
+    the run's own coefficients ``c``; True if the memory changed (the run then restarts there, on
+    the law's new branch).
+
+    Thornton: a new largest indentation ``delta_max`` fixes the unloading curve, Hertz with the
+    radius ``R_p`` enlarged by the plastic flow, ``P = K_p (delta - delta_p)^(3/2)`` with
+    ``K_p = 4/3 E* sqrt(R_p)``, through ``(delta_max, P_max)``: ``R_p = 4 E* a_p^3 / (3 P_max)``,
+    ``a_p^2 = (2 P_max + F_y) / (2 pi p_y)`` (Thornton 1997, eq. 11-13); ``delta_p`` is the
+    residual indentation. Below ``delta_y`` it is Hertz itself (``K_p = K``, ``delta_p = 0``).
+    """
+    if not has_memory(code) or delta <= c[MEMORY_]:
+        return False
+    e_star, delta_y, f_y = _thornton_yield(c)
+    c[MEMORY_] = delta
+    if delta <= delta_y:
+        c[MEMORY_ + 1] = c[K_]
+        c[MEMORY_ + 2] = 0.0
+        return True
+    p_y = c[LAW_]
+    f_max = f_y + math.pi * p_y * c[LAW_ + 1] * (delta - delta_y)
+    a_p = math.sqrt((2.0 * f_max + f_y) / (2.0 * math.pi * p_y))
+    k_p = 4.0 / 3.0 * e_star * math.sqrt(4.0 * e_star * a_p**3 / (3.0 * f_max))
+    c[MEMORY_ + 1] = k_p
+    c[MEMORY_ + 2] = delta - (f_max / k_p) ** (2.0 / 3.0)
+    return True
+
+
+@kernel(python=True, inline="always")
+def force_of(code, c, delta, deltadot, mode):
+    """The contact force of a run with packed coefficients ``c`` (what the engine calls): the
+    law's :func:`contact_force`, or a law with memory read from ``c``."""
+    if has_memory(code):
+        return _thornton(c, delta)[0] if delta > 0 else 0.0
+    return contact_force(code, delta, deltadot, mode, c[K_], c[DAMP_], c[ALPHA_])
+
+
+@kernel(python=True, inline="always")
+def partials_of(code, c, delta, deltadot, mode):
+    """``(dP/ddelta, dP/ddeltadot)`` of :func:`force_of`."""
+    if has_memory(code):
+        return (_thornton(c, delta)[1] if delta > 0 else 0.0), 0.0
+    return force_partials(code, delta, deltadot, mode, c[K_], c[DAMP_], c[ALPHA_])
+
+
+@kernel(python=True)
+def potential_of(code, c, delta):
+    """:func:`contact_potential` of a run (0 for a law with memory: its elastic energy depends on
+    the path, and its whole contact work counts in the ledger)."""
+    if has_memory(code):
+        return 0.0
+    return contact_potential(code, delta, c[K_], c[ALPHA_])
+
+
 @kernel(python=True)
 def stick_bound(code, delta, K, damping, alpha):
     """The largest force a stuck Filippov contact gives at ``delta`` (N): ``|P(delta, 0)|``, the
@@ -310,6 +410,15 @@ class LawEntry:
         A user law's compiled functions (:mod:`phaseimpact.model.userlaw`); None when shipped.
     unit : str or None
         A user law's own unit text for its damping coefficient (default from ``damping_power``).
+    coefficients : callable or None
+        ``params -> tuple`` of the law's own coefficients (at most :data:`N_LAW`), packed at
+        :data:`LAW_`; it raises ``ValueError`` when ``params`` lack what the law needs.
+    memory : int
+        Slots of state the law keeps over a run (at most :data:`N_MEMORY`, at :data:`MEMORY_`,
+        0 at the start), updated by :func:`remember` at each extremum of ``delta``.
+    plastic : bool
+        The contact yields (Thornton): pressure, contact radius and validity are read from the
+        elastic-plastic model (:func:`phaseimpact.case.plastic_contact`), not from Hertz.
     """
 
     name: str
@@ -327,6 +436,9 @@ class LawEntry:
     runaway_factor: float = GUARD_ENERGY_FACTOR
     native: object = None
     unit: str | None = None
+    coefficients: object = None
+    memory: int = 0
+    plastic: bool = False
 
     @property
     def shipped(self) -> bool:
@@ -374,6 +486,25 @@ for _name, _chi, _text in (
 register(LawEntry("kuwabara-kono", KUWABARA_KONO, "kappa", False, True, True, options=("clamp",),
                   damping_name="gamma", damping_power=lambda alpha: alpha,
                   description="K delta^alpha + gamma delta^(alpha-1) deltadot for delta > 0 (viscoelastic spheres)"))
+
+
+
+def _thornton_coefficients(params: Parameters) -> tuple:
+    """``(p_y, R)``: the limiting contact pressure and the effective radius."""
+    if params.limiting_pressure is None:
+        raise ValueError("law 'thornton' needs the limiting contact pressure p_y: give the case a yield_strength "
+                         "(p_y = 1.6 Y of the weaker body) or Parameters(limiting_pressure=...)")
+    if params.R is None:
+        raise ValueError("law 'thornton' needs the effective radius R: derive the parameters from a case, or give "
+                         "Parameters(R=...)")
+    require("alpha", params.alpha, "1.5 for law 'thornton' (Hertz loading and unloading)", params.alpha == 1.5)
+    return params.limiting_pressure, params.R
+
+
+register(LawEntry("thornton", THORNTON, None, False, True, False, coefficients=_thornton_coefficients, memory=3,
+                  plastic=True,
+                  description="elastic-perfectly plastic sphere (Thornton 1997): Hertz to the yield indentation, then "
+                              "linear at the limiting pressure p_y; Hertz unloading with the enlarged radius"))
 
 #: The shipped laws (user laws join :data:`REGISTRY` only).
 LAWS = tuple(REGISTRY)
@@ -475,6 +606,11 @@ class ContactLaw:
     @property
     def is_conservative(self) -> bool:
         return self.entry.conservative
+
+    def coefficients(self, params: Parameters) -> tuple:
+        """The law's own packed coefficients for ``params`` (:attr:`LawEntry.coefficients`)."""
+        own = self.entry.coefficients
+        return () if own is None else tuple(float(x) for x in own(params))
 
     @property
     def runaway_factor(self) -> float:

@@ -21,15 +21,30 @@ import numpy as np
 
 from .._jit import kernel
 from ..parameters import Parameters
-from .laws import (
+from .laws import (  # noqa: F401 (the packed layout, re-exported: the engine's modules read it here)
+    ALPHA_,
+    DAMP_,
+    GUARD_,
+    K_,
+    KB_,
+    KM_,
+    LAW_,
+    M1_,
+    M2_,
+    MEMORY_,
+    N_COEF,
+    N_LAW,
+    N_MEMORY,
     PLAIN,
+    RIGID_,
+    SPRINGS_,
     STUCK,
     ContactLaw,
     as_law,
-    contact_force,
-    contact_potential,
-    force_partials,
+    force_of,
     is_filippov,
+    partials_of,
+    potential_of,
     stick_bound,
 )
 
@@ -42,17 +57,17 @@ __all__ = [
 ]
 
 X1, X2, V1, V2, WORK = range(5)
-# Packed coefficients; GUARD_: the law's runaway factor (its entry, :attr:`ContactLaw.runaway_factor`).
-M1_, M2_, K_, KB_, KM_, DAMP_, ALPHA_, SPRINGS_, RIGID_, GUARD_ = range(10)
-N_COEF = 10
 
 
 def pack(params: Parameters, law: ContactLaw) -> np.ndarray:
-    """The packed coefficient array of ``params`` under ``law`` (springs only on a plate)."""
+    """The packed coefficient array of ``params`` under ``law`` (springs only on a plate; the
+    law's own coefficients; its memory empty)."""
     springs = params.target == "plate"
+    own = law.coefficients(params)
     return np.array([params.M1, params.M2, params.K, params.Kb if springs else 0.0,
                      params.Km if springs else 0.0, law.kappa(params), params.alpha,
-                     1.0 if springs else 0.0, 1.0 if params.target == "rigid" else 0.0, law.runaway_factor])
+                     1.0 if springs else 0.0, 1.0 if params.target == "rigid" else 0.0, law.runaway_factor,
+                     *own, *(0.0,) * (N_LAW - len(own)), *(0.0,) * N_MEMORY])
 
 
 @kernel
@@ -95,7 +110,7 @@ def contact_side(code, c, y, mode):
     delta = y[X1] - y[X2]
     deltadot = y[V1] - y[V2]
     side = 1 if delta > 0 else (-1 if delta < 0 else (1 if deltadot > 0 else (-1 if deltadot < 0 else 0)))
-    if side < 0 and contact_force(code, -1.0, 0.0, mode, c[K_], 0.0, c[ALPHA_]) == 0.0:
+    if side < 0 and force_of(code, c, -1.0, 0.0, mode) == 0.0:
         return FLIGHT  # a unilateral law
     if side == 0 or c[ALPHA_] != 1.5:
         return PLAIN_PHASE
@@ -135,7 +150,7 @@ def rhs_values(code, c, u0, x2, v1, v2, mode, side):
             accel = -spring_force(c, x2) / (c[M1_] + c[M2_])
             force = _stick_force_at(c, x2)
             return v1, v2, accel, accel, force * deltadot, 1.0, force
-        force = contact_force(code, u0 - x2, deltadot, mode, c[K_], c[DAMP_], c[ALPHA_])
+        force = force_of(code, c, u0 - x2, deltadot, mode)
         target = 0.0 if c[RIGID_] > 0 else (force - spring_force(c, x2)) / c[M2_]
         if relative:
             return deltadot + v2, v2, -force / c[M1_] - target, target, force * deltadot, 1.0, force
@@ -143,7 +158,7 @@ def rhs_values(code, c, u0, x2, v1, v2, mode, side):
     if side == FLIGHT:
         return v1, v2, 0.0, 0.0 if c[RIGID_] > 0 else -spring_force(c, x2) / c[M2_], 0.0, 1.0, 0.0
     w = u0
-    force = contact_force(code, side * w * w, deltadot, mode, c[K_], c[DAMP_], c[ALPHA_])
+    force = force_of(code, c, side * w * w, deltadot, mode)
     if w < 0:
         force = -force
     target = 0.0 if c[RIGID_] > 0 else w * (force - spring_force(c, x2)) / c[M2_]
@@ -186,7 +201,7 @@ def damping_rate(code, c, u, mode, side):
     regularised = side == 1 or side == -1
     delta = side * u[0] * u[0] if regularised else u[X1] - u[X2]
     deltadot = u[V1] if relative_slip(code, mode, side) else u[V1] - u[V2]
-    partial = force_partials(code, delta, deltadot, mode, c[K_], c[DAMP_], c[ALPHA_])[1]
+    partial = partials_of(code, c, delta, deltadot, mode)[1]
     rate = partial * (1.0 / c[M1_] + (0.0 if c[RIGID_] > 0 else 1.0 / c[M2_]))
     return rate * abs(u[0]) if regularised else rate
 
@@ -199,7 +214,7 @@ def energy(code, c, y):
     x2sq = x2 * x2
     kinetic = 0.5 * c[M1_] * y[V1] * y[V1] + 0.5 * c[M2_] * y[V2] * y[V2]
     springs = (0.5 * c[KB_] + 0.25 * c[KM_] * x2sq) * x2sq
-    return kinetic + springs + contact_potential(code, y[X1] - x2, c[K_], c[ALPHA_])
+    return kinetic + springs + potential_of(code, c, y[X1] - x2)
 
 
 @kernel
@@ -321,7 +336,7 @@ def jacobian(y, params: Parameters, law, mode: int = 1) -> np.ndarray:
     if mode == STUCK:
         J[2, 1] = J[3, 1] = -spring_rate / (c[M1_] + c[M2_])
         return J
-    P_delta, P_rate = force_partials(law.code, y[X1] - y[X2], y[V1] - y[V2], mode, c[K_], c[DAMP_], c[ALPHA_])
+    P_delta, P_rate = partials_of(law.code, c, y[X1] - y[X2], y[V1] - y[V2], mode)
     dP = np.array([P_delta, -P_delta, P_rate, -P_rate])
     J[2] = -dP / c[M1_]
     if c[RIGID_] == 0:

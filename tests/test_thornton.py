@@ -1,0 +1,118 @@
+"""Thornton's elastic-perfectly plastic sphere (law ``thornton``): known answers of Thornton (1997,
+J. Appl. Mech. 64:383) and REFERENCE.md §7, and the law's memory (its largest indentation)."""
+
+import math
+
+import numpy as np
+import pytest
+
+from phaseimpact import check_law, simulate, simulate_many
+from phaseimpact.case import hertz_scales, load_case, plastic_validity
+from phaseimpact.cli import main
+from phaseimpact.continuation import Axis, atlas
+from phaseimpact.parameters import FIRST_YIELD_FACTOR, STEEL, seed_parameters
+
+P_Y = 1.6e9  # Pa: the seed's steel ball then yields at about 0.14 m/s on a rigid wall
+RIGID = seed_parameters(v=1.0, target="rigid", limiting_pressure=P_Y)
+
+
+def thornton_restitution(r):
+    """REFERENCE.md §7 (Thornton 1997, eq. 36), r = v_y / v <= 1."""
+    return (math.sqrt(6 * math.sqrt(3) / 5) * math.sqrt(1 - r * r / 6)
+            * (r / (r + 2 * math.sqrt(6 / 5 - r * r / 5))) ** 0.25)
+
+
+def test_the_yield_velocity_is_where_the_hertz_pressure_reaches_p_y():
+    """Two routes: the Hertz peak pressure of an impact at v_y (closed form, case.hertz_scales) is p_y;
+    and Thornton's sphere-on-a-wall form v_y = (pi^2/sqrt(40)) sqrt(p_y^5 / (E*^4 rho)) with E* from
+    the materials (not from K) and m = M1 = 4/3 pi R^3 rho, here with R the effective radius."""
+    v_y = RIGID.yield_velocity
+    assert hertz_scales(RIGID.replace(v=v_y))["peak_pressure"] == pytest.approx(P_Y, rel=1e-12)
+    e_star = 1.0 / (2 * (1 - STEEL.nu**2) / STEEL.E)
+    rho = RIGID.M1 / (4 / 3 * math.pi * RIGID.R**3)  # the density that makes the ball of radius R weigh M1
+    assert v_y == pytest.approx(math.pi**2 / math.sqrt(40) * math.sqrt(P_Y**5 / (e_star**4 * rho)), rel=1e-12)
+
+
+@pytest.mark.parametrize("r", [0.9, 0.5, 0.2, 0.1, 0.02])
+def test_restitution_is_thorntons_closed_form(r):
+    """Exact for the law (REFERENCE.md §7): to 1e-9 at rtol 1e-12, 1e-7 at the default 1e-10 (the
+    unloading's end at the residual indentation is stepped over, not regularised as Hertz's onset)."""
+    p = RIGID.replace(v=RIGID.yield_velocity / r)
+    tight = simulate(p, "thornton", rtol=1e-12)
+    assert tight.status == "success" and tight.outcome == "rebound"
+    assert tight.restitution == pytest.approx(thornton_restitution(r), rel=1e-9)
+    assert simulate(p, "thornton").restitution == pytest.approx(thornton_restitution(r), rel=1e-7)
+
+
+def test_high_speed_restitution_falls_as_v_to_the_minus_one_quarter():
+    v_y = RIGID.yield_velocity
+    e1, e2 = (simulate(RIGID.replace(v=v_y * k), "thornton", rtol=1e-12).restitution for k in (1000.0, 4000.0))
+    assert math.log(e2 / e1) / math.log(4.0) == pytest.approx(-0.25, abs=1e-3)
+
+
+def test_below_the_yield_velocity_it_is_hertz():
+    p = RIGID.replace(v=0.8 * RIGID.yield_velocity)
+    mine, hertz = simulate(p, "thornton", rtol=1e-12), simulate(p, "abrate", rtol=1e-12)
+    assert mine.restitution == pytest.approx(1.0, abs=1e-10)
+    assert mine.max_force == pytest.approx(hertz.max_force, rel=1e-10)
+    assert mine.contact_duration == pytest.approx(hertz.contact_duration, rel=1e-10)
+
+
+def test_the_energy_lost_is_the_rebound_deficit():
+    """On a rigid wall the kinetic energy (1 - e^2) M1 v^2 / 2 is what the plastic flow took."""
+    p = RIGID.replace(v=5.0 * RIGID.yield_velocity)
+    tr = simulate(p, "thornton", rtol=1e-12)
+    lost = 0.5 * p.M1 * p.v**2 * (1 - tr.restitution**2)
+    assert tr.dissipated_energy == pytest.approx(lost, rel=1e-9)
+
+
+def test_the_memory_is_each_runs_own():
+    """The largest indentation is kept in the run's copy of its coefficients: repeated and batched
+    runs of the same point agree bit for bit (a shared memory would unload the second run at once)."""
+    p = seed_parameters(v=1.0, limiting_pressure=P_Y)
+    first, again = simulate(p, "thornton"), simulate(p, "thornton")
+    assert np.array_equal(first.event_t, again.event_t) and first.max_force == again.max_force
+    many = simulate_many([p, p, p.replace(v=2.0)], "thornton")
+    assert np.all(many.values["max_force"][:2] == first.max_force)
+    assert many.values["max_force"][2] == simulate(p.replace(v=2.0), "thornton").max_force
+
+
+def test_the_law_passes_the_conformance_suite():
+    """Force, partials, the energy ledger on the plate (two contacts: the second reloads the dent on
+    the unloading curve, then yields again), momentum, and scipy restarted at the turning point."""
+    report = check_law("thornton")
+    assert report.passed, str(report)
+    assert {v.check for v in report.verdicts if v.passed} >= {"force", "partials", "energy ledger", "momentum",
+                                                               "scipy"}
+
+
+def test_a_sweep_runs_the_law_like_simulate():
+    case = load_case("sand-gelcoat")
+    result = atlas(case, "thornton", [Axis("v", np.array([20.0, 50.0, 90.0]))])
+    for v, e in zip((20.0, 50.0, 90.0), result.values["restitution"], strict=True):
+        assert e == simulate(case.parameters(v=v), "thornton").restitution
+
+
+def test_the_limiting_pressure_comes_from_the_weaker_body():
+    case = load_case("sand-gelcoat")
+    strengths = [m.yield_strength for m in (case.projectile, case.plate) if m.yield_strength is not None]
+    assert case.parameters().limiting_pressure == FIRST_YIELD_FACTOR * min(strengths)
+    assert seed_parameters().limiting_pressure is None
+
+
+def test_the_regime_is_named(capsys):
+    p = RIGID.replace(v=5.0 * RIGID.yield_velocity)
+    assert plastic_validity(1.0, p).startswith("elastic-plastic (v = 5 v_y")
+    assert plastic_validity(1.0, p.replace(v=0.5 * RIGID.yield_velocity)).startswith("elastic (v = 0.5 v_y")
+    assert main(["simulate", "--case", "sand-gelcoat", "--law", "thornton", "--json"]) == 0
+    out = capsys.readouterr().out
+    assert '"limiting_pressure"' in out and '"yield_velocity"' in out and "elastic-plastic" in out
+
+
+def test_missing_inputs_are_refused_before_any_work(capsys):
+    assert main(["simulate", "--law", "thornton"]) == 2  # the seed has no yield strength
+    assert "needs the limiting contact pressure" in capsys.readouterr().err
+    with pytest.raises(ValueError, match="integrator = 'rk4' is out of range for law 'thornton'"):
+        simulate(RIGID, "thornton", 1e-4, integrator="rk4")
+    with pytest.raises(ValueError, match="alpha"):
+        simulate(RIGID.replace(alpha=1.4), "thornton")
