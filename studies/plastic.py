@@ -83,7 +83,7 @@ def main(quick=False, jobs=1):
         ax.set_xlabel("impact speed over yield velocity, v / v_y")
         ax.set_ylabel("|e / e_Thornton − 1| (rtol 1e-10)")
         ax.set_title("agreement with the closed form")
-        ax.legend(loc="lower right", fontsize=6.5)
+        ax.legend(loc="center left", fontsize=6.5)
         out = save(fig, FIGURES / f"{NAME}.png")
 
     data = {}

@@ -48,7 +48,7 @@ def main() -> int:
     folder = _cli.output_folder(args.quick)
     print(f"writing {'previews' if args.quick else 'figures'} to {folder.relative_to(HERE.parent)}/", flush=True)
     start = time.perf_counter()
-    bar = tqdm(STUDIES, desc="studies", unit="study")
+    bar = tqdm(STUDIES, desc="studies", unit="study", disable=not sys.stderr.isatty())  # no bar in a log
     for name in bar:
         bar.set_postfix_str(name)
         t0 = time.perf_counter()

@@ -3,14 +3,16 @@ period between impacts.
 
 Claim (docs/physics.md §7), the seed case with Hunt-Crossley contact (kappa = 3e9, 1 m/s), one
 projectile every T seconds on the plate as the previous impacts left it, T from 0.3 to 4 plate
-periods (the plate's small-amplitude period): the attractor's pattern repeats with the plate period.
-Stable period-1 orbits (one point after the transients) fill windows from about a fifth to a half
-of a period past each multiple, where the plate's steady amplitude is largest (about 0.18 mm, a
-quarter period past the multiple); the amplitude is smallest (about 15 µm) at the multiples
-themselves, where the train from rest settles on a period-2 orbit (bottom panel). Just below each
-multiple and near the half multiples the map shows no period within the samples (irregular, or a
-long or slowly reached period). The counts of each kind are in the data file (attribute "counts");
-period-doubling cascades are not resolved at this grid's resolution.
+periods (the plate's small-amplitude period), 200 impacts dropped and 40 kept at each of 400 values:
+the attractor's pattern repeats with the plate period. Stable period-1 orbits (one point after the
+transients) fill most of each period, from about 0.15 to 0.72 of a period past each multiple
+(interrupted near the half multiple), the plate's steady amplitude largest (about 0.18 mm) near
+their start. Just below each multiple lies a narrow window of period-1 orbits of small amplitude
+(about 15 µm), reached as T rises through period 2 and period 4: a period-doubling sequence, which
+this grid resolves only to period 4. From about 0.75 of a period to about 0.13 past each multiple
+the map shows no period within the 40 samples (irregular, or a long period). At exactly one plate
+period the train from rest settles on a period-2 orbit (bottom panel). The counts of each kind are
+in the data file (attribute "counts").
 """
 
 from pathlib import Path
