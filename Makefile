@@ -6,7 +6,7 @@ STAMP := $(VENV)/.installed
 QUICK ?=
 JOBS ?= 2
 
-.PHONY: test reproduce lint benchmarks stress peers clean
+.PHONY: test docs reproduce lint benchmarks stress peers clean
 
 $(BIN)/python:
 	$(PYTHON) -m venv $(VENV)
@@ -20,6 +20,12 @@ $(STAMP): pyproject.toml | $(BIN)/python
 test: $(STAMP)
 	$(BIN)/ruff check .
 	$(BIN)/python -m pytest -q
+
+# The documentation site (mkdocs.yml, docs/) into site/; --strict: any warning fails the build
+# (make test builds it too, strict, in tests/test_docs.py, and runs every tutorial).
+MKDOCS = NO_MKDOCS_2_WARNING=1 $(BIN)/python -m mkdocs build --strict
+docs: $(STAMP)
+	$(MKDOCS)
 
 # Time stamps in archives come from the last commit of the code that makes them (SOURCE_DATE_EPOCH),
 # so regenerating unchanged results leaves git clean, also after a commit of the results themselves;

@@ -1279,7 +1279,7 @@ def cmd_portrait(args) -> int:
 # ------------------------------------------------------------------------------------------------
 
 def _settable_help() -> str:
-    return ", ".join(f"{name} ({unit})" for name, (unit, _) in SETTABLE.items())
+    return ", ".join(f"{name} ({unit})" if unit else name for name, (unit, _) in SETTABLE.items())
 
 
 def build_parser() -> argparse.ArgumentParser:

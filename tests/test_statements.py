@@ -281,7 +281,7 @@ def heyoka_ratios():
 # ------------------------------------------------------------------------------------------------ table
 
 R, D, C = "README.md", "docs/physics.md", "figures/claims.md"
-ST, ER, PL = "studies/staircase.py", "studies/erosion.py", "studies/plastic.py"
+ST, ER, PL, TR = "studies/staircase.py", "studies/erosion.py", "studies/plastic.py", "studies/train.py"
 
 STATEMENTS = [
     # README, findings
@@ -516,6 +516,7 @@ EXEMPT = {
         "3.2145": "the literature's rounded value, quoted as such", "2002": "year", "2008": "year",
         "1997": "year", "383": "page (Thornton 1997, J. Appl. Mech. 64:383)"},
     PL: {"1997": "year", "383": "page (Thornton 1997, J. Appl. Mech. 64:383)"},
+    TR: {"200": "input (impacts dropped)", "400": "input (values of T)"},
     ER: {"1985": "year", "11.4": "Johnson's section", "100": "input (grain size)", "300": "input (grain sizes)",
          "150": "input (speed range)", "120": "input (blade-tip speed range)"},
 }
