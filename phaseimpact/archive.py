@@ -1,10 +1,10 @@
 """HDF5 archives of sweeps, atlases and continued curves: netCDF-4 / CF-1.8 files that xarray opens as
 labelled arrays, and that plain h5py reads just as well.
 
-Layout (``schema_version`` 3). Every variable is in the root group, so
+Layout (``schema_version`` 4). Every variable is in the root group, so
 ``xarray.open_dataset(path, engine="h5netcdf")`` shows them all, with one dimension per axis::
 
-    / attrs       Conventions "CF-1.8", schema_version 3, package_version, kind ("sweep": one axis,
+    / attrs       Conventions "CF-1.8", schema_version 4, package_version, kind ("sweep": one axis,
                   "atlas": two or more, "critical-curve"), law (JSON), contact (its reading of
                   |delta|^alpha), base ("parameters" or "case"), case (JSON: the Case, or the
                   Parameters), parameters (JSON, SI: the base's Parameters), engine, rtol, t_end (s;
@@ -18,10 +18,11 @@ Layout (``schema_version`` 3). Every variable is in the root group, so
                                    (plate.E -> plate_E); attrs units, long_name, parameter (the
                                    original name), log (1: a log-spaced axis)
     status        grid    int8     0 success, 1 step-size-collapse, 2 too-many-steps, 3 non-finite;
-                                   _FillValue -1: not computed (flag_values, flag_meanings)
+                                   -1: not computed, outside valid_range (flag_values, flag_meanings;
+                                   no _FillValue, so that xarray keeps the codes as integers)
     outcome       grid    int8     failed, permanent-stick, ratchet-escape, rebound, runaway, bounded,
-                                   unsettled (flag_values, flag_meanings); _FillValue -1
-    stop_reason   grid    int8     horizon, settled, runaway, asked, failed; _FillValue -1
+                                   unsettled (flag_values, flag_meanings); -1 as status
+    stop_reason   grid    int8     horizon, settled, runaway, asked, failed; -1 as status
     <column>      grid    float64 or int64: every summary column (max_force, n_stick, t_run, ...)
                                    with its units (N, m, s, J, 1); _FillValue NaN or -1
     stick_first   grid    int64    row of the point's first stick phase (-1: none or not computed)
@@ -43,7 +44,7 @@ Layout (``schema_version`` 3). Every variable is in the root group, so
                   group's attribute "json" (a group: the xarray root view leaves it out)
 
 Units are UDUNITS strings (``N s m-2.5`` for kappa with alpha = 1.5). A point is computed when its
-``status`` is not the fill value; its stick phases are rows ``stick_first .. stick_first +
+``status`` is not -1; its stick phases are rows ``stick_first .. stick_first +
 stick_count - 1`` (also found through ``stick_point``).
 
 Writing. :func:`save` writes the whole file to a temporary file beside the target, fsyncs it and
@@ -65,7 +66,8 @@ computed); rows not referenced by a committed point's ``stick_first``/``stick_co
 :func:`load` and reused. A kill during step 2 commits some of the new points, each complete. When the rows run
 out (or the file is not an archive of the same grid) a checkpoint rewrites the file atomically as
 :func:`save` does, with room for the stick phases still to come. Archives of schema 1
-(phaseimpact 0.1) and 2 (groups ``/sweep``, ``/curve``) still load.
+(phaseimpact 0.1), 2 (groups ``/sweep``, ``/curve``) and 3 (this layout with ``_FillValue -1`` on the
+code variables, which made xarray decode them as floats) still load.
 
 Integrity. Every chunk of every variable carries a Fletcher-32 checksum (HDF5's filter, which
 netCDF-4, h5netcdf and h5py verify on every read); the file format is HDF5 1.8's, whose superblock
@@ -109,7 +111,7 @@ __all__ = ["SCHEMA_VERSION", "KINDS", "CHUNK_POINTS", "Checkpoint", "save", "loa
            "check_overwrite", "kind_of", "created_timestamp", "DamagedArchiveError", "to_xarray"]
 
 #: The layout written (module docstring); schemas 1 and 2 still load, a newer one is refused.
-SCHEMA_VERSION = 3
+SCHEMA_VERSION = 4
 #: What an archive holds: a sweep (one axis), an atlas (two or more) or a continued curve.
 KINDS = ("sweep", "atlas", "critical-curve")
 CONVENTIONS = "CF-1.8"
@@ -389,8 +391,13 @@ def _dimension(group, name: str, size: int):
 
 
 def _flags(d, names) -> None:
+    """CF flags. A point not computed holds -1, outside ``valid_range``: CF readers take it as missing,
+    and xarray, which masks only ``_FillValue`` and ``missing_value`` (decoding the variable to
+    float), keeps the codes as integers."""
     d.attrs["flag_values"] = np.arange(len(names), dtype=np.int8)
     d.attrs["flag_meanings"] = " ".join(names)
+    d.attrs["valid_range"] = np.array([0, len(names) - 1], dtype=np.int8)
+    d.attrs["comment"] = "-1 (outside valid_range): not computed"
 
 
 def _boxes(lo: int, hi: int, shape) -> list:
@@ -746,8 +753,10 @@ def _write_sweep(f, r: SweepResult, created: str, layout: _Layout, spare_rows: i
     chunks = _slab_chunks(shape, CHUNK_POINTS)
 
     def gridded(name, data, dtype, units=None):
-        d = _fixed(f, name, np.asarray(data).reshape(shape), dtype, chunks, units=units, dims=scales)
-        if name in _CODES:
+        coded = name in _CODES
+        d = _fixed(f, name, np.asarray(data).reshape(shape), dtype, chunks, units=units, dims=scales,
+                   fill_attr=not coded)
+        if coded:
             _flags(d, _CODES[name])
         return d
 

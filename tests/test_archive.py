@@ -1,4 +1,4 @@
-"""HDF5 archive (schema 3): labelled arrays for xarray, plain h5py, bit-for-bit round trips, schema 1
+"""HDF5 archive (schema 4): labelled arrays for xarray, plain h5py, bit-for-bit round trips, schema 1
 and 2 files, checkpoints written in place (only the new points) and crash-safe (kills between the
 data and the commit, then a resume that gives the numbers of an uninterrupted run)."""
 
@@ -104,6 +104,9 @@ def test_atlas_opens_in_xarray_as_labelled_arrays(tmp_path, small_atlas):
         assert ds.outcome.attrs["flag_meanings"].split() == list(driver.OUTCOMES)
         assert list(ds.outcome.attrs["flag_values"]) == list(range(len(driver.OUTCOMES)))
         assert np.array_equal(ds.outcome.values.ravel(), small_atlas.outcome)
+        for name in ("status", "outcome", "stop_reason"):  # integer codes, not floats with NaN (a colour bar)
+            assert ds[name].dtype == np.int8 and "_FillValue" not in ds[name].attrs, name
+            assert list(ds[name].attrs["valid_range"]) == [0, len(ds[name].attrs["flag_meanings"].split()) - 1]
         # ragged stick phases: an indexed ragged array over the grid stacked in C order
         assert ds.stick_point.attrs["instance_dimension"] == "point"
         flat = ds.stack(point=("kappa", "v"))
@@ -114,7 +117,8 @@ def test_atlas_opens_in_xarray_as_labelled_arrays(tmp_path, small_atlas):
 
 
 def test_points_not_computed_are_fill_values_in_xarray(tmp_path, small_atlas, chunks_of_5):
-    """An archive in progress: what is not computed reads as missing (NaN), not as a sentinel."""
+    """An archive in progress: what is not computed reads as missing (NaN), not as a sentinel; the
+    code variables stay integers, -1 (outside their valid_range) where not computed."""
     path = tmp_path / "partial.h5"
     checkpoint = archive.Checkpoint(path)
 
@@ -130,10 +134,13 @@ def test_points_not_computed_are_fill_values_in_xarray(tmp_path, small_atlas, ch
         atlas(seed_parameters(), "paper", AXES, on_chunk=two_chunks)
     computed = np.arange(28) < 10
     with xr.open_dataset(path, engine="h5netcdf") as ds:
-        for name in ("status", "outcome", "stop_reason", "max_force", "n_stick", "stick_count"):
+        for name in ("max_force", "n_stick", "stick_count"):
             values = ds[name].values.ravel()
             assert np.isnan(values[~computed]).all() and not np.isnan(values[computed]).any(), name
-        assert ds.status.encoding["_FillValue"] == -1 and np.isnan(ds.max_force.encoding["_FillValue"])
+        for name in ("status", "outcome", "stop_reason"):
+            values = ds[name].values.ravel()
+            assert values.dtype == np.int8 and (values[~computed] == -1).all() and (values[computed] >= 0).all(), name
+        assert np.isnan(ds.max_force.encoding["_FillValue"])
         assert np.array_equal(ds.max_force.values.ravel()[computed], small_atlas.max_force[:10])
         rows = ds.stick_point.values
         assert set(rows[rows >= 0]) <= set(range(10))  # free rows are -1, no point's
@@ -357,7 +364,7 @@ def test_each_checkpoint_loads_back_as_the_result_in_memory(tmp_path, monkeypatc
     assert len(reads) == 1  # only before the file existed: later calls know what it holds
     assert_same_result(result, small_atlas)
     with xr.open_dataset(path, engine="h5netcdf") as ds:
-        assert int(ds.status.notnull().sum()) == 28
+        assert int((ds.status >= 0).sum()) == 28
     final = archive.save(result, tmp_path / "final.h5")  # the compact file of the end of a run
     assert_same_result(archive.load(final), small_atlas)
     assert os.path.getsize(final) < os.path.getsize(path)  # no spare rows
@@ -585,7 +592,7 @@ def test_kill_between_data_and_commit_leaves_the_previous_state_and_resume_compl
     with h5py.File(path, "r") as f:  # the 3rd chunk's data did reach the file, without its commit
         assert not np.isnan(f["max_force"][()].ravel()[10:15]).any() and (f["status"][()].ravel()[10:15] == -1).all()
     with xr.open_dataset(path, engine="h5netcdf") as ds:
-        assert int(ds.status.notnull().sum()) == 10
+        assert int((ds.status >= 0).sum()) == 10
     resumed = archive.Checkpoint(path)
     result = atlas(seed_parameters(), "paper", AXES, previous=previous, on_chunk=resumed)
     assert resumed.rewrites == 0 and resumed.in_place == 4  # 18 points left: 4 chunks, all in place
@@ -695,7 +702,7 @@ def test_sigkill_mid_checkpoint_then_resume_equals_uninterrupted(tmp_path, small
     for name, values in small_atlas.values.items():
         assert same_bits(previous.values[name][:done], values[:done]), name
     with xr.open_dataset(path, engine="h5netcdf") as ds:
-        assert int(ds.status.notnull().sum()) == done
+        assert int((ds.status >= 0).sum()) == done
     monkeypatch.setattr(sweep_module, "CHUNK_THREADS", 5)
     result = atlas(seed_parameters(), "paper", AXES, previous=previous, on_chunk=archive.Checkpoint(path))
     assert_same_result(result, small_atlas)
