@@ -50,6 +50,8 @@ DEFAULT_SAMPLES = 96
 #: Panels of one phase portrait.
 MAX_PANELS = 12
 MAX_JOBS = 4 * (os.cpu_count() or 1)
+#: Tasks in flight on a Dask cluster (phaseimpact.continuation._parallel.MAX_DASK_TASKS).
+MAX_DASK_TASKS = 100_000
 BACKENDS = ("threads", "loky", "dask")
 #: Statuses of critical_damping that are answers (anything else is a failure: exit 1).
 CRITICAL_ANSWERS = ("success", "not-found", "unconfirmed")
@@ -157,8 +159,9 @@ def _jobs(text):
         value = float(text)
     except ValueError:
         value = math.nan
-    if not (math.isfinite(value) and value == int(value) and (value == -1 or 1 <= value <= MAX_JOBS)):
-        raise _out_of_range("jobs", text, f"an integer 1 <= jobs <= {MAX_JOBS} (4 per core), or -1 for all cores")
+    if not (math.isfinite(value) and value == int(value) and (value == -1 or 1 <= value <= MAX_DASK_TASKS)):
+        raise _out_of_range("jobs", text, f"an integer 1 <= jobs <= {MAX_JOBS} (4 per core; with --backend dask, "
+                                          f"tasks in flight, up to {MAX_DASK_TASKS}), or -1 for all cores")
     return int(value)
 
 
@@ -786,6 +789,9 @@ def _resume_command(argv) -> str:
 
 
 def _check_grid_options(args) -> None:
+    if args.backend != "dask" and args.jobs > MAX_JOBS:  # the parser allows a Dask cluster's task count
+        raise ValueError(f"jobs = {args.jobs!r} is out of range for --backend {args.backend}; allowed: an integer "
+                         f"1 <= jobs <= {MAX_JOBS} (4 per core), or -1 for all cores (more with --backend dask)")
     if args.scheduler is not None and args.backend != "dask":
         raise ValueError(f"scheduler = {args.scheduler!r} is not read by backend {args.backend!r}; allowed: "
                          "--scheduler together with --backend dask")
@@ -1372,7 +1378,9 @@ def build_parser() -> argparse.ArgumentParser:
 
     def parallel(p):
         p.add_argument("--jobs", type=_jobs, default=1,
-                       help=f"parallel workers, 1..{MAX_JOBS}, or -1 for all cores (default: %(default)s)")
+                       help=f"parallel workers, 1..{MAX_JOBS}, or -1 for all cores; with --backend dask the tasks "
+                            f"in flight, up to {MAX_DASK_TASKS}, -1 for every thread of the cluster's workers "
+                            "(default: %(default)s)")
         p.add_argument("--backend", choices=BACKENDS, default="threads",
                        help="threads of this process, joblib processes (loky) or a Dask cluster "
                             "(default: %(default)s)")

@@ -47,6 +47,32 @@ def test_processes_and_dask_do_not_change_any_number(reference):
     _same(reference, sweep(SEED, "paper", KAPPAS, n_jobs=2, backend="dask"))
 
 
+@pytest.mark.slow
+def test_a_dask_client_of_four_workers_keeps_them_all_busy():
+    """A Client the caller holds (left open), --jobs -1 = every worker thread, chunks from the
+    cluster's size (8 chunks of 256 points here), the engine loaded on each worker first; the
+    numbers unchanged."""
+    distributed = pytest.importorskip("distributed")
+    from phaseimpact.cli import MAX_DASK_TASKS
+    from phaseimpact.continuation import _parallel
+
+    assert MAX_DASK_TASKS == _parallel.MAX_DASK_TASKS
+    cluster = distributed.LocalCluster(n_workers=4, threads_per_worker=1, processes=False, dashboard_address=None)
+    with cluster, distributed.Client(cluster) as client:
+        assert _parallel.tasks_in_flight(-1, client) == 4
+        kappas = np.geomspace(1e9, 1e14, 2048)
+        with distributed.get_task_stream(client) as stream:
+            result = sweep(SEED, "paper", kappas, n_jobs=-1, backend="dask", scheduler=client)
+        _same(sweep(SEED, "paper", kappas, n_jobs=2), result)
+        workers = {task["worker"] for task in stream.data if "_run_chunk" in task["key"]}
+        assert len(workers) == 4, workers
+        assert client.status == "running"  # not closed: it is the caller's
+    with pytest.raises(ValueError, match="jobs = 0 is out of range; allowed: an integer 1..100000"):
+        sweep(SEED, "paper", KAPPAS, n_jobs=0, backend="dask")
+    with pytest.raises(ValueError, match="scheduler = 3"):
+        sweep(SEED, "paper", KAPPAS, backend="dask", scheduler=3)
+
+
 @pytest.mark.parametrize("contact", ["printed", "unilateral"])
 def test_near_kappa_c_window_sweep_equals_simulate(contact):
     """The window where the old batch loop and simulate disagreed (62/20 against 42/6)."""

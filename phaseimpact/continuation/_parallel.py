@@ -2,8 +2,12 @@
 
 ``threads`` (default) runs chunks in this process on ``n_jobs`` numba threads; ``loky`` runs
 chunks in ``n_jobs`` joblib worker processes; ``dask`` sends them to a ``dask.distributed``
-cluster (``scheduler`` address, or an in-process local cluster). Every run is independent of
-its chunk and thread, so results are bit-identical whatever the backend and job count.
+cluster: a ``Client`` the caller holds, a scheduler's address, or an in-process local cluster.
+With Dask, ``n_jobs`` is the number of tasks in flight (any number up to :data:`MAX_DASK_TASKS`,
+-1 for every thread of the cluster's workers), not this machine's cores, and every worker loads
+or compiles the engine once before the first chunk (:func:`warm_workers`). Every run is
+independent of its chunk and thread, so results are bit-identical whatever the backend and job
+count.
 """
 
 from __future__ import annotations
@@ -16,10 +20,13 @@ import numpy as np
 
 from ..integrate.api import run_batch
 
-__all__ = ["BACKENDS", "run_chunks", "check_jobs", "check_scheduler", "connect"]
+__all__ = ["BACKENDS", "run_chunks", "check_jobs", "check_scheduler", "connect", "warm_workers", "tasks_in_flight",
+           "MAX_DASK_TASKS"]
 
 BACKENDS = ("threads", "loky", "dask")
 MAX_JOBS = 4 * (os.cpu_count() or 1)
+#: Tasks in flight on a Dask cluster (its size is not this machine's).
+MAX_DASK_TASKS = 100_000
 #: Scheduler connection timeout, s.
 CONNECT_TIMEOUT = 5
 
@@ -28,17 +35,29 @@ def check_jobs(n_jobs, backend: str, scheduler) -> int:
     """Validate the parallel settings before any work; returns the job count (>= 1)."""
     if backend not in BACKENDS:
         raise ValueError(f"backend = {backend!r} is out of range; allowed: one of {', '.join(BACKENDS)}")
+    top = MAX_DASK_TASKS if backend == "dask" else MAX_JOBS
     if isinstance(n_jobs, bool) or not isinstance(n_jobs, (int, np.integer)) or not (
-            n_jobs == -1 or 1 <= n_jobs <= MAX_JOBS):
-        raise ValueError(f"jobs = {n_jobs!r} is out of range; allowed: an integer 1..{MAX_JOBS}, or -1 for all cores")
+            n_jobs == -1 or 1 <= n_jobs <= top):
+        every = "every thread of the cluster's workers" if backend == "dask" else "all cores"
+        raise ValueError(f"jobs = {n_jobs!r} is out of range; allowed: an integer 1..{top}, or -1 for {every}")
     if scheduler is not None and backend != "dask":
         raise ValueError(f"scheduler = {scheduler!r} is only read with backend 'dask', not {backend!r}")
+    if scheduler is not None and not isinstance(scheduler, str) and not _is_client(scheduler):
+        raise ValueError(f"scheduler = {scheduler!r} is out of range; allowed: a scheduler address (str) or a "
+                         "dask.distributed.Client")
+    if n_jobs == -1 and backend == "dask":
+        return -1  # the cluster's threads, once connected
     return (os.cpu_count() or 1) if n_jobs == -1 else int(n_jobs)
 
 
-def check_scheduler(address: str) -> None:
+def _is_client(value) -> bool:
+    return type(value).__name__ == "Client" and type(value).__module__.startswith("distributed")
+
+
+def check_scheduler(address: str) -> int:
     """Refuse an address where no Dask scheduler answers, within :data:`CONNECT_TIMEOUT` s
-    (before any work: a ``Client`` on a dead address would wait, then fail in its clean-up)."""
+    (before any work: a ``Client`` on a dead address would wait, then fail in its clean-up).
+    Returns the threads of its workers (from the scheduler's identity)."""
     try:
         from distributed.core import rpc
     except ImportError:  # pragma: no cover - depends on the install
@@ -62,18 +81,52 @@ def check_scheduler(address: str) -> None:
                          "allowed: the address of a running Dask scheduler, e.g. tcp://host:8786") from None
     if not (isinstance(answer, dict) and answer.get("type") == "Scheduler"):
         raise ValueError(f"scheduler = {address!r} is out of range: it answers, but is not a Dask scheduler")
+    return sum(int(w.get("nthreads", 0)) for w in answer.get("workers", {}).values())
 
 
-def connect(scheduler: str | None, n_jobs: int):
-    """A ``dask.distributed`` client (an in-process local cluster without an address)."""
+def connect(scheduler, n_jobs: int):
+    """``(client, owned)``: the caller's ``Client`` as it is, or one of ours (closed after the work):
+    to ``scheduler``'s address, or an in-process local cluster without one."""
+    if _is_client(scheduler):
+        return scheduler, False
     try:
         from dask.distributed import Client
     except ImportError as error:  # pragma: no cover - depends on the install
         raise ValueError("backend = 'dask' needs dask.distributed: pip install 'phaseimpact[dask]'") from error
     if scheduler is None:
-        return Client(processes=False, n_workers=1, threads_per_worker=n_jobs, dashboard_address=None)
+        threads = (os.cpu_count() or 1) if n_jobs == -1 else n_jobs
+        return Client(processes=False, n_workers=1, threads_per_worker=threads, dashboard_address=None), True
     check_scheduler(scheduler)
-    return Client(scheduler, timeout=CONNECT_TIMEOUT)
+    return Client(scheduler, timeout=CONNECT_TIMEOUT), True
+
+
+def _warm() -> bool:
+    from ..integrate.precompile import warmup
+
+    return warmup()["compiled"]
+
+
+def warm_workers(client) -> dict:
+    """Load, or compile once, the engine on every worker of ``client`` (``phaseimpact warmup`` in
+    each): ``{worker address: whether it compiled}``. A worker then keeps it for every later task."""
+    return client.run(_warm)
+
+
+def cluster_threads(client) -> int:
+    """Threads of all the cluster's workers: ``n_jobs = -1`` with Dask."""
+    return max(1, sum(client.nthreads().values()))
+
+
+def tasks_in_flight(n_jobs: int, scheduler) -> int:
+    """Dask's ``n_jobs``: as given, or for -1 the threads of the cluster's workers (a ``Client``'s,
+    a scheduler's, or this machine's cores for a local cluster); chunks are sized from it."""
+    if n_jobs != -1:
+        return n_jobs
+    if _is_client(scheduler):
+        return cluster_threads(scheduler)
+    if scheduler is not None:
+        return max(1, check_scheduler(scheduler))
+    return os.cpu_count() or 1
 
 
 def _run_chunk(batch, rtol, settle, stop_on, threads):
@@ -88,14 +141,18 @@ def run_chunks(batches, *, rtol: float, settle: bool, stop_on, n_jobs: int, back
         return
     import joblib
 
-    client = connect(scheduler, n_jobs) if backend == "dask" else None
+    client, owned = connect(scheduler, n_jobs) if backend == "dask" else (None, False)
     try:
-        context = joblib.parallel_config(backend="dask") if client is not None else contextlib.nullcontext()
+        if client is not None:
+            warm_workers(client)
+            n_jobs = tasks_in_flight(n_jobs, client)
+        context = (joblib.parallel_config(backend="dask", client=client) if client is not None
+                   else contextlib.nullcontext())
         with context:
-            parallel = joblib.Parallel(n_jobs=-1 if client is not None else n_jobs, return_as="generator")
+            parallel = joblib.Parallel(n_jobs=n_jobs, return_as="generator")
             yield from parallel(joblib.delayed(_run_chunk)(b, rtol, settle, stop_on, 1) for b in batches)
     finally:
-        if client is not None:
+        if owned:
             client.close()
 
 

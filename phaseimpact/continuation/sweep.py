@@ -23,7 +23,7 @@ from ..integrate.api import check_bool, check_rtol, check_t_end, scales
 from ..integrate.result import SUMMARY_COLUMNS, ColumnAccess
 from ..model.laws import ContactLaw, as_law
 from ..parameters import Parameters
-from ._parallel import check_jobs, run_chunks
+from ._parallel import check_jobs, run_chunks, tasks_in_flight
 from .grid import Axis, Grid
 
 __all__ = ["SweepResult", "sweep", "atlas", "ENGINE"]
@@ -350,7 +350,7 @@ def _check_previous(previous, grid: Grid, t_end, rtol) -> None:
 
 
 def atlas(base: Parameters | Case, law: ContactLaw | str, axes, *, t_end: float | None = None, rtol: float = 1e-10,
-          n_jobs: int = 1, backend: str = "threads", scheduler: str | None = None, progress: bool = False,
+          n_jobs: int = 1, backend: str = "threads", scheduler=None, progress: bool = False,
           previous: SweepResult | None = None,
           on_chunk: Callable[[SweepResult], None] | None = None) -> SweepResult:
     """Evaluate every point of a grid of named parameters (an atlas).
@@ -379,8 +379,11 @@ def atlas(base: Parameters | Case, law: ContactLaw | str, axes, *, t_end: float 
     backend : {"threads", "loky", "dask"}, default "threads"
         Threads of this process (``threads``), joblib processes (``loky``) or a Dask cluster
         (``dask``, at ``scheduler`` or a local one).
-    scheduler : str, optional
-        Address of a Dask scheduler (``dask`` only).
+    scheduler : str or dask.distributed.Client, optional
+        ``dask`` only: a scheduler's address (``tcp://host:8786``), or a ``Client`` you hold (left
+        open); default an in-process local cluster. ``n_jobs`` is then the number of tasks in
+        flight (-1: every thread of the cluster's workers), and each worker loads or compiles the
+        engine once before the first chunk.
     progress : bool, default False
         Draw a progress bar on stderr.
     previous : SweepResult, optional
@@ -445,7 +448,8 @@ def atlas(base: Parameters | Case, law: ContactLaw | str, axes, *, t_end: float 
     todo = np.flatnonzero(result.status != drv.SUCCESS)
     if backend == "threads":
         chunk = CHUNK_THREADS
-    else:
+    else:  # four chunks per worker thread (Dask: per task in flight, from the cluster's size for -1)
+        jobs = tasks_in_flight(jobs, scheduler) if backend == "dask" else jobs
         chunk = int(np.clip(math.ceil(len(todo) / (4 * jobs)), CHUNK_MIN, CHUNK_MAX))
     chunks = [todo[i:i + chunk] for i in range(0, len(todo), chunk)]
     batches = (grid.batch(idx, t_end, rtol) for idx in chunks)
