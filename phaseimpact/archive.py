@@ -1434,7 +1434,7 @@ def _law(f) -> ContactLaw:
 def _base(f):
     from .case import case_from_dict
 
-    if "base" in f.attrs:  # schema 3: case holds the Case, or the Parameters
+    if "base" in f.attrs:  # schema 3 and later: case holds the Case, or the Parameters
         data = _json_attr(f, "case", dict)
         return case_from_dict(data, origin="archive") if _attr_str(f, "base") == "case" else Parameters(**data)
     if "case" in f.attrs:  # schema 2: case only when the base is a case
@@ -1805,7 +1805,7 @@ def describe(path) -> dict:
     >>> path = save(sweep(seed_parameters(), "paper", [1e9, 1e13]), os.path.join(tempfile.mkdtemp(), "s.h5"))
     >>> held = describe(path)
     >>> held["kind"], held["law"]["name"], held["axes"]["kappa"].tolist(), held["t_end"], held["schema_version"]
-    ('sweep', 'paper', [1000000000.0, 10000000000000.0], nan, 3)
+    ('sweep', 'paper', [1000000000.0, 10000000000000.0], nan, 4)
     """
     return _retrying(_describe, os.fspath(path))
 
