@@ -352,7 +352,7 @@ def potential_of(code, c, delta):
     return contact_potential(code, delta, c[K_], c[ALPHA_])
 
 
-@kernel(python=True)
+@kernel(python=True, inline="always")  # read at every step of a stick (the stick-break event)
 def stick_bound(code, delta, K, damping, alpha):
     """The largest force a stuck Filippov contact gives at ``delta`` (N): ``|P(delta, 0)|``, the
     law's force at rest (``paper``: its elastic term ``K |delta|^alpha``). The stick holds while
