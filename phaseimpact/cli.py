@@ -506,6 +506,13 @@ def cmd_cases(args) -> int:
     return EXIT_OK
 
 
+def cmd_completion(args) -> int:
+    import shtab
+
+    print(shtab.complete(build_parser(), shell=args.shell, root_prefix="phaseimpact"))
+    return EXIT_OK
+
+
 def cmd_check_law(args) -> int:
     from .checks import check_law
     from .model import REGISTRY, law_variants
@@ -1422,6 +1429,13 @@ def build_parser() -> argparse.ArgumentParser:
     json_option(p)
     p.set_defaults(func=cmd_cases)
 
+    p = sub.add_parser("completion", help="the shell completion script (bash or zsh)",
+                       description="Print the completion script of phaseimpact's commands and options for a shell, "
+                                   "generated from this parser (shtab); e.g. in ~/.bashrc: "
+                                   "eval \"$(phaseimpact completion bash)\".")
+    p.add_argument("shell", choices=("bash", "zsh"), help="the shell")
+    p.set_defaults(func=cmd_completion)
+
     p = sub.add_parser("warmup", help="compile the engine ahead, and say where its cache is",
                        description="Compile every entry of the engine into its cache now (the first command that "
                                    "integrates would otherwise do it, ~20 s), and say where the cache is: for shared "
@@ -1749,7 +1763,7 @@ def cmd_orbit_diagram(args) -> int:
 
 
 #: Commands that compile and integrate nothing: they start without the engine (numba, SciPy).
-_INTEGRATE_NOTHING = ("cases", "params")
+_INTEGRATE_NOTHING = ("cases", "params", "completion")
 
 
 def _stopped(stop: KeyboardInterrupt) -> str:

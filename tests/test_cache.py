@@ -185,7 +185,8 @@ def test_a_complete_cache_is_read_where_it_cannot_be_written(tmp_path, monkeypat
     assert info.path == locked / name and not info.writable
 
 
-@pytest.mark.parametrize("argv", [["cases"], ["params"], ["--version"], ["--help"], ["cases", "--json"]])
+@pytest.mark.parametrize("argv", [["cases"], ["params"], ["--version"], ["--help"], ["cases", "--json"],
+                                  ["completion", "bash"]])
 def test_commands_that_integrate_nothing_import_no_numba(argv):
     """Their start-up is Python's and phaseimpact's own (NumPy alone is 0.1-0.2 s of it)."""
     code = ("import sys\nfrom phaseimpact.cli import main\ntry:\n    main(sys.argv[1:])\nexcept SystemExit:\n"

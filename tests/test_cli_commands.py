@@ -517,3 +517,18 @@ def test_no_progress_bar_goes_into_a_log(tmp_path):
                         "--t-end", "1e-3", "--out", tmp_path / "s.h5"])
     assert code == 0
     assert "pt/s" not in err and "%|" not in err and "\r" not in err, err
+
+
+@pytest.mark.parametrize("shell", ["bash", "zsh"])
+def test_shell_completion_knows_every_command_and_option(shell):
+    from phaseimpact.cli import build_parser
+
+    code, out, _ = run(["completion", shell])
+    assert code == 0
+    commands = next(a for a in build_parser()._actions if a.dest == "command").choices
+    for name, sub in commands.items():
+        assert name in out, name
+        for action in sub._actions:
+            for option in action.option_strings:
+                if option.startswith("--"):
+                    assert option in out, (name, option)
