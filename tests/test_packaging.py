@@ -1,0 +1,61 @@
+"""What the distributions carry: the sdist is enough to run the tests, the wheel carries the physics
+notes that archives cite."""
+
+import subprocess
+import sys
+import tarfile
+import zipfile
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+#: Everything a test imports or reads from the source tree.
+NEEDED = ("tests", "studies", "docs", "benchmarks")
+
+pytestmark = pytest.mark.slow
+
+
+def _build(kind: str, out: Path) -> Path:
+    code = f"from setuptools import build_meta as b; print(b.build_{kind}({str(out)!r}))"
+    done = subprocess.run([sys.executable, "-c", code], cwd=ROOT, capture_output=True, text=True, check=True)
+    return out / done.stdout.strip().splitlines()[-1]
+
+
+def _source_files() -> set[str]:
+    """The tracked files under :data:`NEEDED` (the working tree's files where git is missing)."""
+    try:
+        listed = subprocess.run(["git", "ls-files", *NEEDED], cwd=ROOT, capture_output=True, text=True, check=True)
+        return set(listed.stdout.split())
+    except (OSError, subprocess.CalledProcessError):
+        return {str(p.relative_to(ROOT)) for d in NEEDED for p in (ROOT / d).rglob("*")
+                if p.is_file() and "__pycache__" not in p.parts and "results" not in p.parts}
+
+
+def test_sdist_has_every_test_input_and_its_tests_run(tmp_path):
+    sdist = _build("sdist", tmp_path)
+    with tarfile.open(sdist) as tar:
+        top = tar.getnames()[0].split("/")[0]
+        names = {n.removeprefix(top + "/") for n in tar.getnames()}
+        tar.extractall(tmp_path / "unpacked", filter="data")
+    missing = sorted(_source_files() - names)
+    assert not missing, f"files the tests need are not in the sdist: {missing[:10]}"
+    assert {"tests/conftest.py", "tests/oracle.py", "Makefile", "mkdocs.yml", "phaseimpact/docs/physics.md"} <= names
+    # Collecting every test imports each test module, conftest and oracle from the unpacked sdist.
+    tree = tmp_path / "unpacked" / top
+    collected = subprocess.run([sys.executable, "-m", "pytest", "--collect-only", "-q", "-p", "no:cacheprovider",
+                                "tests"], cwd=tree, capture_output=True, text=True)
+    assert collected.returncode == 0, collected.stdout[-2000:] + collected.stderr[-2000:]
+    assert " tests collected" in collected.stdout
+    ran = subprocess.run([sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", "tests/test_parameters.py"],
+                         cwd=tree, capture_output=True, text=True)
+    assert ran.returncode == 0, ran.stdout[-2000:]
+
+
+def test_wheel_carries_the_physics_notes_archives_cite(tmp_path):
+    wheel = _build("wheel", tmp_path)
+    with zipfile.ZipFile(wheel) as whl:
+        notes = whl.read("phaseimpact/docs/physics.md").decode()
+        assert "py.typed" in " ".join(whl.namelist())
+    assert notes == (ROOT / "docs" / "physics.md").read_text()
+    assert "§5" in notes or "## 5" in notes
