@@ -37,8 +37,8 @@ RTOL = 1e-10
 
 
 def cli_command(n: int, out: Path, jobs: int) -> list[str]:
-    return [str(VENV_BIN / "phaseimpact"), "sweep", "--law", "paper", "--v", "1", "--kappa-min", "1e8",
-            "--kappa-max", "1e13", "--num", str(n), "--out", str(out), "--no-progress", "--force", "--jobs", str(jobs)]
+    return [str(VENV_BIN / "phaseimpact"), "sweep", "--law", "paper", "--v", "1", "--axis", f"kappa=1e8:1e13:{n}:log",
+            "--out", str(out), "--no-progress", "--force", "--jobs", str(jobs)]
 
 
 def time_cli(n: int, jobs: int, repeats: int) -> tuple[float, list[float]]:

@@ -44,6 +44,8 @@ RESTITUTION_RANGE = (1e-6, 1.0)
 MAX_SWEEP_POINTS = 10_000_000
 #: Values of one critical curve (each is a root search).
 MAX_CURVE_POINTS = 1000
+#: The range syntax every command that computes over values takes (``--axis``).
+RANGE_METAVAR = "NAME=START:STOP:NUM[:log]"
 #: kappa samples of a transition search (each is one run), and the default.
 SAMPLES_RANGE = (8, 10_000)
 DEFAULT_SAMPLES = 96
@@ -795,6 +797,13 @@ def _resume_command(argv) -> str:
     return shlex.join(words)
 
 
+def _one_axis(args, note=""):
+    """The one ``--axis`` of a command that runs over one parameter."""
+    if len(args.axis) != 1:
+        raise ValueError(f"axis is given {len(args.axis)} times; allowed: once for {args.command}{note}")
+    return args.axis[0]
+
+
 def _check_grid_options(args) -> None:
     if args.backend != "dask" and args.jobs > MAX_JOBS:  # the parser allows a Dask cluster's task count
         raise ValueError(f"jobs = {args.jobs!r} is out of range for --backend {args.backend}; allowed: an integer "
@@ -952,22 +961,12 @@ def _finish_grid(args, result, setup: Setup) -> int:
     return EXIT_OK
 
 
-def cmd_sweep(args) -> int:
-    import numpy as np
-
-    from .continuation import Axis
-
-    _check_grid_options(args)
-    _check_kappa_range(args)
-    setup = _setup(args)
-    _check_reads_kappa(setup.law, "point of a kappa sweep")
-    axis = Axis("kappa", np.geomspace(args.kappa_min, args.kappa_max, args.num), log=True)
-    return _finish_grid(args, _run_grid(args, setup, [axis]), setup)
-
-
 def cmd_atlas(args) -> int:
+    """``atlas`` and ``sweep`` (an atlas of one axis)."""
     import numpy as np
 
+    if args.command == "sweep":
+        _one_axis(args, " (atlas takes a grid)")
     _check_grid_options(args)
     setup = _setup(args)
     names = [axis.name for axis in args.axis]
@@ -1013,46 +1012,30 @@ def cmd_atlas(args) -> int:
 # ------------------------------------------------------------------------------------------------
 
 def _curve_values(args, setup: Setup):
-    """``(param, values)`` of a critical curve, checked (both ends valid cases) before any work."""
+    """``(param, values)`` of a critical curve, checked (every value a valid case) before any work."""
     import numpy as np
 
-    shorthand = args.v_min is not None or args.v_max is not None
-    if shorthand and (args.param is not None or args.from_ is not None or args.to is not None):
-        raise ValueError("--v-min/--v-max and --param/--from/--to contradict each other: --v-min A --v-max B is "
-                         "short for --param v --from A --to B --log; give one form")
-    if shorthand:
-        if args.v_min is None or args.v_max is None:
-            raise ValueError("v-min, v-max: allowed: both, or --param v --from A --to B")
-        param, start, stop, log = "v", args.v_min, args.v_max, True
-        label = ("v-min", "v-max")
-    else:
-        if args.param is None or args.from_ is None or args.to is None:
-            missing = [o for o, v in (("--param", args.param), ("--from", args.from_), ("--to", args.to)) if v is None]
-            raise ValueError(f"{', '.join(m.lstrip('-') for m in missing)} missing; allowed: --param NAME --from A "
-                             "--to B (or --v-min A --v-max B)")
-        param, start, stop, log = args.param, args.from_, args.to, args.log
-        label = ("from", "to")
+    axis = _one_axis(args)
+    param, values = axis.name, axis.values
     allowed = [*CURVE_PARAMETERS, *(n for n in QUANTITIES if n not in CURVE_PARAMETERS)]
     if param not in allowed:
-        raise ValueError(f"param = {param!r} is out of range; allowed: one of {', '.join(allowed)}"
+        raise ValueError(f"axis {param!r} is out of range; allowed: one of {', '.join(allowed)}"
                          + (" (kappa is what the curve continues)" if param == "kappa" else ""))
+    if len(values) > MAX_CURVE_POINTS:
+        raise ValueError(f"axis {param!r} has {len(values)} values; allowed: at most {MAX_CURVE_POINTS}")
     if param == "v" and _given(args, "v"):
-        raise ValueError("param = 'v' and --v contradict each other: the curve runs over v; give one")
+        raise ValueError("axis 'v' and --v contradict each other: the curve runs over v; give one")
     if param in _setting_names(args):
-        raise ValueError(f"param = {param!r} is also given as --set {param}=...: the curve runs over it; give one")
-    if not start < stop:
-        raise ValueError(f"{label[0]} = {start!r}, {label[1]} = {stop!r} are out of range; allowed: "
-                         f"{label[0]} < {label[1]}")
-    if log and start <= 0:
-        raise ValueError(f"{label[0]} = {start!r} is out of range with --log; allowed: {label[0]} > 0")
-    for name, value in zip(label, (start, stop), strict=True):
+        raise ValueError(f"axis {param!r} is also given as --set {param}=...: the curve runs over it; give one")
+    if not np.all(np.diff(values) > 0):
+        raise ValueError(f"axis {param!r} = {values.tolist()!r} is out of range; allowed: increasing values")
+    for value in (values[0], values[-1]):
         if param == "v":
-            _check_in_range("v", value, *V_RANGE, "m/s", f"--{name}")
+            _check_in_range("v", float(value), *V_RANGE, "m/s", "axis v")
         try:
-            setup.case.parameters(**{param: value})
+            setup.case.parameters(**{param: float(value)})
         except ValueError as error:
-            raise ValueError(f"{name} = {value!r} is out of range for param {param!r}: {error}") from None
-    values = np.geomspace(start, stop, args.num) if log else np.linspace(start, stop, args.num)
+            raise ValueError(f"axis {param!r} value {float(value)!r} is out of range: {error}") from None
     return param, values
 
 
@@ -1368,6 +1351,14 @@ def build_parser() -> argparse.ArgumentParser:
                        help=f"{what}, s, a finite number > 0 (default: each run until its outcome settles, "
                             "capped by the case's own time scales)")
 
+    def axis_option(p, what, *, repeat=False, names="kappa, v, M1, M2, K, Kb, Km, alpha and the --set names",
+                    limit=MAX_SWEEP_POINTS):
+        """The one range syntax of every command that computes over a list of values."""
+        p.add_argument("--axis", type=_axis, action="append", required=True, metavar=RANGE_METAVAR,
+                       help=f"{what}: NAME=START:STOP:NUM (NUM values, linear; with :log, log spaced) or "
+                            f"NAME=V1,V2,...; names: {names}; at most {limit} values in all"
+                            + ("" if repeat else "; once"))
+
     def kappa_range(p, required, default_text=""):
         kmin = _real("kappa-min", 0.0, KAPPA_MAX, low_open=True, unit=KAPPA_UNIT)
         kmax = _real("kappa-max", 0.0, KAPPA_MAX, low_open=True, unit=KAPPA_UNIT)
@@ -1519,48 +1510,37 @@ def build_parser() -> argparse.ArgumentParser:
     json_option(p)
     p.set_defaults(func=cmd_transitions)
 
-    p = add("sweep", "a kappa sweep archived to HDF5",
-            "Every kappa of a log grid, each run until its outcome settles (or to --t-end), archived to HDF5 and "
-            "checkpointed after every chunk.")
-    case_options(p)
-    law_options(p)
-    speed(p)
-    target(p)
-    kappa_range(p, True)
-    p.add_argument("--num", type=_integer("num", 2, MAX_SWEEP_POINTS), default=50,
-                   help=f"number of kappa values (log spaced), 2 <= NUM <= {MAX_SWEEP_POINTS} (default: %(default)s)")
-    horizon(p)
-    tolerance(p)
-    parallel(p)
-    out_options(p, resume=True)
-    json_option(p)
-    p.set_defaults(func=cmd_sweep)
-
-    p = add("atlas", "outcomes over a grid of any parameters, archived to HDF5",
-            "Every point of a grid over named parameters (kappa, v, M1, ..., and every settable quantity of the "
-            "case), each run until its outcome settles (or to --t-end): outcome class, stick phases, contacts, "
-            "T_run, max force... Archived to HDF5 and checkpointed after every chunk.")
-    case_options(p)
-    law_options(p)
-    speed(p)
-    damping(p)
-    target(p)
-    p.add_argument("--axis", type=_axis, action="append", required=True, metavar="NAME=START:STOP:NUM[:log]",
-                   help="one axis of the grid (repeat for each): NAME=START:STOP:NUM (linear), with :log for log "
-                        "spacing, or NAME=V1,V2,...; names: kappa, v, M1, M2, K, Kb, Km, alpha and the --set names; "
-                        f"at most {MAX_SWEEP_POINTS} points in all; an axis the law does not read is refused")
-    p.add_argument("--refine", default=None, metavar="AXIS",
-                   help="after the grid, locate every class boundary between neighbours along AXIS (one of the "
-                        "--axis names) by bisection, to --refine-rtol, and store the boundary points in the "
-                        "archive (plot draws them); default: no refinement")
-    p.add_argument("--refine-rtol", type=_real("refine-rtol", 1e-12, 1e-2), default=1e-8,
-                   help="relative width of each refined boundary bracket (1e-12..1e-2; default %(default)g)")
-    horizon(p)
-    tolerance(p)
-    parallel(p)
-    out_options(p, resume=True)
-    json_option(p)
-    p.set_defaults(func=cmd_atlas)
+    grid_commands = (
+        ("sweep", "one axis: a sweep of kappa (or any parameter), archived to HDF5",
+         "Every value of one axis (usually kappa: --axis kappa=1e9:1e12:50:log), each run until its outcome settles "
+         "(or to --t-end): outcome class, stick phases, contacts, T_run, max force... Archived to HDF5 and "
+         "checkpointed after every chunk. The same as atlas with one axis."),
+        ("atlas", "outcomes over a grid of any parameters, archived to HDF5",
+         "Every point of a grid over named parameters (kappa, v, M1, ..., and every settable quantity of the "
+         "case), each run until its outcome settles (or to --t-end): outcome class, stick phases, contacts, "
+         "T_run, max force... Archived to HDF5 and checkpointed after every chunk."),
+    )
+    for name, summary, description in grid_commands:
+        p = add(name, summary, description)
+        case_options(p)
+        law_options(p)
+        speed(p)
+        damping(p)
+        target(p)
+        axis_option(p, "the sweep's values" if name == "sweep" else "one axis of the grid (repeat for each)",
+                    repeat=True)
+        p.add_argument("--refine", default=None, metavar="AXIS",
+                       help="after the grid, locate every class boundary between neighbours along AXIS (one of the "
+                            "--axis names) by bisection, to --refine-rtol, and store the boundary points in the "
+                            "archive (plot draws them); default: no refinement")
+        p.add_argument("--refine-rtol", type=_real("refine-rtol", 1e-12, 1e-2), default=1e-8,
+                       help="relative width of each refined boundary bracket (1e-12..1e-2; default %(default)g)")
+        horizon(p)
+        tolerance(p)
+        parallel(p)
+        out_options(p, resume=True)
+        json_option(p)
+        p.set_defaults(func=cmd_atlas)
 
     p = add("critical-curve", "kappa_c, kappa_2 or a grazing value against a parameter, archived to HDF5",
             "A transition continued over a second parameter (v, a material or a geometry quantity): kappa_c or "
@@ -1571,20 +1551,8 @@ def build_parser() -> argparse.ArgumentParser:
     speed(p)
     target(p)
     curve_params = ", ".join([*CURVE_PARAMETERS, *(n for n in QUANTITIES if n not in CURVE_PARAMETERS)])
-    p.add_argument("--param", default=None, metavar="NAME",
-                   help=f"the parameter the curve runs over: {curve_params} (default: none; --v-min/--v-max "
-                        "imply v)")
-    p.add_argument("--from", dest="from_", type=_real("from"), default=None, metavar="A",
-                   help="first value of --param, in its SI unit (default: none)")
-    p.add_argument("--to", type=_real("to"), default=None, metavar="B",
-                   help="last value of --param, in its SI unit, B > A (default: none)")
-    p.add_argument("--log", action="store_true", help="log-spaced values (default: linear spacing)")
-    p.add_argument("--v-min", type=_real("v-min", *V_RANGE, unit="m/s"), default=None,
-                   help=f"short for --param v --from V_MIN --log, m/s, {v_lo:g} <= V_MIN <= {v_hi:g} (default: none)")
-    p.add_argument("--v-max", type=_real("v-max", *V_RANGE, unit="m/s"), default=None,
-                   help=f"short for --to V_MAX with --v-min, m/s, V_MIN < V_MAX <= {v_hi:g} (default: none)")
-    p.add_argument("--num", type=_integer("num", 1, MAX_CURVE_POINTS), default=5,
-                   help=f"number of values, 1 <= NUM <= {MAX_CURVE_POINTS} (default: %(default)s)")
+    axis_option(p, "the parameter the curve runs over and its values, increasing, in its SI unit (e.g. "
+                "v=0.5:10:20:log)", names=curve_params, limit=MAX_CURVE_POINTS)
     p.add_argument("--what", choices=CURVE_WHATS, default="kappa_c",
                    help="what is continued: kappa_c or kappa_2 (law paper), or grazing (a unilateral law: the first "
                         "grazing value in [KAPPA_MIN, KAPPA_MAX] at the first value) (default: %(default)s)")
@@ -1649,7 +1617,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.set_defaults(func=cmd_train)
 
     p = add("orbit-diagram", "the impact map's attractor over T, kappa or v",
-            "The impact map iterated at each value of --param (the period T, kappa or v) from a plate at rest: "
+            "The impact map iterated at each value of --axis (the period T, kappa or v) from a plate at rest: "
             "--transients impacts dropped, then --samples plate states kept (one point each); the number of "
             "distinct points tells a fixed point (1), a period-k orbit (k) or irregular motion.")
     case_options(p)
@@ -1657,15 +1625,10 @@ def build_parser() -> argparse.ArgumentParser:
     speed(p)
     damping(p)
     target(p)
-    p.add_argument("--param", choices=("T", "kappa", "v"), required=True, help="the parameter varied")
-    p.add_argument("--from", dest="from_", type=_real("from"), required=True, metavar="A",
-                   help="first value (s, N s/m^(1+alpha) or m/s)")
-    p.add_argument("--to", type=_real("to"), required=True, metavar="B", help="last value")
-    p.add_argument("--num", type=_integer("num", 1, MAX_CURVE_POINTS), default=50,
-                   help=f"values, 1 to {MAX_CURVE_POINTS} (default: %(default)s)")
-    p.add_argument("--log", action="store_true", help="log-spaced values (default: linear spacing)")
+    axis_option(p, "the parameter varied and its values (s, N s/m^(1+alpha) or m/s; e.g. T=2e-3:8e-3:400)",
+                names="T, kappa, v", limit=MAX_CURVE_POINTS)
     p.add_argument("--period", type=_real("period", 0.0, None, low_open=True, unit="s"), default=None, metavar="T",
-                   help="time between arrivals (s) when --param is not T (default: none)")
+                   help="time between arrivals (s) when the axis is not T (default: none)")
     p.add_argument("--transients", type=_integer("transients", 0, 100_000), default=200,
                    help="impacts dropped at each value (default: %(default)s)")
     p.add_argument("--samples", type=_integer("samples", 1, 100_000), default=50,
@@ -1721,33 +1684,39 @@ def cmd_orbit_diagram(args) -> int:
     import numpy as np
 
     from . import plotting
-    from .train import orbit_diagram
+    from .train import TRAIN_PARAMETERS, orbit_diagram
 
     if args.out is not None:
         _check_figure_target(args.out, args.force)
     setup = _setup(args)
-    if args.param != "T" and args.period is None:
-        raise ValueError(f"period = None is out of range for --param {args.param}; allowed: --period T (s) > 0")
-    if args.param == "kappa":
+    axis = _one_axis(args)
+    param, values = axis.name, axis.values
+    if param not in TRAIN_PARAMETERS:
+        raise ValueError(f"axis {param!r} is out of range; allowed: one of {', '.join(TRAIN_PARAMETERS)}")
+    if len(values) > MAX_CURVE_POINTS:
+        raise ValueError(f"axis {param!r} has {len(values)} values; allowed: at most {MAX_CURVE_POINTS}")
+    if param != "T" and args.period is None:
+        raise ValueError(f"period = None is out of range for axis {param}; allowed: --period T (s) > 0")
+    if param == "kappa":
         _check_reads_kappa(setup.law, "orbit-diagram value")
-    values = (np.geomspace(args.from_, args.to, args.num) if args.log else np.linspace(args.from_, args.to, args.num))
-    if args.param == "v":
-        for x in (args.from_, args.to):
-            _check_in_range("v", x, *V_RANGE, "m/s", "--from/--to")
-    elif args.param == "kappa":
-        for x in (args.from_, args.to):
-            _check_in_range("kappa", x, 0.0, KAPPA_MAX, KAPPA_UNIT, "--from/--to")
-    elif min(args.from_, args.to) <= 0:
-        raise ValueError(f"T = {min(args.from_, args.to)!r} is out of range; allowed: T > 0 (s)")
-    _note(f"orbit diagram of {setup.law.label()} over {args.param}: {args.num} values x "
+    low, high = float(np.min(values)), float(np.max(values))
+    if param == "v":
+        for x in (low, high):
+            _check_in_range("v", x, *V_RANGE, "m/s", "axis v")
+    elif param == "kappa":
+        for x in (low, high):
+            _check_in_range("kappa", x, 0.0, KAPPA_MAX, KAPPA_UNIT, "axis kappa")
+    elif low <= 0:
+        raise ValueError(f"T = {low!r} is out of range; allowed: T > 0 (s)")
+    _note(f"orbit diagram of {setup.law.label()} over {param}: {len(values)} values x "
           f"{args.transients + args.samples} impacts")
-    diagram = orbit_diagram(setup.params, setup.law, args.param, values, period=args.period,
+    diagram = orbit_diagram(setup.params, setup.law, param, values, period=args.period,
                             transients=args.transients, samples=args.samples, rtol=args.rtol, n_jobs=args.jobs)
     if args.out is not None:
         with exclusive(args.out, "out"):
             title = f"{setup.law.label()}, {setup.case.name}, v = {setup.params.v:g} m/s"
             plotting.save(plotting.plot_orbit_diagram(diagram, title=title), args.out)
-    out = {"out": args.out, **_law_fields(setup), "v": setup.params.v, "param": args.param,
+    out = {"out": args.out, **_law_fields(setup), "v": setup.params.v, "param": param,
            "period": args.period, "values": diagram.values.tolist(), "transients": args.transients,
            "samples": args.samples, "distinct": diagram.distinct.tolist(),
            "x2": diagram.plate[:, :, 0].tolist(), "x2dot": diagram.plate[:, :, 1].tolist(),
@@ -1756,7 +1725,7 @@ def cmd_orbit_diagram(args) -> int:
         _print_json(args, out)
     else:
         counts = {int(k): int(n) for k, n in zip(*np.unique(diagram.distinct, return_counts=True), strict=True)}
-        print(f"orbit diagram over {args.param}: {args.num} values; distinct points after {args.transients} "
+        print(f"orbit diagram over {param}: {len(values)} values; distinct points after {args.transients} "
               f"impacts (1: fixed point, k: period k, {args.samples}: irregular): {counts}"
               + (f"; wrote {args.out}" if args.out else ""))
     return EXIT_OK

@@ -21,7 +21,7 @@ from phaseimpact.continuation import sweep
 from phaseimpact.model import ContactLaw
 
 CLI = [sys.executable, "-m", "phaseimpact.cli"]
-SWEEP = ["sweep", "--law", "paper", "--v", "1", "--kappa-min", "1e9", "--kappa-max", "1e14", "--num", "40",
+SWEEP = ["sweep", "--law", "paper", "--v", "1", "--axis", "kappa=1e9:1e14:40:log",
          "--no-progress"]
 
 
@@ -179,7 +179,7 @@ def test_out_refuses_foreign_file_and_other_work_unless_force(tmp_path, capsys):
     out = tmp_path / "s.h5"
     assert main([*SWEEP, "--out", str(out)]) == 0
     before = out.read_bytes()
-    other = [a if a != "40" else "41" for a in SWEEP]  # a different grid
+    other = [a.replace(":40:", ":41:") for a in SWEEP]  # a different grid
     assert main([*other, "--out", str(out)]) == 2
     err = capsys.readouterr().err
     assert "holds other work" in err and "--force" in err
@@ -195,7 +195,7 @@ def test_out_refuses_foreign_file_and_other_work_unless_force(tmp_path, capsys):
 
 def test_resume_onto_wrong_kind_or_other_work_is_refused(tmp_path, capsys):
     curve = tmp_path / "curve.h5"
-    assert main(["critical-curve", "--v-min", "1", "--v-max", "2", "--num", "2", "--no-progress",
+    assert main(["critical-curve", "--axis", "v=1:2:2:log", "--no-progress",
                  "--out", str(curve)]) == 0
     before = curve.read_bytes()
     assert main([*SWEEP, "--out", str(curve), "--resume"]) == 2
@@ -309,7 +309,7 @@ KILL_AFTER = textwrap.dedent("""
 def test_sweep_killed_after_two_checkpoints_then_resumed_equals_uninterrupted(tmp_path):
     """SIGKILL after the 2nd checkpoint leaves a valid partial archive; --resume completes it without
     recomputing finished points and gives the numbers of an uninterrupted run."""
-    args = [*SWEEP[:-2], "64", "--no-progress"]
+    args = [a.replace(":40:", ":64:") for a in SWEEP]
     partial = tmp_path / "partial.h5"
     env = {**os.environ, "KILL_AFTER": "2"}
     killed = subprocess.run([sys.executable, "-c", KILL_AFTER, *args, "--out", str(partial)], env=env,
@@ -464,10 +464,10 @@ def test_a_resume_of_other_work_names_what_differs_with_the_asked_value(tmp_path
     from _cli import run
 
     out = tmp_path / "s.h5"
-    base = ["sweep", "--law", "paper", "--v", "1", "--kappa-min", "1e9", "--kappa-max", "1e14", "--num", "5",
+    base = ["sweep", "--law", "paper", "--v", "1", "--axis", "kappa=1e9:1e14:5:log",
             "--no-progress", "--out", out]
     assert run(base)[0] == 0
     code, _, err = run([*base, "--t-end", "0.01", "--resume"])
     assert code == 2 and "t_end none (each run until its outcome settles) (asked 0.01 s)" in err, err
-    code, _, err = run([*base[:8], "1.0000000001e14", *base[9:], "--resume"])
+    code, _, err = run([*base[:6], "kappa=1e9:1.0000000001e14:5:log", *base[7:], "--resume"])
     assert code == 2 and "100000000010000.0" in err, err

@@ -24,7 +24,7 @@ from phaseimpact.integrate import OUTCOMES, STATUSES
 from phaseimpact.integrate import driver as _driver
 
 KAPPAS = np.geomspace(1e9, 1e14, 6)
-SWEEP_ARGS = ["sweep", "--law", "paper", "--v", "1", "--kappa-min", "1e9", "--kappa-max", "1e14", "--num", "6",
+SWEEP_ARGS = ["sweep", "--law", "paper", "--v", "1", "--axis", "kappa=1e9:1e14:6:log",
               "--no-progress"]
 
 

@@ -237,7 +237,7 @@ def test_transitions_paper_starts_at_kappa_c():
 
 def test_critical_curve_over_v_archive_round_trip_and_independent_searches(tmp_path):
     path = tmp_path / "curve.h5"
-    out = run_json(["critical-curve", "--law", "paper", "--param", "v", "--from", "1", "--to", "3", "--num", "3",
+    out = run_json(["critical-curve", "--law", "paper", "--axis", "v=1:3:3",
                     "--no-progress", "--out", path])
     assert_finite(out)
     assert out["param"] == "v" and out["what"] == "kappa_c" and out["values"] == [1.0, 2.0, 3.0]  # linear
@@ -253,22 +253,21 @@ def test_critical_curve_over_v_archive_round_trip_and_independent_searches(tmp_p
     assert out["kappa"][-1] == pytest.approx(single.kappa_c, rel=1e-8)
     closed = np.asarray(out["closed_form"])
     assert np.allclose(out["kappa"], closed, rtol=2.5e-3)  # REFERENCE §5 at every speed
-    # the old spelling: log-spaced speeds
-    short = run_json(["critical-curve", "--v-min", "1", "--v-max", "4", "--num", "3", "--no-progress",
+    # log-spaced speeds
+    short = run_json(["critical-curve", "--axis", "v=1:4:3:log", "--no-progress",
                       "--out", tmp_path / "short.h5"])
     assert np.allclose(short["v"], [1.0, 2.0, 4.0]) and short["kappa_c"][0] == pytest.approx(out["kappa"][0])
 
 
 def test_critical_curve_kappa_2_over_a_material_and_grazing_over_v(tmp_path):
-    k2 = run_json(["critical-curve", "--param", "plate.E", "--from", "1e11", "--to", "2e11", "--num", "2",
+    k2 = run_json(["critical-curve", "--axis", "plate.E=1e11:2e11:2",
                    "--what", "kappa_2", "--no-progress", "--out", tmp_path / "k2.h5"])
-    kc = run_json(["critical-curve", "--param", "plate.E", "--from", "1e11", "--to", "2e11", "--num", "2",
+    kc = run_json(["critical-curve", "--axis", "plate.E=1e11:2e11:2",
                    "--no-progress", "--out", tmp_path / "kc.h5"])
     assert all(b > a for a, b in zip(kc["kappa"], k2["kappa"], strict=True))
     assert archive.load(tmp_path / "k2.h5").what == "kappa_2"
-    graz = run_json(["critical-curve", "--law", "hunt-crossley", "--param", "v", "--from", "1", "--to", "2",
-                     "--num", "2", "--what", "grazing", "--kappa-min", "1e8", "--kappa-max", "1e13",
-                     "--no-progress", "--out", tmp_path / "g.h5"])
+    graz = run_json(["critical-curve", "--law", "hunt-crossley", "--axis", "v=1:2:2", "--what", "grazing",
+                     "--kappa-min", "1e8", "--kappa-max", "1e13", "--no-progress", "--out", tmp_path / "g.h5"])
     first = run_json(["transitions", "--law", "hunt-crossley", "--v", "1", "--kappa-min", "1e8", "--kappa-max",
                       "1e13"])["transitions"][0]
     assert graz["kappa"][0] == pytest.approx(first["kappa"], rel=1e-8)
@@ -280,7 +279,7 @@ def test_critical_curve_kappa_2_over_a_material_and_grazing_over_v(tmp_path):
 
 def test_critical_curve_refuses_to_replace_another_curve(tmp_path):
     path = tmp_path / "c.h5"
-    base = ["critical-curve", "--param", "v", "--from", "1", "--to", "2", "--num", "2", "--no-progress", "--out", path]
+    base = ["critical-curve", "--axis", "v=1:2:2", "--no-progress", "--out", path]
     assert run(base)[0] == 0
     assert run(base)[0] == 0  # the same work: replaced (intermediate steps do not count as other work)
     code, _, err = run([*base, "--what", "kappa_2"])
@@ -356,9 +355,9 @@ def test_plot_draws_an_atlas_a_sweep_and_a_curve(tmp_path):
     atlas_h5, sweep_h5, curve_h5 = tmp_path / "a.h5", tmp_path / "s.h5", tmp_path / "c.h5"
     assert run(["atlas", "--law", "paper", "--axis", "kappa=1e11:1e13:12:log", "--axis", "v=1:3:4",
                 "--no-progress", "--out", atlas_h5])[0] == 0
-    assert run(["sweep", "--kappa-min", "1e11", "--kappa-max", "1e13", "--num", "12", "--no-progress",
+    assert run(["sweep", "--axis", "kappa=1e11:1e13:12:log", "--no-progress",
                 "--out", sweep_h5])[0] == 0
-    assert run(["critical-curve", "--param", "v", "--from", "1", "--to", "3", "--num", "3", "--no-progress",
+    assert run(["critical-curve", "--axis", "v=1:3:3", "--no-progress",
                 "--out", curve_h5])[0] == 0
     for archive_path, kind, extra in ((atlas_h5, "atlas", ["--contours", "n_stick", "--curve", curve_h5]),
                                       (sweep_h5, "sweep", []), (curve_h5, "curve", [])):
@@ -378,7 +377,7 @@ def test_plot_refuses_what_it_cannot_draw_or_would_destroy(tmp_path):
     code, _, err = run(["plot", notes, "--out", tmp_path / "x.png"])
     assert code == 2 and "not a readable HDF5 file" in err
     curve_h5 = tmp_path / "c.h5"
-    assert run(["critical-curve", "--param", "v", "--from", "1", "--to", "2", "--num", "2", "--no-progress",
+    assert run(["critical-curve", "--axis", "v=1:2:2", "--no-progress",
                 "--out", curve_h5])[0] == 0
     before = curve_h5.read_bytes()
     code, _, err = run(["plot", curve_h5, "--out", curve_h5])
@@ -423,7 +422,8 @@ def no_work(monkeypatch):
         monkeypatch.setattr(module, name, forbidden)
 
 
-CURVE = ["critical-curve", "--num", "2", "--out", "a.h5"]
+CURVE = ["critical-curve", "--out", "a.h5"]
+OVER_V = [*CURVE, "--axis", "v=1:2:2"]
 BAD = [
     (["atlas", "--axis", "kappa=1:0:x", "--out", "a.h5"], "kappa"),
     (["atlas", "--axis", "foo=1:2:3", "--out", "a.h5"], "foo"),
@@ -440,30 +440,30 @@ BAD = [
     (["params", "--set", "R1"], "set"),
     (["simulate", "--case", "missing"], "case"),
     (["critical", "--case", "missing.toml"], "case"),
-    (["sweep", "--case", "missing", "--kappa-min", "1e9", "--kappa-max", "1e12", "--out", "a.h5"], "case"),
-    ([*CURVE, "--param", "kappa", "--from", "1", "--to", "2"], "kappa"),
-    ([*CURVE, "--param", "nope", "--from", "1", "--to", "2"], "param"),
-    ([*CURVE, "--param", "v", "--from", "2", "--to", "1"], "from"),
-    ([*CURVE, "--param", "v", "--from", "0", "--to", "1", "--log"], "from"),
-    ([*CURVE, "--param", "R1", "--from", "-0.01", "--to", "0.02"], "R1"),
-    ([*CURVE, "--param", "v", "--from", "1"], "to"),
-    ([*CURVE, "--param", "v", "--from", "1", "--to", "2", "--v", "3"], "v"),
-    ([*CURVE, "--param", "v", "--from", "1", "--to", "2", "--v-min", "1", "--v-max", "2"], "v-min"),
-    ([*CURVE, "--param", "v", "--from", "1", "--to", "2", "--what", "grazing", "--law", "paper", "--kappa-min",
+    (["sweep", "--case", "missing", "--axis", "kappa=1e9:1e12:3:log", "--out", "a.h5"], "case"),
+    ([*CURVE, "--axis", "kappa=1:2:2"], "kappa"),
+    ([*CURVE, "--axis", "nope=1:2:2"], "nope"),
+    ([*CURVE, "--axis", "v=2:1:2"], "axis"),
+    ([*CURVE, "--axis", "v=0:1:2:log"], "axis"),
+    ([*CURVE, "--axis", "R1=-0.01:0.02:2"], "R1"),
+    ([*CURVE, "--axis", "v=1:2"], "axis"),
+    ([*OVER_V, "--v", "3"], "v"),
+    ([*OVER_V, "--axis", "v=1:2:5:log"], "axis"),
+    ([*OVER_V, "--what", "grazing", "--law", "paper", "--kappa-min",
       "1e8", "--kappa-max", "1e13"], "grazing"),
-    ([*CURVE, "--param", "v", "--from", "1", "--to", "2", "--what", "grazing", "--law", "hunt-crossley"],
+    ([*OVER_V, "--what", "grazing", "--law", "hunt-crossley"],
      "kappa-min"),
-    ([*CURVE, "--param", "v", "--from", "1", "--to", "2", "--what", "kappa_c", "--law", "hunt-crossley"], "what"),
-    ([*CURVE, "--param", "v", "--from", "1", "--to", "2", "--kappa-min", "1e8"], "kappa-min"),
-    ([*CURVE, "--param", "v", "--from", "1", "--to", "2", "--what", "nonsense"], "what"),
+    ([*OVER_V, "--what", "kappa_c", "--law", "hunt-crossley"], "what"),
+    ([*OVER_V, "--kappa-min", "1e8"], "kappa-min"),
+    ([*OVER_V, "--what", "nonsense"], "what"),
     (["transitions", "--kappa-min", "1e12", "--kappa-max", "1e8"], "kappa-min"),
     (["transitions", "--law", "abrate", "--kappa-min", "1e8", "--kappa-max", "1e12"], "kappa"),
     (["transitions", "--kappa-min", "1e8", "--kappa-max", "1e12", "--samples", "3"], "samples"),
     (["transitions", "--law", "hunt-crossley", "--target", "free", "--kappa-min", "1e8", "--kappa-max", "1e12"],
      "target"),
-    ([*CURVE, "--param", "v", "--from", "1", "--to", "2", "--what", "grazing", "--law", "abrate", "--kappa-min",
+    ([*OVER_V, "--what", "grazing", "--law", "abrate", "--kappa-min",
       "1e8", "--kappa-max", "1e13"], "kappa"),
-    ([*CURVE, "--param", "v", "--from", "1", "--to", "2", "--what", "grazing", "--law", "hunt-crossley",
+    ([*OVER_V, "--what", "grazing", "--law", "hunt-crossley",
       "--target", "rigid", "--kappa-min", "1e8", "--kappa-max", "1e13"], "target"),
     (["critical", "--law", "hunt-crossley"], "law"),
     (["portrait", "--kappa", "1e9,abc", "--out", "p.png"], "kappa"),
@@ -513,7 +513,7 @@ def test_atlas_refine_axis_must_be_an_axis():
 
 def test_no_progress_bar_goes_into_a_log(tmp_path):
     """stderr redirected (a log file, a pipe): notes and errors only, never a bar's redraws."""
-    code, _, err = run(["sweep", "--law", "hunt-crossley", "--kappa-min", "1e9", "--kappa-max", "1e10", "--num", "4",
+    code, _, err = run(["sweep", "--law", "hunt-crossley", "--axis", "kappa=1e9:1e10:4:log",
                         "--t-end", "1e-3", "--out", tmp_path / "s.h5"])
     assert code == 0
     assert "pt/s" not in err and "%|" not in err and "\r" not in err, err

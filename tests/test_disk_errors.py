@@ -28,7 +28,11 @@ from phaseimpact.continuation import sweep
 from phaseimpact.model import ContactLaw
 
 CLI = [sys.executable, "-m", "phaseimpact.cli"]
-SWEEP = ["sweep", "--law", "paper", "--v", "1", "--kappa-min", "1e9", "--kappa-max", "1e14", "--no-progress"]
+SWEEP = ["sweep", "--law", "paper", "--v", "1", "--no-progress"]
+
+
+def kappas(num: int) -> list[str]:
+    return ["--axis", f"kappa=1e9:1e14:{num}:log"]
 
 
 
@@ -74,7 +78,7 @@ def test_a_sweep_whose_disk_fills_after_its_first_checkpoint_exits_1_and_keeps_i
         real(fd, end)
 
     monkeypatch.setattr(archive, "reserve", fills_once_the_archive_exists)
-    code, _, err = run([*SWEEP, "--num", "40", "--jobs", "1", "--out", path])
+    code, _, err = run([*SWEEP, *kappas(40), "--jobs", "1", "--out", path])
     assert code == 1, err
     assert err.strip() == f"phaseimpact: error: [Errno 28] No space left on device: {str(path)!r}"
     done = archive.load(path).done
@@ -130,7 +134,7 @@ def _said(stderr: str) -> str:
 
 def test_a_sweep_filling_a_real_disk_ends_in_one_line_and_keeps_its_checkpoint(tiny_disk):
     path = tiny_disk / "s.h5"
-    done = _cli(*SWEEP, "--num", "8000", "--jobs", "1", "--out", path, cwd=tiny_disk)
+    done = _cli(*SWEEP, *kappas(8000), "--jobs", "1", "--out", path, cwd=tiny_disk)
     assert done.returncode == 1, done.stderr  # not 139: no crash inside HDF5
     assert _said(done.stderr) == f"phaseimpact: error: [Errno 28] No space left on device: {str(path)!r}"
     assert sorted(p.name for p in tiny_disk.iterdir()) == ["s.h5"]  # no lock, no temporary file
@@ -146,7 +150,7 @@ def test_commands_on_a_disk_already_full_name_the_path_and_leave_no_lock(tiny_di
         while True:
             filler.write(b"\0" * 65536)
             filler.flush()
-    for argv, out in ((["plot", archive_path], "p.png"), ([*SWEEP, "--num", "20"], "s.h5")):
+    for argv, out in ((["plot", archive_path], "p.png"), ([*SWEEP, *kappas(20)], "s.h5")):
         done = _cli(*argv, "--out", tiny_disk / out, cwd=tmp_path)
         assert done.returncode == 1, done.stderr
         named = str(tiny_disk / out)
@@ -158,11 +162,11 @@ def test_commands_on_a_disk_already_full_name_the_path_and_leave_no_lock(tiny_di
 # Non-regular files
 # ------------------------------------------------------------------------------------------------
 
-@pytest.mark.parametrize("argv", [[*SWEEP, "--num", "5", "--out", "{fifo}"],
-                                  ["critical-curve", "--v-min", "0.5", "--v-max", "1", "--num", "2", "--out", "{fifo}"],
+@pytest.mark.parametrize("argv", [[*SWEEP, *kappas(5), "--out", "{fifo}"],
+                                  ["critical-curve", "--axis", "v=0.5:1:2:log", "--out", "{fifo}"],
                                   ["plot", "{fifo}", "--out", "{dir}/p.png"],
                                   ["plot", "{archive}", "--out", "{fifo_png}"],
-                                  [*SWEEP, "--num", "5", "--out", "/dev/null"]])
+                                  [*SWEEP, *kappas(5), "--out", "/dev/null"]])
 def test_a_fifo_or_a_device_is_refused_before_any_work(tmp_path, small_sweep, argv):
     fifo, fifo_png = tmp_path / "f.h5", tmp_path / "f.png"
     os.mkfifo(fifo)

@@ -36,9 +36,9 @@ def outputs(tmp_path_factory):
         "fixed-points": ["fixed-points"],
         "critical": ["critical", "--v", "2"],
         "transitions": ["transitions", "--law", "hunt-crossley", "--kappa-min", "1e8", "--kappa-max", "1e12"],
-        "sweep": ["sweep", *hc, "--kappa-min", "1e9", "--kappa-max", "1e10", "--num", "3", "--out", tmp / "s.h5"],
+        "sweep": ["sweep", *hc, "--axis", "kappa=1e9:1e10:3:log", "--out", tmp / "s.h5"],
         "atlas": ["atlas", *hc, "--axis", "kappa=1e9:1e10:2:log", "--axis", "v=1:2:2", "--out", tmp / "a.h5"],
-        "critical-curve": ["critical-curve", "--param", "v", "--from", "1", "--to", "2", "--num", "2",
+        "critical-curve": ["critical-curve", "--axis", "v=1:2:2",
                            "--out", tmp / "c.h5"],
         "check-law": ["check-law", "abrate"],
         "warmup": ["warmup"],
@@ -46,8 +46,8 @@ def outputs(tmp_path_factory):
         "portrait": ["portrait", "--kappa", "3e9", "--out", tmp / "p.png"],
         "train": ["train", "--law", "hunt-crossley", "--kappa", "3e9", "--period", "3e-3", "--impacts", "3",
                   "--fixed-point"],
-        "orbit-diagram": ["orbit-diagram", "--law", "hunt-crossley", "--param", "T", "--from", "2e-3", "--to", "3e-3",
-                          "--num", "2", "--transients", "3", "--samples", "2"],
+        "orbit-diagram": ["orbit-diagram", "--law", "hunt-crossley", "--axis", "T=2e-3:3e-3:2", "--transients", "3",
+                          "--samples", "2"],
     }
     out = {}
     for name, argv in argvs.items():  # in order: plot reads the sweep's archive

@@ -104,7 +104,7 @@ def test_unit_in_the_cli_json_and_archive(tmp_path, capsys):
     assert main(["simulate", "--law", "kuwabara-kono", "--kappa", "1e4"]) == 0
     assert "gamma = 1e+04 N s/m^1.5" in capsys.readouterr().out
     path = tmp_path / "kk.h5"
-    assert main(["sweep", "--law", "kuwabara-kono", "--kappa-min", "1e3", "--kappa-max", "1e5", "--num", "3",
+    assert main(["sweep", "--law", "kuwabara-kono", "--axis", "kappa=1e3:1e5:3:log",
                  "--out", str(path), "--no-progress"]) == 0
     with h5py.File(path) as f:
         assert f["kappa"].attrs["units"] == "N s m-1.5"

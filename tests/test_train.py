@@ -92,7 +92,7 @@ def test_bad_input_is_refused_before_any_work():
         impact_train(SEED, "abrate", 1e-3, 0)
     with pytest.raises(ValueError, match="param = 'M1'"):
         orbit_diagram(SEED, "abrate", "M1", [1.0])
-    code, _, err = run(["orbit-diagram", "--law", "abrate", "--param", "v", "--from", "1", "--to", "2"])
+    code, _, err = run(["orbit-diagram", "--law", "abrate", "--axis", "v=1:2:3"])
     assert code == 2 and "--period" in err
     code, _, err = run(["train", "--law", "abrate", "--period", "0"])
     assert code == 2 and "period" in err

@@ -151,7 +151,7 @@ def test_the_law_file_runs_everywhere_from_the_command_line(tmp_path, capsys):
     assert main(["simulate", *law, "--kappa", "1e4", "--json"]) == 0
     out = json.loads(capsys.readouterr().out)
     assert out["law"] == "file-kk" and out["kappa_unit"] == "N s/m^1.5" and out["outcome"]
-    assert main(["sweep", *law, "--kappa-min", "1e3", "--kappa-max", "1e5", "--num", "3", "--out",
+    assert main(["sweep", *law, "--axis", "kappa=1e3:1e5:3:log", "--out",
                  str(tmp_path / "s.h5"), "--no-progress"]) == 0
     assert main(["atlas", *law, "--axis", "kappa=1e3:1e5:2:log", "--axis", "v=0.5:1:2", "--out",
                  str(tmp_path / "a.h5"), "--no-progress"]) == 0

@@ -270,7 +270,8 @@ class Grid:
             if not self.law.reads(axis.name):
                 source = self.law.damping_source or "no damping"
                 raise ValueError(f"axis {axis.name!r} is not read by law {self.law.label()!r} (its damping "
-                                 f"comes from {source}): every point would be the same")
+                                 f"comes from {source}): every point would be the same; allowed: a parameter "
+                                 "the law reads")
         if self.size > MAX_POINTS:
             raise ValueError(f"grid of {self.size} points is out of range; allowed: at most {MAX_POINTS}")
         # every corner must be a valid case, and each axis's smallest and largest value (a range of the
