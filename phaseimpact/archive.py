@@ -1,22 +1,23 @@
-"""HDF5 archives of sweeps, atlases and continued curves: netCDF-4 / CF-1.8 files that xarray opens as
-labelled arrays, and that plain h5py reads just as well.
+"""HDF5 archives of sweeps, atlases and continued curves: netCDF-4 / CF-1.11 files (conventionally
+``.nc``) that xarray, netCDF4, cfdm and other CF readers open as labelled arrays, and that plain h5py
+reads just as well.
 
-Layout (``schema_version`` 4). Every variable is in the root group, so
-``xarray.open_dataset(path, engine="h5netcdf")`` shows them all, with one dimension per axis::
+Layout (``schema_version`` 5). Every variable of the result is in the root group, so
+``xarray.open_dataset(path)`` shows them all, with one dimension per axis::
 
-    / attrs       Conventions "CF-1.8", schema_version 4, package_version, kind ("sweep": one axis,
-                  "atlas": two or more, "critical-curve"), law (JSON), contact (its reading of
-                  |delta|^alpha), base ("parameters" or "case"), case (JSON: the Case, or the
-                  Parameters), parameters (JSON, SI: the base's Parameters), engine, rtol, t_end (s;
-                  NaN: each run until its outcome settles), created (ISO 8601 UTC; from
+    / attrs       Conventions "CF-1.11", title, history, source, references (CF's), schema_version 5,
+                  package_version, kind ("sweep": one axis, "atlas": two or more, "critical-curve"), law
+                  (JSON), contact (its reading of |delta|^alpha), base ("parameters" or "case"), case (JSON:
+                  the Case, or the Parameters), parameters (JSON, SI: the base's Parameters), engine, rtol,
+                  t_end (s; NaN: each run until its outcome settles), created (ISO 8601 UTC; from
                   SOURCE_DATE_EPOCH when set), settings (JSON)
 
     sweep or atlas, grid shape (n_1, ..., n_d) in C order over the axes (attrs axes: the names,
-    dimensions: their netCDF names, columns: the summary columns stored, both JSON lists):
+    axis_dimensions: their netCDF names, columns: the summary columns stored, all JSON lists):
     <axis>        (n_i,)  float64  a coordinate variable (HDF5 dimension scale) per axis, named by it
                                    with characters other than letters, digits and _ made _
-                                   (plate.E -> plate_E); attrs units, long_name, parameter (the
-                                   original name), log (1: a log-spaced axis)
+                                   (plate.E -> plate_E); attrs units (or fractional_units, below),
+                                   long_name, parameter (the original name), log (1: a log-spaced axis)
     status        grid    int8     0 success, 1 step-size-collapse, 2 too-many-steps, 3 non-finite;
                                    -1: not computed, outside valid_range (flag_values, flag_meanings;
                                    no _FillValue, so that xarray keeps the codes as integers)
@@ -24,14 +25,20 @@ Layout (``schema_version`` 4). Every variable is in the root group, so
                                    unsettled (flag_values, flag_meanings); -1 as status
     stop_reason   grid    int8     horizon, settled, runaway, asked, failed; -1 as status
     <column>      grid    float64 or int64: every summary column (max_force, n_stick, t_run, ...)
-                                   with its units (N, m, s, J, 1); _FillValue NaN or -1
+                                   with its units (N, m, s, J, 1); _FillValue NaN or -1 (xarray reads
+                                   the counts as float, NaN where not computed: a missing count, never
+                                   a -1 in a sum or mean)
     stick_first   grid    int64    row of the point's first stick phase (-1: none or not computed)
     stick_count   grid    int64    its number of stick phases (-1: not computed)
-    stick_point   (stick,) int64   flat (C order) index of each row's point: a CF indexed ragged
-                                   array, instance_dimension "point" (the grid stacked in C order,
-                                   ``ds.stack(point=dims)``); -1: an unused row
+    stick_point   (stick,) int64   flat (C order) index of each row's point; -1: an unused row
     stick_t, stick_delta, stick_dwell  (stick,) float64  s, m, s (dwell inf: a permanent stick)
-    point, stick  netCDF dimensions without a variable: the grid's size, the rows
+    stick         a netCDF dimension without a variable: the rows
+
+    The row indices (stick_first, stick_count, stick_point) have no _FillValue (xarray keeps them
+    integers, so they index) and valid_min 0: CF readers take -1 as missing. The rows are long-form,
+    each point's rows contiguous in a whole file but not in a checkpoint's; not a CF discrete sampling
+    geometry (no featureType), whose features need space-time coordinates (CF 9.1) that a grid point
+    does not have. :func:`stick_phases` gives the rows of computed points with their coordinates.
 
     critical curve, k points (attrs param, what, contact_index, message):
     <param>       (k,)  float64    coordinate variable, e.g. v (m s-1)
@@ -41,11 +48,24 @@ Layout (``schema_version`` 4). Every variable is in the root group, so
     closed_form, predicted  (k,) float64
 
     /extras       SweepResult.extras: arrays as datasets, dicts as groups, the rest as JSON in the
-                  group's attribute "json" (a group: the xarray root view leaves it out)
+                  group's attribute "json" (a group: the xarray root view leaves it out; open it with
+                  ``group="extras/boundaries"``). Each array has netCDF dimensions, ``<name>_dim<i>``
+                  unless its meaning is known: the refined boundaries of ``atlas --refine``
+                  (/extras/boundaries) share ``boundary``; ``points`` (boundary, column) names its
+                  columns (the axes) and their units in the attributes columns and column_units;
+                  ``below`` and ``above`` are outcome codes (flag_values, flag_meanings).
 
-Units are UDUNITS strings (``N s m-2.5`` for kappa with alpha = 1.5). A point is computed when its
-``status`` is not -1; its stick phases are rows ``stick_first .. stick_first +
-stick_count - 1`` (also found through ``stick_point``).
+Units are UDUNITS strings with integer powers (``m s-1``, ``kg m-3``), which cf_units, cfdm and
+compliance-checker convert correctly. UDUNITS, and so CF, has no fractional power: it reads
+``N s m-2.5`` (kappa of the Hertz laws, alpha = 1.5) as ``0.5 kg m-1 s-1`` and ``N m-1.5`` (K) as
+``0.5 kg s-2``, a wrong dimension and a factor 0.5. Such a unit is the attribute
+``fractional_units`` (``N s m-2.5``), with no ``units``, a comment saying why, and the unit in the
+``long_name`` (``kappa [N s m-2.5]``, xarray's plot label): a CF reader takes the values as pure
+numbers, which they are (the numbers of that unit), and no reader converts them wrongly
+(:func:`unit_attributes`). CF has no attribute for a log-spaced axis; ``log`` (1 or 0) says it, and
+a plot asks for it (``plot(xscale="log")``). A point is computed when its ``status`` is not -1; its
+stick phases are rows ``stick_first .. stick_first + stick_count - 1`` (also found through
+``stick_point``).
 
 Writing. :func:`save` writes the whole file to a temporary file beside the target, fsyncs it and
 renames it over the target, under the path's write lock (:mod:`phaseimpact._atomic`): a reader or a
@@ -66,8 +86,10 @@ computed); rows not referenced by a committed point's ``stick_first``/``stick_co
 :func:`load` and reused. A kill during step 2 commits some of the new points, each complete. When the rows run
 out (or the file is not an archive of the same grid) a checkpoint rewrites the file atomically as
 :func:`save` does, with room for the stick phases still to come. Archives of schema 1
-(phaseimpact 0.1), 2 (groups ``/sweep``, ``/curve``) and 3 (this layout with ``_FillValue -1`` on the
-code variables, which made xarray decode them as floats) still load.
+(phaseimpact 0.1), 2 (groups ``/sweep``, ``/curve``), 3 (this layout with ``_FillValue -1`` on the
+code variables, which made xarray decode them as floats) and 4 (CF-1.8 with int64 variables, a root
+attribute ``dimensions`` that CF 1.9 readers take as a domain variable's, units with fractional
+powers, /extras without netCDF dimensions) still load.
 
 Integrity. Every chunk of every variable carries a Fletcher-32 checksum (HDF5's filter, which
 netCDF-4, h5netcdf and h5py verify on every read); the file format is HDF5 1.8's, whose superblock
@@ -108,13 +130,18 @@ from .model import ContactLaw
 from .parameters import Parameters
 
 __all__ = ["SCHEMA_VERSION", "KINDS", "CHUNK_POINTS", "Checkpoint", "save", "load", "describe", "same_work",
-           "check_overwrite", "kind_of", "created_timestamp", "DamagedArchiveError", "to_xarray"]
+           "check_overwrite", "kind_of", "created_timestamp", "DamagedArchiveError", "to_xarray", "stick_phases",
+           "unit_attributes"]
 
 #: The layout written (module docstring); schemas 1 and 2 still load, a newer one is refused.
-SCHEMA_VERSION = 4
+SCHEMA_VERSION = 5
 #: What an archive holds: a sweep (one axis), an atlas (two or more) or a continued curve.
 KINDS = ("sweep", "atlas", "critical-curve")
-CONVENTIONS = "CF-1.8"
+#: CF 1.9 and later allow int64 variables (the counts and stick rows).
+CONVENTIONS = "CF-1.11"
+#: The global attribute ``references``: where the equations and the outcome classes are defined.
+REFERENCES = ("docs/physics.md of phaseimpact (equations, corrections, outcome classes); the seed paper: "
+              "\"An improved model for the damped impact of composite materials applicable to wind turbine blades\"")
 #: Points of one chunk of a grid variable (a C-order slab; 64 KiB of float64).
 CHUNK_POINTS = 8192
 #: Rows of one chunk of the stick variables.
@@ -136,9 +163,19 @@ _LONG_NAMES = {
     "stick_t": "time the stick phase began", "stick_delta": "indentation of the stick phase",
     "stick_dwell": "duration of the stick phase (inf: permanent)",
 }
+#: Root attribute: the axes' netCDF names (schemas 3 and 4 called it ``dimensions``, which CF 1.9 made the
+#: attribute of a domain variable: CF readers inherit root attributes, and took every variable as one).
+_AXIS_DIMENSIONS = "axis_dimensions"
+#: Integer variables that locate the stick rows: no _FillValue (xarray keeps them integers, so that they
+#: index), -1 below valid_min (CF readers take it as missing).
+_ROW_INDICES = {
+    "stick_first": "-1 (below valid_min): no stick phase, or the point is not computed",
+    "stick_count": "-1 (below valid_min): the point is not computed",
+    "stick_point": "-1 (below valid_min): an unused row (room for the stick phases a checkpoint has still to write)",
+}
 #: Datasets of a sweep that are not summary columns (an axis must not take these names).
 _RESERVED = ("status", "outcome", "stop_reason", "stick_first", "stick_count", "stick_point", "stick_t",
-             "stick_delta", "stick_dwell", "point", "stick", "extras")
+             "stick_delta", "stick_dwell", "stick", "extras")
 _NOT_A_VARIABLE = "This is a netCDF dimension but not a netCDF variable."
 #: Every dataset that holds data carries a Fletcher-32 checksum per chunk (HDF5's own filter, which
 #: netCDF-4, h5netcdf and h5py all read): damaged bytes fail the read instead of loading as numbers.
@@ -295,17 +332,18 @@ def _udunits(text: str) -> str:
 def kappa_units(alpha: float, law=None) -> str:
     """Units of the damping coefficient set by ``kappa``, from the law's entry (e.g. ``N s m-2.5``
     for ``(K + kappa deltadot) delta^alpha`` with Hertz, ``N s m-1.5`` for Kuwabara-Kono);
-    ``N s m-(1+alpha)`` without a law."""
+    ``N s m-(1+alpha)`` without a law. A power of m that is not an integer makes it a
+    ``fractional_units`` attribute, not ``units`` (:func:`unit_attributes`)."""
     if law is not None:
         from .model.laws import as_law
 
-        return as_law(law).entry.damping_udunits(alpha)
+        return _udunits(as_law(law).entry.damping_udunits(alpha))  # a user law's own unit may read N s/m^1.5
     return f"N s m-{_g(1 + alpha)}"
 
 
 def axis_units(name: str, alpha: float, law=None) -> str:
-    """UDUNITS units of a grid axis or curve parameter (``alpha``: the base case's exponent;
-    ``law``: whose entry gives the damping's unit)."""
+    """Units of a grid axis or curve parameter in UDUNITS syntax (``alpha``: the base case's
+    exponent; ``law``: whose entry gives the damping's unit); see :func:`unit_attributes`."""
     from .case import SETTABLE
 
     fixed = {"kappa": kappa_units(alpha, law), "K": f"N m-{_g(alpha)}", "v": "m s-1", "M1": "kg", "M2": "kg",
@@ -313,6 +351,50 @@ def axis_units(name: str, alpha: float, law=None) -> str:
     if name in fixed:
         return fixed[name]
     return _udunits(SETTABLE[name][0]) if name in SETTABLE else "1"
+
+
+#: A product of powers in UDUNITS syntax with integer exponents (``N s m-2``, ``kg m-3``, ``1``).
+_INTEGER_POWERS = re.compile(r"1|[A-Za-z]+-?\d*( [A-Za-z]+-?\d*)*")
+
+
+def unit_attributes(units: str) -> dict:
+    """The attributes that state a variable's unit, given in UDUNITS syntax (``N s m-2.5``).
+
+    UDUNITS, and with it CF, allows integer exponents only: it reads ``m-2.5`` as ``0.5 m-1``
+    (``N s m-2.5`` as ``0.5 kg m-1 s-1``, a wrong dimension and a factor 0.5). A unit with integer
+    powers is the ``units`` attribute. Any other (a power such as ``m-2.5``, or a law's own text)
+    is ``fractional_units``, with no ``units``: CF then reads the values as pure numbers (CF 3.1,
+    "a variable with no units attribute is assumed to be dimensionless"), the numbers of that unit,
+    which is how they are meant; no UDUNITS reader converts them wrongly.
+
+    Parameters
+    ----------
+    units : str
+        The unit, e.g. from :func:`axis_units`.
+
+    Returns
+    -------
+    dict
+        ``{"units": units}``, or ``{"fractional_units": units, "comment": ...}``.
+
+    Examples
+    --------
+    >>> from phaseimpact.archive import unit_attributes
+    >>> unit_attributes("N s m-2")
+    {'units': 'N s m-2'}
+    >>> unit_attributes("N s m-2.5")["fractional_units"]
+    'N s m-2.5'
+    """
+    if _INTEGER_POWERS.fullmatch(units):
+        return {"units": units}
+    return {"fractional_units": units,
+            "comment": f"values in {units}; no units attribute because UDUNITS, which CF units follow, allows "
+                       "integer powers only (it would read a power such as m-2.5 as 0.5 m-1)"}
+
+
+def _long_name(name: str, units: str) -> str:
+    """A coordinate's long_name; with the unit when no ``units`` attribute can state it (a plot's label)."""
+    return name if "units" in unit_attributes(units) else f"{name} [{units}]"
 
 
 def _axis_names(names) -> list[str]:
@@ -484,7 +566,7 @@ def _digest(tree) -> str:
 def save(result: SweepResult | CriticalCurve, path, *, force: bool = False) -> str:
     """Write ``result`` to ``path`` atomically (temporary file, fsync, rename) under its write lock.
 
-    The layout is the module docstring's (netCDF-4 / CF-1.8, schema :data:`SCHEMA_VERSION`); a
+    The layout is the module docstring's (netCDF-4 / CF-1.11, schema :data:`SCHEMA_VERSION`); a
     reader or a crash sees the previous file or the complete new one.
 
     Parameters
@@ -492,7 +574,7 @@ def save(result: SweepResult | CriticalCurve, path, *, force: bool = False) -> s
     result : SweepResult or CriticalCurve
         A sweep, an atlas (complete or partial) or a continued curve.
     path : str or path-like
-        The archive to write (conventionally ``.h5``).
+        The archive to write (conventionally ``.nc``: netCDF-4).
     force : bool, default False
         Replace ``path`` even if it exists and is not a phaseimpact archive. Without it such a file
         is refused (``ValueError``); an existing archive is replaced. (The command line also refuses
@@ -520,7 +602,7 @@ def save(result: SweepResult | CriticalCurve, path, *, force: bool = False) -> s
     >>> from phaseimpact import seed_parameters
     >>> from phaseimpact.archive import load, save
     >>> from phaseimpact.continuation import sweep
-    >>> path = os.path.join(tempfile.mkdtemp(), "sweep.h5")
+    >>> path = os.path.join(tempfile.mkdtemp(), "sweep.nc")
     >>> save(sweep(seed_parameters(), "paper", [1e9, 1e12, 1e13]), path) == path
     True
     >>> load(path).outcome_names().tolist()
@@ -630,7 +712,7 @@ def to_xarray(result: SweepResult | CriticalCurve):
     >>> from phaseimpact.archive import to_xarray
     >>> from phaseimpact.continuation import sweep
     >>> ds = to_xarray(sweep(seed_parameters(), "paper", [1e9, 1e12, 1e13]))
-    >>> dict(ds.sizes), ds["max_force"].attrs["units"], ds["kappa"].attrs["units"]
+    >>> dict(ds.sizes), ds["max_force"].attrs["units"], ds["kappa"].attrs["fractional_units"]
     ({'kappa': 3, 'stick': 4}, 'N', 'N s m-2.5')
     """
     if not isinstance(result, (SweepResult, CriticalCurve)):
@@ -646,6 +728,64 @@ def to_xarray(result: SweepResult | CriticalCurve):
     buffer.seek(0)
     with xarray.open_dataset(buffer, engine="h5netcdf") as ds:
         return ds.load()
+
+
+def stick_phases(ds_or_path):
+    """The stick phases of a sweep or atlas, one row each, with the grid coordinates of their point.
+
+    Only the rows of computed points are kept (a committed ``status``, the row within the point's
+    ``stick_first`` .. ``stick_first + stick_count - 1``): the unused rows of an archive in
+    progress (``stick_point`` -1) and rows a killed checkpoint left behind are never mapped to a
+    grid point.
+
+    Parameters
+    ----------
+    ds_or_path : xarray.Dataset, str or path-like
+        An archive (schema 3 or later), or the Dataset that ``xarray.open_dataset`` or
+        :func:`to_xarray` gives of one.
+
+    Returns
+    -------
+    xarray.Dataset
+        Along dimension ``stick``, in point order: ``stick_t`` (s), ``stick_delta`` (m),
+        ``stick_dwell`` (s; inf: permanent) as data, and as coordinates ``stick_point`` (the
+        point's flat, C-order index) and each axis (e.g. ``kappa``, ``v``) at the point.
+
+    Raises
+    ------
+    ValueError
+        For a critical curve (it has no stick phases), or without xarray and h5netcdf.
+
+    Examples
+    --------
+    >>> from phaseimpact import seed_parameters
+    >>> from phaseimpact.archive import stick_phases, to_xarray
+    >>> from phaseimpact.continuation import sweep
+    >>> rows = stick_phases(to_xarray(sweep(seed_parameters(), "paper", [1e9, 1e13])))
+    >>> rows.sizes["stick"], rows.kappa.values.tolist()
+    (3, [1000000000.0, 10000000000000.0, 10000000000000.0])
+    """
+    try:
+        import xarray
+    except ImportError:
+        raise ValueError("stick_phases needs xarray and h5netcdf: pip install xarray h5netcdf") from None
+    if not isinstance(ds_or_path, xarray.Dataset):
+        with xarray.open_dataset(os.fspath(ds_or_path), engine="h5netcdf") as ds:
+            return stick_phases(ds.load())
+    ds = ds_or_path
+    if "stick_point" not in ds:
+        raise ValueError(f"a {ds.attrs.get('kind', 'dataset')} holds no stick phases; allowed: a sweep or atlas")
+    def flat(name):  # schemas 3 and 4 had _FillValue -1 here: xarray decoded -1 as NaN
+        return ds[name].fillna(-1).values.reshape(-1).astype(np.int64)
+
+    dims = ds["status"].dims
+    rows = _owned_rows(flat("stick_first"), flat("stick_count"), flat("status") >= 0)
+    point = ds["stick_point"].values[rows]
+    out = ds[["stick_t", "stick_delta", "stick_dwell"]].isel(stick=rows)
+    index = np.unravel_index(point, ds["status"].shape)
+    return out.assign_coords({"stick_point": ("stick", point, ds["stick_point"].attrs),
+                              **{dim: ("stick", ds[dim].values[i], ds[dim].attrs) for dim, i in zip(dims, index,
+                                                                                                   strict=True)}})
 
 
 def _texts_digest(f) -> str:
@@ -666,8 +806,14 @@ def _texts_digest(f) -> str:
     return h.hexdigest()
 
 
-def _header(f, kind: str, law: ContactLaw, base, t_end, rtol, engine: str, created: str, settings=None) -> None:
+def _header(f, kind: str, law: ContactLaw, base, t_end, rtol, engine: str, created: str, title: str,
+            settings=None) -> None:
     f.attrs["Conventions"] = CONVENTIONS
+    f.attrs["title"] = title
+    f.attrs["history"] = f"{created} phaseimpact {__version__}: written by phaseimpact.archive"
+    f.attrs["source"] = (f"phaseimpact {__version__}: impact simulations ({law.name} contact law, engine "
+                         f"{engine or 'default'}, rtol {_float(rtol):g})")
+    f.attrs["references"] = REFERENCES
     f.attrs["schema_version"] = np.int64(SCHEMA_VERSION)
     f.attrs["package_version"] = __version__
     f.attrs["kind"] = kind
@@ -732,11 +878,14 @@ def _write_sweep(f, r: SweepResult, created: str, layout: _Layout, spare_rows: i
     grid = r.grid
     shape = grid.shape
     alpha = _base_parameters(grid.base).alpha
-    _header(f, kind_of(r), r.law, grid.base, r.t_end, r.settings.get("rtol"), r.settings.get("engine", ""), created,
+    kind = kind_of(r)
+    title = (f"phaseimpact {kind}: {r.law.name} law, {' x '.join(str(n) for n in shape)} points over "
+             f"{', '.join(grid.names)}")
+    _header(f, kind, r.law, grid.base, r.t_end, r.settings.get("rtol"), r.settings.get("engine", ""), created, title,
             r.settings)
     dims = _axis_names(grid.names)
     f.attrs["axes"] = _json(list(grid.names))
-    f.attrs["dimensions"] = _json(dims)
+    f.attrs[_AXIS_DIMENSIONS] = _json(dims)
     columns = list(r.values)
     f.attrs["columns"] = _json(columns)
     f.attrs["extras_digest"] = _digest(r.extras)
@@ -744,18 +893,18 @@ def _write_sweep(f, r: SweepResult, created: str, layout: _Layout, spare_rows: i
     for axis, dim in zip(grid.axes, dims, strict=True):
         d = f.create_dataset(dim, data=np.asarray(axis.values, dtype=float), **_CHECKED)
         d.make_scale(dim)
-        d.attrs["units"] = axis_units(axis.name, alpha, r.law)
-        d.attrs["long_name"] = axis.name
+        units = axis_units(axis.name, alpha, r.law)
+        d.attrs.update(unit_attributes(units))
+        d.attrs["long_name"] = _long_name(axis.name, units)
         d.attrs["parameter"] = axis.name
         d.attrs["log"] = np.int8(bool(axis.log))
         scales.append(d)
-    _dimension(f, "point", grid.size)
     chunks = _slab_chunks(shape, CHUNK_POINTS)
 
     def gridded(name, data, dtype, units=None):
         coded = name in _CODES
         d = _fixed(f, name, np.asarray(data).reshape(shape), dtype, chunks, units=units, dims=scales,
-                   fill_attr=not coded)
+                   fill_attr=not coded and name not in _ROW_INDICES)
         if coded:
             _flags(d, _CODES[name])
         return d
@@ -774,34 +923,67 @@ def _write_sweep(f, r: SweepResult, created: str, layout: _Layout, spare_rows: i
     stick = _dimension(f, "stick", rows)
     row_chunks = (min(CHUNK_ROWS, max(rows, 1)),)
 
-    sp = _fixed(f, "stick_point", layout.point, np.int64, row_chunks, fill=-1, fill_attr=False, units="1",
-                dims=(stick,), rows=rows)
-    sp.attrs["instance_dimension"] = "point"
+    _fixed(f, "stick_point", layout.point, np.int64, row_chunks, fill=-1, fill_attr=False, dims=(stick,), rows=rows)
     for name, values, units in (("stick_t", layout.t, "s"), ("stick_delta", layout.delta, "m"),
                                 ("stick_dwell", layout.dwell, "s")):
         _fixed(f, name, values, float, row_chunks, units=units, dims=(stick,), rows=rows)
+    for name in _ROW_INDICES:
+        f[name].attrs["valid_min"] = np.int64(0)
+        f[name].attrs["comment"] = _ROW_INDICES[name]
     if r.extras:
-        _write_tree(f.create_group("extras"), r.extras)
+        _write_tree(f.create_group("extras"), r.extras, _extras_dimensions(r))
 
 
-def _write_tree(group, tree: dict) -> None:
-    rest = {}
+def _extras_dimensions(r: SweepResult) -> dict:
+    """Dimensions and attributes of the extras whose meaning is known, as ``{group: {array: (dimension names,
+    attributes)}}``: the refined class boundaries of ``phaseimpact atlas --refine`` (``extras["boundaries"]``,
+    :class:`~phaseimpact.continuation.Boundaries`), one row per boundary, one column per grid axis."""
+    grid = r.grid
+    alpha = _base_parameters(grid.base).alpha
+    codes = {"flag_values": np.arange(len(OUTCOMES), dtype=np.int8), "flag_meanings": " ".join(OUTCOMES)}
+    return {"boundaries": {
+        "points": (("boundary", "column"), {
+            "long_name": "refined class boundary points, one column per grid axis (columns)",
+            "columns": _json(list(grid.names)),
+            "column_units": _json([axis_units(name, alpha, r.law) for name in grid.names]),
+            "comment": "no units attribute: the columns differ in unit (column_units, in UDUNITS syntax)"}),
+        "below": (("boundary",), {"long_name": "outcome class on the low side along the refined axis", **codes}),
+        "above": (("boundary",), {"long_name": "outcome class on the high side along the refined axis", **codes}),
+    }}
+
+
+def _write_tree(group, tree: dict, known: dict) -> None:
+    """``tree`` (``SweepResult.extras``) under ``group``: arrays as datasets with netCDF dimensions (those of
+    ``known`` where their sizes agree, else one per array and axis, ``<name>_dim<i>``), the rest as JSON."""
+    rest, sizes = {}, {}
     for key, value in tree.items():
         key = str(key)
         if isinstance(value, dict):
-            _write_tree(group.create_group(key), value)
+            _write_tree(group.create_group(key), value, known.get(key, {}) if isinstance(known.get(key), dict) else {})
             continue
         array = np.asarray(value) if isinstance(value, (np.ndarray, list, tuple)) else None
-        if array is not None and array.dtype.kind in "biuf" and array.size:
-            d = group.create_dataset(key, data=array.astype(np.int8) if array.dtype.kind == "b" else array, **_CHECKED)
-            d.attrs["type"] = "bool" if array.dtype.kind == "b" else "array"
-        else:
+        if array is None or array.dtype.kind not in "biuf" or not array.size:
             rest[key] = value
+            continue
+        d = group.create_dataset(key, data=array.astype(np.int8) if array.dtype.kind == "b" else array, **_CHECKED)
+        d.attrs["type"] = "bool" if array.dtype.kind == "b" else "array"
+        dims, attrs = known.get(key, ((), {}))
+        if len(dims) != array.ndim or any(sizes.get(name, n) != n for name, n in zip(dims, array.shape, strict=True)):
+            dims, attrs = [f"{key}_dim{i}" for i in range(array.ndim)], {}
+        for i, (name, n) in enumerate(zip(dims, array.shape, strict=True)):
+            while name in tree or sizes.get(name, n) != n or (name in group and name not in sizes):
+                name += "_"  # a name the tree uses, or a dimension of another size
+            if name not in sizes:
+                sizes[name] = n
+                _dimension(group, name, n)
+            d.dims[i].attach_scale(group[name])
+        d.attrs.update(attrs)
     group.attrs["json"] = _json(rest)
 
 
 def _write_curve(f, c: CriticalCurve, created: str) -> None:
-    _header(f, "critical-curve", c.law, c.base, None, c.rtol, "", created)
+    _header(f, "critical-curve", c.law, c.base, None, c.rtol, "", created,
+            f"phaseimpact critical curve: {c.what} of the {c.law.name} law over {c.param}")
     alpha = _base_parameters(c.base).alpha
     dim = _axis_names([c.param])[0]
     f.attrs["param"] = c.param
@@ -810,15 +992,17 @@ def _write_curve(f, c: CriticalCurve, created: str) -> None:
     f.attrs["message"] = str(c.message)
     values = f.create_dataset(dim, data=np.asarray(c.values, dtype=float), **_CHECKED)
     values.make_scale(dim)
-    values.attrs["units"] = axis_units(c.param, alpha, c.law)
-    values.attrs["long_name"] = c.param
+    units = axis_units(c.param, alpha, c.law)
+    values.attrs.update(unit_attributes(units))
+    values.attrs["long_name"] = _long_name(c.param, units)
     values.attrs["parameter"] = c.param
+    units = kappa_units(alpha, c.law)
     for name in ("kappa", "closed_form", "predicted"):
         d = f.create_dataset(name, data=np.asarray(getattr(c, name), dtype=float), **_CHECKED)
         d.attrs["_FillValue"] = np.float64(np.nan)
-        d.attrs["units"] = kappa_units(alpha, c.law)
-        d.attrs["long_name"] = {"kappa": c.what, "closed_form": "closed-form kappa_c (docs/physics.md section 5)",
-                                "predicted": "the continuation's prediction"}[name]
+        d.attrs.update(unit_attributes(units))
+        d.attrs["long_name"] = _long_name({"kappa": c.what, "closed_form": "closed-form kappa_c (docs/physics.md "
+                                           "section 5)", "predicted": "the continuation's prediction"}[name], units)
         d.dims[0].attach_scale(values)
     d = f.create_dataset("requested", data=np.asarray(c.requested, dtype=bool).astype(np.int8), **_CHECKED)
     d.attrs["flag_values"] = np.array([0, 1], dtype=np.int8)
@@ -895,7 +1079,7 @@ class Checkpoint:
     >>> from phaseimpact import seed_parameters
     >>> from phaseimpact.archive import Checkpoint, load, save
     >>> from phaseimpact.continuation import atlas
-    >>> checkpoint = Checkpoint(os.path.join(tempfile.mkdtemp(), "atlas.h5"))
+    >>> checkpoint = Checkpoint(os.path.join(tempfile.mkdtemp(), "atlas.nc"))
     >>> result = atlas(seed_parameters(), "paper", {"kappa": [1e11, 1e13], "v": [1.0, 2.0]}, on_chunk=checkpoint)
     >>> checkpoint.rewrites, checkpoint.in_place
     (1, 0)
@@ -958,7 +1142,7 @@ class Checkpoint:
     # -- reading the file's state ---------------------------------------------------------------
 
     def _read_disk(self, r: SweepResult) -> _OnDisk | None:
-        """The file's state if it is a schema-3 archive of ``r``'s grid that can be written in place."""
+        """The file's state if it is an archive of this schema of ``r``'s grid that can be written in place."""
         path = self.path
         if not os.path.isfile(path) or not _is_archive(path):
             return None
@@ -1182,7 +1366,7 @@ def _same_grid(f, r: SweepResult) -> bool:
             return False
         if _attr_str(f, "extras_digest") != _digest(r.extras):
             return False
-        dims = json.loads(_attr_str(f, "dimensions"))
+        dims = json.loads(_attr_str(f, _AXIS_DIMENSIONS))
         return all(np.array_equal(f[dim][()], np.asarray(axis.values, dtype=float))
                    for dim, axis in zip(dims, grid.axes, strict=True))
     except (KeyError, TypeError, ValueError):
@@ -1262,11 +1446,11 @@ class DamagedArchiveError(ValueError):
     Examples
     --------
     >>> from phaseimpact.archive import DamagedArchiveError
-    >>> error = DamagedArchiveError("atlas.h5", "status holds code 9")
+    >>> error = DamagedArchiveError("atlas.nc", "status holds code 9")
     >>> isinstance(error, ValueError), error.reason
     (True, 'status holds code 9')
     >>> str(error)
-    "'atlas.h5' is an incomplete or damaged phaseimpact archive: status holds code 9"
+    "'atlas.nc' is an incomplete or damaged phaseimpact archive: status holds code 9"
     """
 
     def __init__(self, path: str, reason: str, *, checksum: bool = False):
@@ -1476,11 +1660,11 @@ def load(path):
     >>> from phaseimpact.archive import load, save
     >>> from phaseimpact.continuation import critical_curve
     >>> path = save(critical_curve(seed_parameters(), "paper", "v", [1.0, 2.0]),
-    ...             os.path.join(tempfile.mkdtemp(), "curve.h5"))
+    ...             os.path.join(tempfile.mkdtemp(), "curve.nc"))
     >>> curve = load(path)
     >>> type(curve).__name__, curve.what, [f"{k:.4g}" for k in curve.kappa[curve.requested]]
     ('CriticalCurve', 'kappa_c', ['1.499e+12', '9.542e+11'])
-    >>> load(os.path.join(tempfile.mkdtemp(), "missing.h5"))
+    >>> load(os.path.join(tempfile.mkdtemp(), "missing.nc"))
     Traceback (most recent call last):
     ...
     ValueError: ...
@@ -1569,7 +1753,7 @@ def _settings(f) -> dict:
 
 def _axes(f) -> tuple:
     names = _json_attr(f, "axes", list)
-    dims = _json_attr(f, "dimensions", list)
+    dims = _json_attr(f, _AXIS_DIMENSIONS if _AXIS_DIMENSIONS in f.attrs else "dimensions", list)  # schema 3, 4
     if not names or len(names) != len(dims) or not all(isinstance(x, str) for x in names + dims):
         raise _Damaged(f"attributes axes = {_short(names)} and dimensions = {_short(dims)} are out of range; "
                        "allowed: two lists of as many names")
@@ -1626,7 +1810,7 @@ def _read_tree(group) -> dict:
     for key, item in group.items():
         if isinstance(item, h5py.Group):
             tree[key] = _read_tree(item)
-        else:
+        elif not h5py.h5ds.is_scale(item.id):  # a netCDF dimension (schema 5), not an extra
             data = _data(group, key)
             tree[key] = data.astype(bool) if _attr_str(item, "type") == "bool" else data
     return tree
@@ -1802,10 +1986,10 @@ def describe(path) -> dict:
     >>> from phaseimpact import seed_parameters
     >>> from phaseimpact.archive import describe, save
     >>> from phaseimpact.continuation import sweep
-    >>> path = save(sweep(seed_parameters(), "paper", [1e9, 1e13]), os.path.join(tempfile.mkdtemp(), "s.h5"))
+    >>> path = save(sweep(seed_parameters(), "paper", [1e9, 1e13]), os.path.join(tempfile.mkdtemp(), "s.nc"))
     >>> held = describe(path)
     >>> held["kind"], held["law"]["name"], held["axes"]["kappa"].tolist(), held["t_end"], held["schema_version"]
-    ('sweep', 'paper', [1000000000.0, 10000000000000.0], nan, 4)
+    ('sweep', 'paper', [1000000000.0, 10000000000000.0], nan, 5)
     """
     return _retrying(_describe, os.fspath(path))
 
@@ -1890,7 +2074,7 @@ def same_work(held: dict, kind: str, law: ContactLaw, params: Parameters, axes: 
     >>> from phaseimpact.archive import describe, same_work, save
     >>> from phaseimpact.continuation import sweep
     >>> s = sweep(seed_parameters(), "paper", [1e9, 1e13])
-    >>> held = describe(save(s, os.path.join(tempfile.mkdtemp(), "s.h5")))
+    >>> held = describe(save(s, os.path.join(tempfile.mkdtemp(), "s.nc")))
     >>> same_work(held, "sweep", s.law, seed_parameters(), {"kappa": s.kappa}, None, 1e-10)
     []
     >>> same_work(held, "sweep", s.law, seed_parameters(), {"kappa": s.kappa}, None, 1e-9)
@@ -1948,12 +2132,12 @@ def check_overwrite(path, kind: str, law: ContactLaw, params: Parameters, axes: 
     >>> from phaseimpact.archive import check_overwrite, save
     >>> from phaseimpact.continuation import sweep
     >>> s = sweep(seed_parameters(), "paper", [1e9, 1e13])
-    >>> path = save(s, os.path.join(tempfile.mkdtemp(), "s.h5"))
+    >>> path = save(s, os.path.join(tempfile.mkdtemp(), "s.nc"))
     >>> check_overwrite(path, "sweep", s.law, seed_parameters(), {"kappa": s.kappa}, None, 1e-10)
     >>> check_overwrite(path, "sweep", s.law, seed_parameters(), {"kappa": s.kappa}, None, 1e-9)
     Traceback (most recent call last):
     ...
-    ValueError: out = '...s.h5' holds other work (rtol 1e-10 (asked 1e-09)); refusing to overwrite it ...
+    ValueError: out = '...s.nc' holds other work (rtol 1e-10 (asked 1e-09)); refusing to overwrite it ...
     """
     path = os.fspath(path)
     if force or not os.path.exists(path):

@@ -89,10 +89,13 @@ def test_atlas_opens_in_xarray_as_labelled_arrays(tmp_path, small_atlas):
         for name in ("status", "outcome", "max_force", "n_stick", "t_run", "stick_first"):
             assert ds[name].dims == ("kappa", "v"), name
         assert ds.stick_t.dims == ("stick",) and ds.stick_point.dims == ("stick",)
-        assert ds.kappa.attrs["units"] == "N s m-2.5" and ds.kappa.attrs["log"] == 1 and ds.v.attrs["log"] == 0
+        # UDUNITS has no fractional power: kappa's unit is stated beside units, not in it (test_cf.py)
+        assert "units" not in ds.kappa.attrs and ds.kappa.attrs["fractional_units"] == "N s m-2.5"
+        assert ds.kappa.attrs["long_name"] == "kappa [N s m-2.5]"
+        assert ds.kappa.attrs["log"] == 1 and ds.v.attrs["log"] == 0
         assert ds.v.attrs["units"] == "m s-1" and ds.max_force.attrs["units"] == "N"
         assert ds.dissipated_energy.attrs["units"] == "J" and ds.stick_dwell.attrs["units"] == "s"
-        assert ds.attrs["Conventions"] == "CF-1.8" and ds.attrs["kind"] == "atlas"
+        assert ds.attrs["Conventions"] == "CF-1.11" and ds.attrs["kind"] == "atlas"
         assert ds.attrs["schema_version"] == archive.SCHEMA_VERSION and ds.attrs["contact"] == "printed"
         # sel by value, nearest grid point
         kappa, v = 1.6e12, 1.1
@@ -107,8 +110,9 @@ def test_atlas_opens_in_xarray_as_labelled_arrays(tmp_path, small_atlas):
         for name in ("status", "outcome", "stop_reason"):  # integer codes, not floats with NaN (a colour bar)
             assert ds[name].dtype == np.int8 and "_FillValue" not in ds[name].attrs, name
             assert list(ds[name].attrs["valid_range"]) == [0, len(ds[name].attrs["flag_meanings"].split()) - 1]
-        # ragged stick phases: an indexed ragged array over the grid stacked in C order
-        assert ds.stick_point.attrs["instance_dimension"] == "point"
+        # long-form stick rows: the flat (C order) index of each row's point, an integer that indexes
+        assert ds.stick_point.dtype == np.int64 and ds.stick_point.attrs["valid_min"] == 0
+        assert "instance_dimension" not in ds.stick_point.attrs and "featureType" not in ds.attrs
         flat = ds.stack(point=("kappa", "v"))
         of_rows = flat.isel(point=ds.stick_point.values)
         assert np.array_equal(of_rows.kappa.values, small_atlas.kappa[np.unravel_index(
@@ -134,16 +138,21 @@ def test_points_not_computed_are_fill_values_in_xarray(tmp_path, small_atlas, ch
         atlas(seed_parameters(), "paper", AXES, on_chunk=two_chunks)
     computed = np.arange(28) < 10
     with xr.open_dataset(path, engine="h5netcdf") as ds:
-        for name in ("max_force", "n_stick", "stick_count"):
+        for name in ("max_force", "n_stick"):  # quantities: missing where not computed
             values = ds[name].values.ravel()
             assert np.isnan(values[~computed]).all() and not np.isnan(values[computed]).any(), name
-        for name in ("status", "outcome", "stop_reason"):
+        for name in ("status", "outcome", "stop_reason", "stick_count"):  # codes and row indices: integers
             values = ds[name].values.ravel()
-            assert values.dtype == np.int8 and (values[~computed] == -1).all() and (values[computed] >= 0).all(), name
+            assert values.dtype.kind == "i" and (values[~computed] == -1).all() and (values[computed] >= 0).all(), name
         assert np.isnan(ds.max_force.encoding["_FillValue"])
         assert np.array_equal(ds.max_force.values.ravel()[computed], small_atlas.max_force[:10])
         rows = ds.stick_point.values
         assert set(rows[rows >= 0]) <= set(range(10))  # free rows are -1, no point's
+        assert (rows == -1).any()
+        phases = archive.stick_phases(ds)  # the rows of computed points, never a free row
+        assert np.array_equal(phases.stick_point.values, small_atlas.stick_point[small_atlas.stick_point < 10])
+        i, j = np.unravel_index(phases.stick_point.values, (7, 4))
+        assert np.array_equal(phases.kappa.values, AXES["kappa"][i]) and np.array_equal(phases.v.values, AXES["v"][j])
     back = archive.load(path)
     assert back.done.sum() == 10 and (back.status[10:] == -1).all()
     assert np.isnan(back.max_force[10:]).all() and (back.values["n_stick"][10:] == -1).all()
@@ -160,10 +169,12 @@ def _exponents(units: str) -> dict:
 
 
 def test_units_are_products_of_powers_and_kappa_times_rates_is_a_force(tmp_path, small_atlas):
-    """Units read by UDUNITS-style parsers; eq. 8's damping force kappa delta^alpha deltadot is in N."""
+    """Units (``units``, or ``fractional_units`` for a power UDUNITS cannot state) are products of powers;
+    eq. 8's damping force kappa delta^alpha deltadot is in N."""
     path = archive.save(small_atlas, tmp_path / "atlas.h5")
     with h5py.File(path, "r") as f:
-        units = {name: f[name].attrs["units"] for name in f if "units" in f[name].attrs}
+        units = {name: f[name].attrs.get("units", f[name].attrs.get("fractional_units")) for name in f
+                 if {"units", "fractional_units"} & set(f[name].attrs)}
     assert set(units) >= {"kappa", "v", "max_force", "stick_t"}
     exps = {name: _exponents(u) for name, u in units.items()}
     alpha = seed_parameters().alpha
@@ -185,7 +196,8 @@ def test_curve_round_trip_and_xarray(tmp_path):
         (curve.param, curve.what, curve.law, curve.base, curve.rtol, curve.contact_index, curve.message)
     with xr.open_dataset(path, engine="h5netcdf") as ds:
         assert ds.kappa.dims == ("v",) and np.array_equal(ds.v.values, curve.values)
-        assert ds.kappa.attrs["units"] == "N s m-2.5" and ds.kappa.attrs["long_name"] == "kappa_c"
+        assert ds.kappa.attrs["fractional_units"] == "N s m-2.5" and "units" not in ds.kappa.attrs
+        assert ds.kappa.attrs["long_name"] == "kappa_c [N s m-2.5]"
         assert ds.attrs["kind"] == "critical-curve" and ds.attrs["what"] == "kappa_c"
         assert ds.kappa.sel(v=2.0).item() == curve.kappa[curve.values == 2.0][0]
         assert ds.requested.values.tolist() == curve.requested.astype(int).tolist()
@@ -340,6 +352,30 @@ def test_schema_2_archives_still_load(tmp_path, small_atlas):
     checkpoint(back)
     assert checkpoint.rewrites == 1 and archive.describe(path)["schema_version"] == archive.SCHEMA_VERSION
 
+
+def test_schema_4_archives_still_load(tmp_path, small_atlas):
+    """Schema 4: CF-1.8, the axes' netCDF names in the root attribute ``dimensions``, a variable-less
+    dimension ``point``, /extras arrays without netCDF dimensions."""
+    result = SweepResult(small_atlas.grid, small_atlas.t_end, small_atlas.settings, status=small_atlas.status,
+                         outcome=small_atlas.outcome, stop_reason=small_atlas.stop_reason,
+                         stick_point=small_atlas.stick_point, stick_t=small_atlas.stick_t,
+                         stick_delta=small_atlas.stick_delta, stick_dwell=small_atlas.stick_dwell,
+                         extras={"boundary": {"kappa": np.array([1.5e12])}})
+    result.values.update(small_atlas.values)
+    path = archive.save(result, tmp_path / "v4.h5")
+    with h5py.File(path, "a") as f:
+        f.attrs["schema_version"], f.attrs["Conventions"] = np.int64(4), "CF-1.8"
+        f.attrs["dimensions"] = f.attrs["axis_dimensions"]
+        del f.attrs["axis_dimensions"]
+        group = f["extras/boundary"]
+        data = group["kappa"][()]
+        del group["kappa"], group["kappa_dim0"]
+        group.create_dataset("kappa", data=data).attrs["type"] = "array"
+        f.attrs["text_sha256"] = archive._texts_digest(f)
+    back = archive.load(path)
+    assert_same_result(back, result)
+    assert same_bits(back.extras["boundary"]["kappa"], result.extras["boundary"]["kappa"])
+    assert archive.describe(path)["schema_version"] == 4
 
 # ------------------------------------------------------------------------------------------------
 # Checkpoints: in place, only the new points
@@ -715,6 +751,6 @@ def test_to_xarray_is_the_archive_in_memory(tmp_path, small_atlas):
     memory = archive.to_xarray(small_atlas)
     with xr.open_dataset(path, engine="h5netcdf") as disk:
         xr.testing.assert_identical(memory, disk.load())
-    assert memory.max_force.dims == ("kappa", "v") and memory.kappa.attrs["units"] == "N s m-2.5"
+    assert memory.max_force.dims == ("kappa", "v") and memory.kappa.attrs["fractional_units"] == "N s m-2.5"
     with pytest.raises(TypeError, match="SweepResult or a CriticalCurve"):
         archive.to_xarray([1, 2])
