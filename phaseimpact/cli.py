@@ -1387,7 +1387,7 @@ def build_parser() -> argparse.ArgumentParser:
                             "local in-process cluster)")
 
     def out_options(p, resume):
-        p.add_argument("--out", type=_path("out"), required=True, metavar="FILE.h5",
+        p.add_argument("--out", type=_path("out"), required=True, metavar="FILE.nc",
                        help="HDF5 archive to write (written atomically; refused if it exists and is not an "
                             "archive of the same work, unless --force)")
         p.add_argument("--force", action="store_true",
@@ -1568,11 +1568,11 @@ def build_parser() -> argparse.ArgumentParser:
                        description="Draw an archive: an atlas (two axes: outcome classes as a colour map, log axes "
                                    "where the axis is log), a sweep (one axis: counts and max force), or a critical "
                                    "curve (kappa against the parameter, the closed form dashed).")
-    p.add_argument("archive", metavar="FILE.h5", help="archive written by sweep, atlas or critical-curve")
+    p.add_argument("archive", metavar="FILE.nc", help="archive written by sweep, atlas or critical-curve")
     figure_out(p)
     p.add_argument("--contours", choices=("none", "n_stick", "n_contacts"), default="none",
                    help="atlas only: overlay the level lines of this count (default: %(default)s)")
-    p.add_argument("--curve", action="append", default=None, metavar="CURVE.h5",
+    p.add_argument("--curve", action="append", default=None, metavar="CURVE.nc",
                    help="atlas only: overlay a critical curve over the atlas's second axis; repeatable "
                         "(default: none)")
     json_option(p)
