@@ -48,6 +48,10 @@ def outputs(tmp_path_factory):
                   "--fixed-point"],
         "orbit-diagram": ["orbit-diagram", "--law", "hunt-crossley", "--param", "T", "--from", "2e-3", "--to", "3e-3",
                           "--num", "2", "--transients", "3", "--samples", "2"],
+        "map-continuation": ["map-continuation", "--law", "hunt-crossley", "--kappa", "3e9", "--param", "T",
+                             "--from", "0.99e-3", "--to", "0.975e-3", "--num", "5"],
+        "basins": ["basins", "--law", "hunt-crossley", "--kappa", "3e9", "--period", "1.0036e-3", "--grid", "2",
+                   "--iterations", "50", "--out", tmp / "b.png"],
     }
     out = {}
     for name, argv in argvs.items():  # in order: plot reads the sweep's archive
