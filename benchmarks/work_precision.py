@@ -249,56 +249,57 @@ def equal_accuracy(points):
     return rows, targets
 
 
+#: Each method's marker (shape and colour): with events a filled marker on a solid line, without a
+#: hollow one on a dotted line, so the series read apart in grayscale too.
+MARKERS = {"DOP853": ("s", "C0"), "RK45": ("D", "C1"), "Radau": ("^", "C2"), "BDF": ("v", "C3"), "LSODA": ("P", "C4")}
+
+
 def plot(points, quick: bool = False) -> None:
-    """The figure: ``figures/work_precision.png``, or a preview in ``figures/preview/`` (quick)."""
-    import matplotlib
+    """The figure: ``figures/work_precision.png`` (and ``.pdf``), or a preview in ``figures/preview/`` (quick)."""
+    from phaseimpact.plotting import figure, for_print, save, style
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    fig, axes = plt.subplots(len(LAWS), len(ERRORS), figsize=(12, 9.5), squeeze=False)
-    colors = {"DOP853": "C0", "RK45": "C1", "Radau": "C2", "BDF": "C3", "LSODA": "C4"}
     floor = 1e-16
     methods = list(dict.fromkeys(p["method"] for p in points))
-    for i, law in enumerate(LAWS):
-        for k, err in enumerate(ERRORS):
-            ax = axes[i][k]
-            for method in methods:
-                pts = sorted((p for p in points if p["law"] == law and p["method"] == method), key=lambda p: p["rtol"])
-                if not pts:
-                    continue
-                x = [max(p["errors"][k], floor) for p in pts]
-                y = [p["time"] * 1e3 for p in pts]
-                if method == OURS:
-                    ax.loglog(x, y, "o-", color="k", lw=2.5, ms=6, label=method, zorder=5)
-                elif method.startswith("heyoka"):
-                    ax.loglog(x, y, "*-", color="m", lw=1.8, ms=8, label=method, zorder=4)
-                else:
-                    m = method.split()[1].rstrip(",")
-                    events = "events" in method and "no events" not in method
-                    ax.loglog(x, y, "s-" if events else "x:", color=colors.get(m, "gray"), lw=1.2 if events else 1.0,
-                              ms=4, alpha=0.9, label=method)
-            ax.set_xlabel(f"relative error of the {err}")
-            ax.set_ylabel("time per run [ms]")
-            no_peer = any(p["method"].startswith("heyoka") for p in points) and not any(
-                p["method"].startswith("heyoka") and p["law"] == law for p in points)
-            ax.set_title(f"{law}: {err}" + (" (heyoka: not set up for its stick)" if no_peer else ""))
-            ax.grid(True, which="both", alpha=0.3)
-    handles, labels = [], []
-    for ax in axes.flat:
-        for h, lab in zip(*ax.get_legend_handles_labels(), strict=True):
-            if lab not in labels:
-                handles.append(h)
-                labels.append(lab)
-    fig.legend(handles, labels, loc="lower center", ncol=4, fontsize=8, frameon=False)
-    fig.suptitle(f"Work-precision, seed case kappa = {KAPPA:g}, v = 1 m/s, t_end = {T_END:g} s "
-                 "(lower left is better; errors below 1e-16 drawn at 1e-16)", fontsize=11)
-    fig.tight_layout(rect=(0, 0.08, 1, 0.97))
-    path = (FIGURES / "preview" if quick else FIGURES) / "work_precision.png"
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    emit(f"\nwrote {path}")
+    with style():
+        fig, axes = figure(len(LAWS), len(ERRORS), height=6.8)
+        for i, law in enumerate(LAWS):
+            for k, err in enumerate(ERRORS):
+                ax = axes[i][k]
+                for method in methods:
+                    pts = sorted((p for p in points if p["law"] == law and p["method"] == method),
+                                 key=lambda p: p["rtol"])
+                    if not pts:
+                        continue
+                    x = [max(p["errors"][k], floor) for p in pts]
+                    y = [p["time"] * 1e3 for p in pts]
+                    if method == OURS:
+                        ax.loglog(x, y, "o-", color="k", lw=2.0, ms=4.5, label=method, zorder=5)
+                    elif method.startswith("heyoka"):
+                        ax.loglog(x, y, "*-", color="m", lw=1.4, ms=7, label=method, zorder=4)
+                    else:
+                        marker, color = MARKERS.get(method.split()[1].rstrip(","), ("x", "gray"))
+                        events = "events" in method and "no events" not in method
+                        ax.loglog(x, y, marker=marker, ls="-" if events else ":", color=color,
+                                  mfc=color if events else "none", lw=1.0 if events else 0.9, ms=3.5, label=method)
+                ax.set_xlabel(f"relative error of the {err}")
+                ax.set_ylabel("time per run (ms)")
+                no_peer = any(p["method"].startswith("heyoka") for p in points) and not any(
+                    p["method"].startswith("heyoka") and p["law"] == law for p in points)
+                ax.set_title(f"{law}: {err}" + ("\n(heyoka: not set up for its stick)" if no_peer else ""))
+                ax.grid(True, which="major", alpha=0.3)
+        handles, labels = [], []
+        for ax in axes.flat:
+            for h, lab in zip(*ax.get_legend_handles_labels(), strict=True):
+                if lab not in labels:
+                    handles.append(h)
+                    labels.append(lab)
+        fig.legend(handles, labels, loc="outside lower center", ncol=3)
+        fig.suptitle(f"Work-precision, seed case κ = {KAPPA:g}, v = 1 m/s, t_end = {T_END:g} s\n"
+                     "(lower left is better; errors below 1e-16 drawn at 1e-16)")
+        path = (FIGURES / "preview" if quick else FIGURES) / "work_precision.png"
+        with for_print():
+            save(fig, path)
+    emit(f"\nwrote {path} (and .pdf)")
 
 
 if __name__ == "__main__":

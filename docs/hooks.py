@@ -2,9 +2,10 @@
 
 * ``cli.md``: the command-line reference, from ``phaseimpact.cli.build_parser()`` (every subcommand's
   usage, description and options with their help text), in place of ``<!-- cli-reference -->``.
-* ``gallery.md``: every ``figures/*.png`` with its caption (README.md's figure table) and the command
-  that regenerates it, in place of ``<!-- gallery -->``. The PNGs are served from ``figures/`` in the
-  built site (added to the build here; never copied into ``docs/``).
+* ``gallery.md``: every ``figures/*.png`` with its caption (README.md's figure table), a link to its
+  vector PDF (for print) and the command that regenerates it, in place of ``<!-- gallery -->``. The
+  PNGs and PDFs are served from ``figures/`` in the built site (added to the build here; never copied
+  into ``docs/``).
 * ``reference/phaseimpact.md``: the table of the package's top-level names, in place of
   ``<!-- top-level-names -->``.
 
@@ -46,10 +47,12 @@ _figures: list[Path] = []
 
 
 def on_files(files, config):
-    """Serve ``figures/*.png`` at ``figures/NAME.png`` in the site."""
+    """Serve ``figures/*.png`` at ``figures/NAME.png`` in the site, and the PDF beside each."""
     _figures[:] = sorted(FIGURES.glob("*.png"))
     for png in _figures:
-        files.append(File.generated(config, f"figures/{png.name}", abs_src_path=str(png)))
+        for path in (png, png.with_suffix(".pdf")):
+            if path.is_file():
+                files.append(File.generated(config, f"figures/{path.name}", abs_src_path=str(path)))
     return files
 
 
@@ -139,6 +142,8 @@ def gallery() -> str:
         if command is None:
             log.warning("gallery: no script in studies/ or benchmarks/ makes figures/%s.png", name)
         parts += [f"## {name}", "", f"![{name}](figures/{name}.png)", "", caption, ""]
+        if (FIGURES / f"{name}.pdf").is_file():
+            parts += [f"[PDF for print](figures/{name}.pdf)", ""]
         if command:
             parts += ["```sh", command, "```", ""]
     return "\n".join(parts)

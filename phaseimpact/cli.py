@@ -1641,6 +1641,66 @@ def build_parser() -> argparse.ArgumentParser:
     tolerance(p)
     json_option(p)
     p.set_defaults(func=cmd_orbit_diagram)
+
+    p = add("map-continuation", "a branch of periodic orbits of the impact map over T, kappa or v, with its "
+                                "bifurcations",
+            "The period-K orbit of the impact map followed over the --axis parameter from START to STOP "
+            "(pseudo-arclength continuation, docs/physics.md §7), its Floquet multipliers along the way, and its "
+            "period-doubling (a multiplier through -1), fold (through +1), Neimark-Sacker (a complex pair through "
+            "the unit circle) and grazing points (the contacts per period change) located by bisection.")
+    case_options(p)
+    law_options(p)
+    speed(p)
+    damping(p)
+    target(p)
+    axis_option(p, "the parameter varied, from START to STOP, the largest step along the branch the axis's "
+                "spacing (s, N s/m^(1+alpha) or m/s; e.g. T=0.99e-3:0.975e-3:6)", names="T, kappa, v",
+                limit=MAX_CURVE_POINTS)
+    p.add_argument("--period", type=_real("period", 0.0, None, low_open=True, unit="s"), default=None, metavar="T",
+                   help="time between arrivals (s) when the axis is not T (default: none)")
+    p.add_argument("--k", type=_integer("k", 1, 64), default=1,
+                   help="the orbit's period in impacts, 1 to 64 (default: %(default)s)")
+    p.add_argument("--max-points", type=_integer("max-points", 3, 100_000), default=500,
+                   help="points of the branch at most, 3 to 100000 (default: %(default)s)")
+    p.add_argument("--xtol", type=_real("xtol", 1e-14, 1e-3), default=1e-9,
+                   help="length of each bisection's final segment in the scaled (state, parameter) space, "
+                        "1e-14 <= XTOL <= 1e-3 (default: %(default)g)")
+    p.add_argument("--rtol", type=_RTOL, default=1e-12,
+                   help="integrator tolerance (relative), %(type)s; the multipliers come from finite differences "
+                        "of the map, so tighter than elsewhere (default: %(default)s)")
+    json_option(p)
+    p.set_defaults(func=cmd_map_continuation)
+
+    p = add("basins", "basins of attraction of the impact map over the plate's initial state",
+            "From each initial plate state (x2, x2dot) of a NUM x NUM grid the impact map is iterated until a "
+            "period up to --max-period repeats (docs/physics.md §7); each state is labelled by the attractor it "
+            "reaches (attractors told apart by their points and period), or as reaching none.")
+    case_options(p)
+    law_options(p)
+    speed(p)
+    damping(p)
+    target(p)
+    p.add_argument("--period", type=_real("period", 0.0, None, low_open=True, unit="s"), required=True, metavar="T",
+                   help="time between arrivals, s, T > 0")
+    p.add_argument("--x2-max", type=_real("x2-max", 0.0, None, low_open=True, unit="m"), default=None,
+                   metavar="X", help="initial positions from -X to X, m, X > 0 (default: 1.5 v / omega, omega = "
+                                     "sqrt(Kb/M2): the plate's swing at speed v)")
+    p.add_argument("--x2dot-max", type=_real("x2dot-max", 0.0, None, low_open=True, unit="m/s"), default=None,
+                   metavar="V", help="initial velocities from -V to V, m/s, V > 0 (default: 1.5 v)")
+    p.add_argument("--grid", type=_integer("grid", 1, 400), default=21,
+                   help="initial states per axis, 1 to 400 (default: %(default)s)")
+    p.add_argument("--iterations", type=_integer("iterations", 1, 100_000), default=500,
+                   help="impacts at most from each state, 1 to 100000 (default: %(default)s)")
+    p.add_argument("--max-period", type=_integer("max-period", 1, 64), default=16,
+                   help="longest period recognised, 1 to 64 (default: %(default)s)")
+    p.add_argument("--jobs", type=_integer("jobs", 1, MAX_JOBS), default=1,
+                   help="initial states computed side by side in threads (default: %(default)s)")
+    p.add_argument("--out", type=_figure_path, default=None, metavar="FIG.png",
+                   help="also draw the basins into this figure, .png, .pdf or .svg (default: none)")
+    p.add_argument("--force", action="store_true", help="replace --out even if it is not a figure (default: refuse)")
+    tolerance(p)
+    json_option(p)
+    p.set_defaults(func=cmd_basins)
     return parser
 
 
@@ -1684,30 +1744,12 @@ def cmd_orbit_diagram(args) -> int:
     import numpy as np
 
     from . import plotting
-    from .train import TRAIN_PARAMETERS, orbit_diagram
+    from .train import orbit_diagram
 
     if args.out is not None:
         _check_figure_target(args.out, args.force)
     setup = _setup(args)
-    axis = _one_axis(args)
-    param, values = axis.name, axis.values
-    if param not in TRAIN_PARAMETERS:
-        raise ValueError(f"axis {param!r} is out of range; allowed: one of {', '.join(TRAIN_PARAMETERS)}")
-    if len(values) > MAX_CURVE_POINTS:
-        raise ValueError(f"axis {param!r} has {len(values)} values; allowed: at most {MAX_CURVE_POINTS}")
-    if param != "T" and args.period is None:
-        raise ValueError(f"period = None is out of range for axis {param}; allowed: --period T (s) > 0")
-    if param == "kappa":
-        _check_reads_kappa(setup.law, "orbit-diagram value")
-    low, high = float(np.min(values)), float(np.max(values))
-    if param == "v":
-        for x in (low, high):
-            _check_in_range("v", x, *V_RANGE, "m/s", "axis v")
-    elif param == "kappa":
-        for x in (low, high):
-            _check_in_range("kappa", x, 0.0, KAPPA_MAX, KAPPA_UNIT, "axis kappa")
-    elif low <= 0:
-        raise ValueError(f"T = {low!r} is out of range; allowed: T > 0 (s)")
+    param, values = _train_axis(args, setup)
     _note(f"orbit diagram of {setup.law.label()} over {param}: {len(values)} values x "
           f"{args.transients + args.samples} impacts")
     diagram = orbit_diagram(setup.params, setup.law, param, values, period=args.period,
@@ -1729,6 +1771,119 @@ def cmd_orbit_diagram(args) -> int:
               f"impacts (1: fixed point, k: period k, {args.samples}: irregular): {counts}"
               + (f"; wrote {args.out}" if args.out else ""))
     return EXIT_OK
+
+
+def _train_axis(args, setup: Setup):
+    """``(param, values)`` of the one --axis of orbit-diagram or map-continuation, checked before any work."""
+    import numpy as np
+
+    from .train import TRAIN_PARAMETERS
+
+    axis = _one_axis(args)
+    param, values = axis.name, axis.values
+    if param not in TRAIN_PARAMETERS:
+        raise ValueError(f"axis {param!r} is out of range; allowed: one of {', '.join(TRAIN_PARAMETERS)}")
+    if len(values) > MAX_CURVE_POINTS:
+        raise ValueError(f"axis {param!r} has {len(values)} values; allowed: at most {MAX_CURVE_POINTS}")
+    if param != "T" and args.period is None:
+        raise ValueError(f"period = None is out of range for axis {param}; allowed: --period T (s) > 0")
+    if param == "kappa":
+        _check_reads_kappa(setup.law, f"{args.command} value")
+    low, high = float(np.min(values)), float(np.max(values))
+    for x in (low, high):
+        if param == "v":
+            _check_in_range("v", x, *V_RANGE, "m/s", "axis v")
+        elif param == "kappa":
+            _check_in_range("kappa", x, 0.0, KAPPA_MAX, KAPPA_UNIT, "axis kappa")
+        elif x <= 0:
+            raise ValueError(f"T = {x!r} is out of range; allowed: T > 0 (s)")
+    return param, values
+
+
+def _multiplier_text(multipliers) -> str:
+    return ", ".join(f"{m.real:.6g}{m.imag:+.3g}i" for m in multipliers)
+
+
+def cmd_map_continuation(args) -> int:
+    import numpy as np
+
+    from .integrate import scales
+    from .train import continue_map_orbit
+
+    setup = _setup(args)
+    param, values = _train_axis(args, setup)
+    if len(values) < 2:
+        raise ValueError(f"axis {param!r} has {len(values)} value; allowed: START:STOP:NUM with NUM >= 2 (the "
+                         "branch runs from START to STOP, its largest step the axis's spacing)")
+    start, stop = float(values[0]), float(values[-1])
+    p, law = setup.params, setup.law
+    _note(f"period-{args.k} orbits of {law.label()} over {param} from {start:g} to {stop:g}")
+    branch = continue_map_orbit(p, law, param, start, stop, period=args.period, k=args.k,
+                                step=float(np.max(np.abs(np.diff(values)))), max_points=args.max_points,
+                                xtol=args.xtol, rtol=args.rtol)
+    out = {**_law_fields(setup), "v": p.v, "kappa": law.kappa(p), "kappa_unit": law.damping_unit(p.alpha),
+           "target": p.target, "plate_period": scales(p).plate_period, "period": args.period, "param": param,
+           "from": start, "to": stop, "num": len(values), **branch.as_dict(), "case": setup.case.as_dict()}
+    if args.json:
+        _print_json(args, out)
+    else:
+        print(f"period-{args.k} orbits of {law.label()} ({setup.case.name}), v = {p.v:g} m/s, over {param} "
+              f"from {start:g} to {stop:g}: {len(branch.values)} points, "
+              f"{int(branch.stable.sum())} stable; {branch.message}")
+        if not branch.points:
+            print("  no bifurcation located")
+        for point in branch.points:
+            print(f"  {point.kind:16s} {param} = {point.value:.12g} (bracket {point.bracket:.2g}); "
+                  f"x2 = {point.plate[0]:.6g} m, x2dot = {point.plate[1]:.6g} m/s; multipliers "
+                  f"{_multiplier_text(point.multipliers)}"
+                  + (f"; contacts per period {point.contacts[0][0]} -> {point.contacts[1][0]}"
+                     if point.kind == "grazing" else "") + ("; the branch turns" if point.turning else ""))
+    if len(branch.values) == 0:
+        print(f"phaseimpact: {branch.message}", file=sys.stderr)
+        return EXIT_FAILURE
+    return EXIT_OK
+
+
+def cmd_basins(args) -> int:
+    import numpy as np
+
+    from . import plotting
+    from .integrate import scales
+    from .train import basins
+
+    if args.out is not None:
+        _check_figure_target(args.out, args.force)
+    setup = _setup(args)
+    p, law = setup.params, setup.law
+    omega = math.sqrt(p.Kb / p.M2) if p.target == "plate" and p.Kb > 0 else None
+    if args.x2_max is None and omega is None:
+        raise ValueError(f"x2-max = None is out of range for a {p.target} target without springs; allowed: "
+                         "--x2-max X (m) > 0")
+    x2_max = args.x2_max if args.x2_max is not None else 1.5 * p.v / omega
+    x2dot_max = args.x2dot_max if args.x2dot_max is not None else 1.5 * p.v
+    xs, vs = np.linspace(-x2_max, x2_max, args.grid), np.linspace(-x2dot_max, x2dot_max, args.grid)
+    _note(f"basins of {law.label()} at T = {args.period:g} s: {args.grid} x {args.grid} initial states")
+    result = basins(p, law, args.period, xs, vs, iterations=args.iterations, max_period=args.max_period,
+                    rtol=args.rtol, n_jobs=args.jobs)
+    if args.out is not None:
+        with exclusive(args.out, "out"):
+            title = f"{law.label()}, {setup.case.name}, v = {p.v:g} m/s, T = {args.period:g} s"
+            plotting.save(plotting.plot_basins(result, title=title), args.out)
+    out = {"out": args.out, **_law_fields(setup), "v": p.v, "kappa": law.kappa(p),
+           "kappa_unit": law.damping_unit(p.alpha), "target": p.target, "plate_period": scales(p).plate_period,
+           "iterations": args.iterations, "max_period": args.max_period, **result.as_dict(),
+           "case": setup.case.as_dict()}
+    if args.json:
+        _print_json(args, out)
+    else:
+        total = result.labels.size
+        print(f"basins of {law.label()} ({setup.case.name}), v = {p.v:g} m/s, T = {args.period:g} s: {total} initial "
+              f"states, {len(result.attractors)} periodic attractor(s)" + (f"; wrote {args.out}" if args.out else ""))
+        for i, a in enumerate(result.attractors):
+            print(f"  {i}: period {a.period}, basin {a.count} ({100 * a.count / total:.1f}%), "
+                  f"x2 = {a.plate[0, 0]:.6g} m, x2dot = {a.plate[0, 1]:.6g} m/s before its first impact")
+        print(f"  no period within {args.iterations} impacts: {result.not_converged}; runs failed: {result.no_map}")
+    return EXIT_FAILURE if result.no_map else EXIT_OK
 
 
 #: Commands that compile and integrate nothing: they start without the engine (numba, SciPy).

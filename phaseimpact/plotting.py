@@ -4,6 +4,11 @@ the command line (``phaseimpact plot``, ``phaseimpact portrait``).
 Uses the non-interactive ``Agg`` backend. Lengths are drawn in µm, times in ms, velocities in
 m/s and forces in N. The only I/O is :func:`save` (PNG, PDF or SVG) and :func:`save_h5` (HDF5 data).
 
+Figures are made for print: at most :data:`PAGE_WIDTH` wide (a journal's two columns;
+:data:`COLUMN_WIDTH` for one), every text at least :data:`MIN_TEXT_PT` at that size
+(:func:`print_problems` says which are not), PNG at 300 dpi and, inside :func:`for_print`, a vector
+PDF beside each PNG.
+
 Archives and trajectories: :func:`plot_atlas` (two axes: outcome classes as a categorical colour
 map), :func:`plot_sweep` (one axis: counts and max force), :func:`plot_curve` (a continued
 ``kappa_c``, ``kappa_2`` or grazing value against its parameter) and :func:`plot_portraits` (one
@@ -13,7 +18,10 @@ phase portrait per trajectory, events marked). Each returns a figure for :func:`
 from __future__ import annotations
 
 import contextlib
+import contextvars
 import os
+import textwrap
+import warnings
 
 import matplotlib
 
@@ -25,26 +33,47 @@ from ._atomic import atomic_path  # noqa: E402
 
 __all__ = ["STYLE", "style", "figure", "plot_displacements", "plot_force", "plot_hysteresis",
            "mark_points", "save", "save_h5", "figure_format", "FIGURE_FORMATS", "UM", "MS", "OUTCOME_COLOURS",
-           "axis_label", "plot_atlas", "plot_sweep", "plot_curve", "plot_portraits", "plot_orbit_diagram"]
+           "axis_label", "plot_atlas", "plot_sweep", "plot_curve", "plot_portraits", "plot_orbit_diagram",
+           "MIN_TEXT_PT", "COLUMN_WIDTH", "PAGE_WIDTH", "print_problems", "for_print"]
 
 UM = 1e6  #: m -> µm
 MS = 1e3  #: s -> ms
 
-#: matplotlib rcParams of the study figures (:func:`style`).
+#: Smallest text of a printed figure, points (journals ask for 7-8 pt at the printed size).
+MIN_TEXT_PT = 8
+#: Width of one journal column and of a full page (two columns), inches.
+COLUMN_WIDTH = 3.5
+PAGE_WIDTH = 7.2
+
+#: matplotlib rcParams of the study figures (:func:`style`): every text :data:`MIN_TEXT_PT`, figures
+#: drawn at the size they are printed at.
 STYLE = {
-    "figure.dpi": 110,
-    "savefig.dpi": 110,
-    "font.size": 8,
-    "axes.titlesize": 9,
-    "axes.labelsize": 8,
-    "legend.fontsize": 7,
-    "xtick.labelsize": 7,
-    "ytick.labelsize": 7,
-    "lines.linewidth": 1.1,
+    "figure.dpi": 100,
+    "savefig.dpi": 300,
+    "font.size": MIN_TEXT_PT,
+    "axes.titlesize": MIN_TEXT_PT,
+    "axes.labelsize": MIN_TEXT_PT,
+    "legend.fontsize": MIN_TEXT_PT,
+    "legend.title_fontsize": MIN_TEXT_PT,
+    "figure.titlesize": MIN_TEXT_PT + 1,
+    "xtick.labelsize": MIN_TEXT_PT,
+    "ytick.labelsize": MIN_TEXT_PT,
+    "axes.titlepad": 4.0,
+    "axes.labelpad": 2.0,
+    "legend.handlelength": 1.6,
+    "legend.handletextpad": 0.4,
+    "legend.labelspacing": 0.3,
+    "legend.borderaxespad": 0.3,
+    "legend.columnspacing": 1.0,
+    "lines.linewidth": 1.0,
+    "lines.markersize": 4.0,
     "axes.grid": True,
     "grid.alpha": 0.3,
     "legend.frameon": False,
     "figure.constrained_layout.use": True,
+    "figure.constrained_layout.h_pad": 0.03,
+    "figure.constrained_layout.w_pad": 0.03,
+    "pdf.fonttype": 42,  # TrueType, not Type 3: journals' PDF checks reject Type 3 fonts
 }
 
 
@@ -69,15 +98,15 @@ def style():
         yield
 
 
-def figure(nrows=1, ncols=1, *, width=7.0, height=None, **kwargs):
+def figure(nrows=1, ncols=1, *, width=PAGE_WIDTH, height=None, **kwargs):
     """``plt.subplots`` in the study style (call inside :func:`style`).
 
     Parameters
     ----------
     nrows, ncols : int, default 1
         The grid of axes.
-    width : float, default 7.0
-        Figure width, inches.
+    width : float, default :data:`PAGE_WIDTH`
+        Figure width, inches: the printed width (text sizes are the printed sizes).
     height : float, optional
         Figure height, inches; default 2.4 per row.
     **kwargs
@@ -96,14 +125,14 @@ def figure(nrows=1, ncols=1, *, width=7.0, height=None, **kwargs):
     >>> with style():
     ...     fig, axes = figure(1, 3)
     >>> axes.shape, fig.get_size_inches().tolist()
-    ((1, 3), [7.0, 2.4])
+    ((1, 3), [7.2, 2.4])
     >>> plt.close(fig)
     """
     height = height if height is not None else 2.4 * nrows
     return plt.subplots(nrows, ncols, figsize=(width, height), squeeze=False, **kwargs)
 
 
-def plot_displacements(ax, trajectory, *, label="", relative=True, linestyle="-"):
+def plot_displacements(ax, trajectory, *, label="", relative=True, linestyle=None):
     """x1, x2 (and x1 - x2) against time, µm vs ms.
 
     Parameters
@@ -116,8 +145,9 @@ def plot_displacements(ax, trajectory, *, label="", relative=True, linestyle="-"
         Appended to each line's label.
     relative : bool, default True
         Also draw the indentation ``x1 - x2``.
-    linestyle : str, default "-"
-        Line style of the three lines.
+    linestyle : str, optional
+        Line style of the three lines; default: solid, dashed and dash-dotted, so they read apart
+        in grayscale too.
 
     Examples
     --------
@@ -134,10 +164,11 @@ def plot_displacements(ax, trajectory, *, label="", relative=True, linestyle="-"
     """
     t = trajectory.t * MS
     suffix = f" {label}" if label else ""
-    ax.plot(t, trajectory.x1 * UM, "C0", ls=linestyle, label=f"$x_1$ projectile{suffix}")
-    ax.plot(t, trajectory.x2 * UM, "C1", ls=linestyle, label=f"$x_2$ target{suffix}")
+    styles = (linestyle,) * 3 if linestyle is not None else ("-", "--", "-.")
+    ax.plot(t, trajectory.x1 * UM, "C0", ls=styles[0], label=f"$x_1$ projectile{suffix}")
+    ax.plot(t, trajectory.x2 * UM, "C1", ls=styles[1], label=f"$x_2$ target{suffix}")
     if relative:
-        ax.plot(t, trajectory.delta * UM, "C2", ls=linestyle, label=f"$x_1-x_2${suffix}")
+        ax.plot(t, trajectory.delta * UM, "C2", ls=styles[2], label=f"$x_1-x_2${suffix}")
     ax.set_xlabel("time t (ms)")
     ax.set_ylabel("displacement (µm)")
 
@@ -291,12 +322,108 @@ def figure_format(path) -> str:
     return fmt
 
 
-def save(fig, path, dpi=110):
+#: What :func:`for_print` asks of :func:`save`: formats written beside each figure, and whether a
+#: figure that would not print legibly is an error (else a warning).
+_PRINT: contextvars.ContextVar[tuple[tuple[str, ...], bool] | None] = contextvars.ContextVar("print", default=None)
+
+
+def print_problems(fig, minimum: float = MIN_TEXT_PT, width: float = PAGE_WIDTH) -> list[str]:
+    """What keeps ``fig`` from printing legibly at its own size: wider than ``width``, or a visible
+    text (tick label, axis label, title, legend entry, annotation, contour label...) smaller than
+    ``minimum``.
+
+    Parameters
+    ----------
+    fig : matplotlib.figure.Figure
+        The figure, at the size it is printed at (its size in inches).
+    minimum : float, default :data:`MIN_TEXT_PT`
+        Smallest text size, points.
+    width : float, default :data:`PAGE_WIDTH`
+        Widest figure, inches.
+
+    Returns
+    -------
+    list of str
+        One line per problem; empty when the figure prints legibly.
+
+    Examples
+    --------
+    >>> import matplotlib.pyplot as plt
+    >>> from phaseimpact.plotting import figure, print_problems, style
+    >>> with style():
+    ...     fig, axes = figure(width=8.0)
+    ...     _ = axes[0, 0].set_title("fine")
+    ...     _ = axes[0, 0].annotate("tiny", (0.5, 0.5), fontsize=6)
+    >>> for problem in print_problems(fig):
+    ...     print(problem)
+    8 in wide (at most 7.2 in)
+    6 pt text (at least 8 pt): 'tiny'
+    >>> plt.close(fig)
+    """
+    problems = []
+    wide = float(fig.get_size_inches()[0])
+    if wide > width + 1e-9:
+        problems.append(f"{wide:g} in wide (at most {width:g} in)")
+    fig.canvas.draw()  # tick labels exist only once drawn
+    for text in fig.findobj(matplotlib.text.Text):
+        if text.get_text().strip() and _shown(text) and text.get_fontsize() < minimum - 1e-9:
+            problems.append(f"{text.get_fontsize():g} pt text (at least {minimum:g} pt): {text.get_text()!r}")
+    return problems
+
+
+def _shown(text) -> bool:
+    """Whether ``text`` is drawn: it and its axes are visible (a hidden panel's texts are not printed)."""
+    return text.get_visible() and (text.axes is None or text.axes.get_visible())
+
+
+@contextlib.contextmanager
+def for_print(beside=("pdf",), strict: bool = False):
+    """Context in which :func:`save` writes each figure for print: also in the formats ``beside`` (same
+    name, their suffix), and checked by :func:`print_problems` (a warning, or ``ValueError`` if ``strict``).
+
+    Parameters
+    ----------
+    beside : sequence of str, default ("pdf",)
+        Formats (keys of :data:`FIGURE_FORMATS`) written beside the one a path names.
+    strict : bool, default False
+        Raise, rather than warn, for a figure that does not print legibly (nothing is written then).
+
+    Yields
+    ------
+    None
+
+    Raises
+    ------
+    ValueError
+        For a format not in :data:`FIGURE_FORMATS`.
+
+    Examples
+    --------
+    >>> import os, tempfile
+    >>> from phaseimpact.plotting import figure, for_print, save, style
+    >>> folder = tempfile.mkdtemp()
+    >>> with style(), for_print():
+    ...     fig, axes = figure(width=3.5)
+    ...     _ = axes[0, 0].plot([0, 1], [0, 1])
+    ...     _ = save(fig, os.path.join(folder, "line.png"))
+    >>> sorted(os.listdir(folder))
+    ['line.pdf', 'line.png']
+    """
+    beside = tuple(figure_format(f"figure.{fmt}") for fmt in beside)
+    token = _PRINT.set((beside, strict))
+    try:
+        yield
+    finally:
+        _PRINT.reset(token)
+
+
+def save(fig, path, dpi=300):
     """Write ``fig`` to ``path`` (.png, .pdf or .svg; PNG without a suffix; directories created) and close it.
 
     Written atomically (temporary file, then rename) and without the matplotlib version or a
     creation date in its metadata, so the same figure gives the same bytes on every run (SVG: its
-    element ids are hashed with a fixed salt, not a random one).
+    element ids are hashed with a fixed salt, not a random one). Inside :func:`for_print`, also
+    written in its formats beside ``path``, and checked for print.
 
     Parameters
     ----------
@@ -304,7 +431,7 @@ def save(fig, path, dpi=110):
         The figure; closed afterwards, also when the write fails.
     path : str or path-like
         Where to write; the suffix gives the format (:func:`figure_format`).
-    dpi : float, default 110
+    dpi : float, default 300
         Resolution of PNG (and of rasterised parts of PDF and SVG), dots per inch.
 
     Returns
@@ -316,7 +443,8 @@ def save(fig, path, dpi=110):
     ------
     ValueError
         For a format not in :data:`FIGURE_FORMATS`, a path that cannot be written, or another
-        process writing it.
+        process writing it; inside ``for_print(strict=True)``, for a figure :func:`print_problems`
+        finds fault with.
 
     Examples
     --------
@@ -332,8 +460,23 @@ def save(fig, path, dpi=110):
     path = os.fspath(path)
     try:
         fmt = figure_format(path)
-        with atomic_path(path) as tmp, plt.rc_context({"svg.hashsalt": "phaseimpact"}):
-            fig.savefig(tmp, dpi=dpi, format=fmt, metadata=FIGURE_FORMATS[fmt])
+        paths = {fmt: path}
+        printing = _PRINT.get()
+        if printing is not None:
+            beside, strict = printing
+            problems = print_problems(fig)
+            if problems:
+                message = f"figure {path!r} does not print legibly: " + "; ".join(problems)
+                if strict:
+                    raise ValueError(message)
+                warnings.warn(message, stacklevel=2)
+            stem = os.path.splitext(path)[0]
+            paths.update({other: f"{stem}.{other}" for other in beside if other != fmt})
+        # deterministic PDF and SVG: no random ids (svg.hashsalt); PDF ids come from the content
+        with plt.rc_context({"svg.hashsalt": "phaseimpact"}):
+            for kind, target in paths.items():
+                with atomic_path(target) as tmp:
+                    fig.savefig(tmp, dpi=dpi, format=kind, metadata=FIGURE_FORMATS[kind])
     finally:
         plt.close(fig)
     return path
@@ -525,7 +668,7 @@ def plot_atlas(result, *, contours: str | None = None, curves=()):
     colour_of = np.array([names.index(n) for n in OUTCOME_LABELS])
     codes = colour_of[result.outcome_indices()].reshape(result.shape)
     with style():
-        fig, axes = figure(1, 1, width=6.6, height=4.4)
+        fig, axes = figure(1, 1, width=PAGE_WIDTH, height=4.2)
         ax = axes[0, 0]
         cmap = ListedColormap([OUTCOME_COLOURS[n] for n in names])
         norm = BoundaryNorm(np.arange(len(names) + 1) - 0.5, len(names))
@@ -547,7 +690,7 @@ def plot_atlas(result, *, contours: str | None = None, curves=()):
                 low = int(finite.min())
                 levels = np.arange(low, min(int(finite.max()), low + 10)) + 0.5
                 lines = ax.contour(ax0.values, ax1.values, count.T, levels=levels, colors="k", linewidths=0.8)
-                ax.clabel(lines, fmt=lambda x: f"{int(x - 0.5)}|{int(x + 0.5)}", fontsize=6)
+                ax.clabel(lines, fmt=lambda x: f"{int(x - 0.5)}|{int(x + 0.5)}", fontsize=MIN_TEXT_PT)
             label = "stick phases" if contours == "n_stick" else "contacts"
             ax.plot([], [], "k-", lw=0.8, label=f"{label}: n|n+1")
         for i, curve in enumerate(curves):
@@ -610,7 +753,7 @@ def plot_sweep(result):
     computed = result.status >= 0
     cut = np.asarray(result.cut, dtype=bool)
     with style():
-        fig, axes = figure(2, 1, width=6.6, height=5.0, sharex=True)
+        fig, axes = figure(2, 1, width=PAGE_WIDTH, height=5.0, sharex=True)
         top, bottom = axes[0, 0], axes[1, 0]
         for ax, y in ((top, count), (bottom, force)):
             for name in OUTCOME_COLOURS:
@@ -675,7 +818,7 @@ def plot_curve(curve):
     >>> print(fig.axes[0].get_ylabel())
     $\\kappa_c$ (N s/m$^{2.5}$)
     >>> fig.axes[0].get_legend_handles_labels()[1][1:]
-    ['values asked for', 'intermediate steps', 'closed-form $\\\\kappa_c$ (docs/physics.md §5)']
+    ['values asked for', 'intermediate steps', 'closed-form $\\\\kappa_c$']
     >>> import matplotlib.pyplot as plt; plt.close(fig)
     """
     x = np.asarray(curve.values, dtype=float)
@@ -684,7 +827,7 @@ def plot_curve(curve):
     finite = np.isfinite(y)
     what = _what_label(curve)
     with style():
-        fig, axes = figure(1, 1, width=5.6, height=3.6)
+        fig, axes = figure(1, 1, width=COLUMN_WIDTH + 1.0, height=3.4)
         ax = axes[0, 0]
         ax.plot(x[finite], y[finite], "C0-", lw=1.2, label=f"{what} (continued)")
         ax.plot(x[finite & asked], y[finite & asked], "C0o", ms=4, label="values asked for")
@@ -692,8 +835,7 @@ def plot_curve(curve):
             ax.plot(x[finite & ~asked], y[finite & ~asked], "C0.", ms=3, label="intermediate steps")
         closed = np.isfinite(curve.closed_form)
         if np.any(closed):
-            ax.plot(x[closed], curve.closed_form[closed], "k--", lw=1.0,
-                    label=r"closed-form $\kappa_c$ (docs/physics.md §5)")
+            ax.plot(x[closed], curve.closed_form[closed], "k--", lw=1.0, label=r"closed-form $\kappa_c$")
         if np.any(~finite):
             ax.plot(x[~finite], np.full(np.count_nonzero(~finite), np.nanmin(y) if np.any(finite) else 1.0), "rx",
                     label="lost")
@@ -704,7 +846,7 @@ def plot_curve(curve):
         ax.set_ylabel(f"{what} ({_damping_unit(curve.law, curve.base)})")
         ax.legend()
         title = f"{curve.law.label()}, case {_case_name(curve.base)}"
-        ax.set_title(title + (f"\n{curve.message}" if curve.message else ""))
+        ax.set_title("\n".join([title, *textwrap.wrap(curve.message, 60)]))
     return fig
 
 
@@ -790,7 +932,7 @@ def plot_portraits(trajectories, plane=("delta", "deltadot"), *, summaries=None,
     Returns
     -------
     matplotlib.figure.Figure
-        Up to three panels a row, for :func:`save`.
+        Up to two panels a row (an odd last one centred), :data:`PAGE_WIDTH` wide, for :func:`save`.
 
     Raises
     ------
@@ -813,14 +955,18 @@ def plot_portraits(trajectories, plane=("delta", "deltadot"), *, summaries=None,
     plane = tuple(plane)
     summaries = trajectories if summaries is None else summaries
     n = len(trajectories)
-    ncols = min(n, 3)
+    ncols = min(n, 2)  # two panels a row: each wide enough for its legend at the printed size
     nrows = -(-n // ncols)
     names = {"delta": r"$\delta = x_1 - x_2$ (µm)", "deltadot": r"$\dot\delta$ (m/s)", "x1": "$x_1$ (µm)",
              "x2": "$x_2$ (µm)", "x1dot": r"$\dot x_1$ (m/s)", "x2dot": r"$\dot x_2$ (m/s)"}
     with style():
-        fig, axes = figure(nrows, ncols, width=3.3 * ncols + 0.4, height=2.9 * nrows + 0.5)
+        fig = plt.figure(figsize=(COLUMN_WIDTH if n == 1 else PAGE_WIDTH, 3.0 * nrows + 0.3 * bool(title)))
+        # each panel spans two grid columns, so an odd last panel is centred rather than beside an empty slot
+        grid = fig.add_gridspec(nrows, 2 * ncols)
         for k, (tr, summary) in enumerate(zip(trajectories, summaries, strict=True)):
-            ax = axes[k // ncols, k % ncols]
+            row, col = divmod(k, ncols)
+            first = 2 * col + (ncols - (n - row * ncols) if row == nrows - 1 else 0)
+            ax = fig.add_subplot(grid[row, first:first + 2])
             a, b = plane_coordinates(tr.y, plane)
             ax.plot(np.asarray(a) * UM, b, color="0.25", lw=0.8)
             a0, b0 = plane_coordinates(summary.initial_state, plane)
@@ -857,9 +1003,238 @@ def plot_portraits(trajectories, plane=("delta", "deltadot"), *, summaries=None,
             if not summary.ok:
                 counts += f"; {summary.status}"
             ax.set_title(rf"$\kappa$ = {kappa:.6g}: {summary.outcome}" + f"\n{counts}")
-            ax.legend(loc="best", fontsize=6)
-        for k in range(n, nrows * ncols):
-            axes[k // ncols, k % ncols].set_visible(False)
+            ax.legend(loc="best", frameon=True, framealpha=0.8, edgecolor="none")
         if title:
             fig.suptitle(title)
     return fig
+
+
+# ------------------------------------------------------------------------------------------------
+# The impact map: branches of periodic orbits, their bifurcations, basins of attraction
+# ------------------------------------------------------------------------------------------------
+
+#: Marker, colour and label of each kind of located bifurcation of the impact map (shapes differ, not
+#: only colours).
+BIFURCATION_MARKERS = {
+    "period-doubling": ("s", "#cc3311", "period-doubling"),
+    "fold": ("^", "#0077bb", "fold (saddle-node)"),
+    "neimark-sacker": ("D", "#ee7733", "Neimark–Sacker"),
+    "grazing": ("X", "#009988", "grazing"),
+}
+#: Colours of basins (cycled), of states that reach no periodic attractor and of failed runs.
+BASIN_COLOURS = ("#88ccee", "#ddcc77", "#cc6677", "#44aa99", "#aa4499", "#999933", "#882255", "#117733")
+NOT_CONVERGED_COLOUR, NO_MAP_COLOUR = "#dddddd", "#000000"
+#: Markers of the attractors in a basin picture, in turn.
+ATTRACTOR_MARKERS = ("o", "s", "^", "D", "v", "P", "*", "h")
+
+
+def _branch_y(plate, omega):
+    plate = np.asarray(plate, dtype=float).reshape(-1, 2)
+    return (plate[:, 0] if omega is None else np.hypot(plate[:, 0], plate[:, 1] / omega)) * UM
+
+
+def plot_map_branch(ax, branch, *, x_scale: float = 1.0, label: str | None = None, colour: str = "k",
+                    points: bool = True, omega: float | None = None):
+    """Draw a branch of periodic orbits of the impact map onto ``ax``: the plate's position before
+    the orbit's first impact (µm) against the parameter, stable parts solid, unstable parts dashed,
+    and its located bifurcations marked (:data:`BIFURCATION_MARKERS`).
+
+    Parameters
+    ----------
+    ax : matplotlib.axes.Axes
+    branch : MapBranch
+        From :func:`phaseimpact.train.continue_map_orbit`.
+    x_scale : float, default 1
+        The parameter is drawn divided by it (e.g. the plate period, to draw T / T_plate).
+    label : str, optional
+        Legend label of the stable part.
+    colour : str, default "k"
+    points : bool, default True
+        Mark the located points (each kind labelled once per axes).
+    omega : float, optional
+        With the plate's angular frequency (rad/s), draw its amplitude before the impact,
+        ``sqrt(x2^2 + (x2dot / omega)^2)`` (µm), instead of ``x2``.
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+        ``ax``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from phaseimpact.plotting import figure, plot_map_branch, style
+    >>> from phaseimpact.train import MapBifurcation, MapBranch
+    >>> pd = MapBifurcation("period-doubling", "T", 1.5, np.zeros(2), np.array([-1.0, 0.5]), 1e-9, 0.0,
+    ...                     ((1, 0, 0),) * 2)
+    >>> branch = MapBranch("T", 1, np.array([1.0, 2.0]), np.zeros((2, 2)), np.array([[0.5, -0.9], [0.5, -1.1]]),
+    ...                    np.array([True, False]), np.ones((2, 3), int), [pd], "reached the end of the range")
+    >>> with style():
+    ...     fig, axes = figure()
+    ...     _ = plot_map_branch(axes[0, 0], branch)
+    >>> len(axes[0, 0].lines)
+    3
+    >>> import matplotlib.pyplot as plt; plt.close(fig)
+    """
+    x = np.asarray(branch.values, dtype=float) / x_scale
+    y = _branch_y(branch.plate, omega)
+    stable = np.asarray(branch.stable, dtype=bool)
+    # one line per stretch of equal stability, each joined to the next point so the branch is unbroken
+    cuts = [0, *(np.flatnonzero(np.diff(stable.astype(int))) + 1), len(x)]
+    labelled = False
+    for a, b in zip(cuts[:-1], cuts[1:], strict=True):
+        end = min(b + 1, len(x))
+        ax.plot(x[a:end], y[a:end], color=colour, lw=1.2 if stable[a] else 0.9, ls="-" if stable[a] else "--",
+                label=(label if stable[a] and not labelled else None))
+        labelled = labelled or bool(stable[a])
+    if points:
+        mark_bifurcations(ax, branch.points, x_scale=x_scale, omega=omega)
+    return ax
+
+
+def mark_bifurcations(ax, points, *, x_scale: float = 1.0, omega: float | None = None):
+    """Mark located bifurcations of the impact map at (parameter, plate position before impact, µm).
+
+    Parameters
+    ----------
+    ax : matplotlib.axes.Axes
+    points : sequence of MapBifurcation
+    x_scale : float, default 1
+        The parameter is drawn divided by it.
+    omega : float, optional
+        As for :func:`plot_map_branch`: mark at the plate's amplitude instead of ``x2``.
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+        ``ax``; each kind is labelled once per axes.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from phaseimpact.plotting import figure, mark_bifurcations, style
+    >>> from phaseimpact.train import MapBifurcation
+    >>> fold = MapBifurcation("fold", "T", 1.0, np.zeros(2), np.array([1.0, 0.3]), 0.0, 0.0, ((1, 0, 0),) * 2)
+    >>> with style():
+    ...     fig, axes = figure()
+    ...     _ = mark_bifurcations(axes[0, 0], [fold])
+    >>> axes[0, 0].lines[0].get_marker()
+    '^'
+    >>> import matplotlib.pyplot as plt; plt.close(fig)
+    """
+    present = {line.get_label() for line in ax.lines}
+    for p in points:
+        marker, colour, text = BIFURCATION_MARKERS[p.kind]
+        ax.plot(p.value / x_scale, _branch_y(p.plate, omega)[0], ls="none", marker=marker, color=colour, mec="k",
+                mew=0.6, ms=6.5, zorder=5, label=None if text in present else text)
+        present.add(text)
+    return ax
+
+
+def plot_bifurcation_curves(ax, curves, *, x_scale: float = 1.0, y_scale: float = 1.0):
+    """Draw bifurcations followed in two parameters onto ``ax``: the first parameter (divided by
+    ``x_scale``) horizontally, the second (divided by ``y_scale``) vertically, one line per curve,
+    its points marked by kind (:data:`BIFURCATION_MARKERS`; each kind labelled once per axes).
+
+    Parameters
+    ----------
+    ax : matplotlib.axes.Axes
+    curves : sequence of BifurcationCurve
+        From :func:`phaseimpact.train.continue_map_bifurcation`.
+    x_scale, y_scale : float, default 1
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+        ``ax``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from phaseimpact.plotting import figure, plot_bifurcation_curves, style
+    >>> from phaseimpact.train import BifurcationCurve
+    >>> c = BifurcationCurve("fold", "T", "kappa", np.array([1e9, 2e9]), np.array([1.0, 1.1]), np.zeros((2, 2)),
+    ...                      np.ones((2, 2)), np.zeros(2), "followed over the whole grid")
+    >>> with style():
+    ...     fig, axes = figure()
+    ...     _ = plot_bifurcation_curves(axes[0, 0], [c])
+    >>> axes[0, 0].lines[0].get_marker()
+    '^'
+    >>> import matplotlib.pyplot as plt; plt.close(fig)
+    """
+    present = {line.get_label() for line in ax.lines}
+    for curve in curves:
+        marker, colour, text = BIFURCATION_MARKERS[curve.kind]
+        ax.plot(np.asarray(curve.values) / x_scale, np.asarray(curve.second_values) / y_scale, marker=marker,
+                color=colour, mec="k", mew=0.5, ms=5, lw=1.0, label=None if text in present else text)
+        present.add(text)
+    return ax
+
+
+def plot_basins(result, *, ax=None, title: str = ""):
+    """The basins of attraction of the impact map: each initial plate state of the grid coloured by
+    the attractor it goes to, the attractors' points marked (a marker shape each), states that reach
+    no periodic attractor light grey, failed runs black.
+
+    Parameters
+    ----------
+    result : Basins
+        From :func:`phaseimpact.train.basins`.
+    ax : matplotlib.axes.Axes, optional
+        Where to draw; default a new figure.
+    title : str
+        The axes' title.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        The figure drawn into (for :func:`save`).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from phaseimpact.plotting import plot_basins
+    >>> from phaseimpact.train import Attractor, Basins
+    >>> b = Basins(1e-3, np.array([0.0, 1e-4]), np.array([0.0, 1.0]), np.array([[0, 1], [-1, 0]]),
+    ...            np.ones((2, 2), int), [Attractor(np.zeros((1, 2)), 1, 2), Attractor(np.ones((2, 2)), 2, 1)], 1, 0)
+    >>> fig = plot_basins(b)
+    >>> print(fig.axes[0].get_xlabel())
+    initial plate position x2 (µm)
+    >>> import matplotlib.pyplot as plt; plt.close(fig)
+    """
+    from matplotlib.colors import BoundaryNorm, ListedColormap
+    from matplotlib.lines import Line2D
+
+    n = len(result.attractors)
+    colours = [NO_MAP_COLOUR, NOT_CONVERGED_COLOUR, *(BASIN_COLOURS[i % len(BASIN_COLOURS)] for i in range(n))]
+    cmap = ListedColormap(colours)
+    norm = BoundaryNorm(np.arange(-2.5, n + 0.5), cmap.N)
+    xs = np.asarray(result.x2_values, dtype=float) * UM
+    vs = np.asarray(result.x2dot_values, dtype=float)
+    with style():
+        if ax is None:
+            fig, axes = figure(1, 1, width=COLUMN_WIDTH + 1.4, height=COLUMN_WIDTH)
+            ax = axes[0, 0]
+        ax.pcolormesh(_edges(xs, False), _edges(vs, False), result.labels, cmap=cmap, norm=norm, rasterized=True)
+        ax.grid(False)
+        total = result.labels.size
+        legend = []
+        for i, a in enumerate(result.attractors):
+            style_ = {"ls": "none", "marker": ATTRACTOR_MARKERS[i % len(ATTRACTOR_MARKERS)], "mfc": colours[i + 2],
+                      "mec": "k", "mew": 0.9, "ms": 7}
+            ax.plot(a.plate[:, 0] * UM, a.plate[:, 1], zorder=5, **style_)
+            legend.append(Line2D([], [], label=f"period {a.period}: basin {100 * a.count / total:.0f}%", **style_))
+        for count, colour, text in ((result.not_converged, NOT_CONVERGED_COLOUR, "no period found"),
+                                    (result.no_map, NO_MAP_COLOUR, "run failed")):
+            if count:
+                legend.append(Line2D([], [], ls="none", marker="s", mfc=colour, mec="k", ms=8,
+                                     label=f"{text}: {100 * count / total:.0f}%"))
+        ax.legend(handles=legend, loc="upper left", bbox_to_anchor=(1.01, 1.0), frameon=False)
+        ax.set_xlabel("initial plate position x2 (µm)")
+        ax.set_ylabel("initial plate velocity (m/s)")
+        if title:
+            ax.set_title(title)
+    return ax.figure
+
+
+__all__ += ["plot_map_branch", "mark_bifurcations", "plot_bifurcation_curves", "plot_basins", "BIFURCATION_MARKERS"]

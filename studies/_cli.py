@@ -1,9 +1,10 @@
 """Command-line wrapper shared by the study scripts (``--quick``, ``--jobs``, timing).
 
 Full runs write into ``figures/`` (committed); ``--quick`` previews go to ``figures/preview/``
-(git-ignored), so a preview never replaces a committed figure, archive or table. Time stamps in
-the files come from ``SOURCE_DATE_EPOCH`` (the last commit's time when unset and in a git
-checkout), so regenerating unchanged results leaves ``git status`` clean.
+(git-ignored), so a preview never replaces a committed figure, archive or table. Each figure is
+written for print (PNG and a PDF beside it, checked for legibility: ``phaseimpact.plotting.for_print``).
+Time stamps in the files come from ``SOURCE_DATE_EPOCH`` (the last commit's time when unset and in
+a git checkout), so regenerating unchanged results leaves ``git status`` clean.
 """
 
 import argparse
@@ -11,6 +12,8 @@ import os
 import subprocess
 import time
 from pathlib import Path
+
+from phaseimpact.plotting import for_print
 
 ROOT = Path(__file__).resolve().parents[1]
 FIGURES = ROOT / "figures"
@@ -70,5 +73,6 @@ def run(main, doc: str) -> None:
     set_source_date_epoch()
     redirect(main.__globals__, args.quick)
     start = time.perf_counter()
-    out = main(quick=args.quick, jobs=args.jobs)
+    with for_print():
+        out = main(quick=args.quick, jobs=args.jobs)
     print(out, f"({time.perf_counter() - start:.1f} s)")

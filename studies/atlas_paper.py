@@ -64,27 +64,23 @@ def main(quick=False, jobs=1):
     shape = (len(speeds), len(kappas))
     xe, ye = edges(kappas), edges(speeds)
 
-    def overlay(ax, legend=True):
+    def overlay(ax):
         ax.plot(kc.kappa, kc.values, "w-", lw=2.2)
         ax.plot(kc.kappa, kc.values, "k-", lw=1.0, label="κc(v), continued")
         ax.plot(k2.kappa, k2.values, "--", color="C3", lw=1.0, label="κ2(v)")
-        ax.plot(kc.closed_form, kc.values, ":", color="yellow", lw=1.2, label="closed form")
+        ax.plot(kc.closed_form, kc.values, ":", color="yellow", lw=1.2, label="closed form of κc")
         ax.set_xscale("log")
         ax.set_yscale("log")
+        ax.set_xticks([1e11, 1e13])  # every other decade, none at an edge: room for the labels of narrow panels
         ax.set_xlabel(KAPPA_LABEL)
-        ax.set_ylabel(V_LABEL)
         ax.grid(False)
-        if legend:
-            ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.16), ncol=2, fontsize=6)
 
     with style():
-        fig, axes = figure(1, 3, width=13, height=4.8)
-        labels = {
-            "printed": ["permanent stick (N = 1)", "N = 2, escape, runaway", "N ≥ 3, escape, runaway", "",
-                        "escape after N = 1 (missed re-stick)"],
-            "unilateral": ["permanent stick (N = 1)", "N = 2, escape, rebound", "N ≥ 3, escape, rebound",
-                           "escape, stopped by the energy guard", "escape after N = 1 (missed re-stick)"],
-        }
+        fig, axes = figure(1, 3, height=3.7, sharey=True)
+        labels = ["permanent stick (N = 1)", "N = 2, escape (printed: runaway; unilateral: rebound)",
+                  "N ≥ 3, escape (printed: runaway; unilateral: rebound)",
+                  "unilateral: escape, stopped by the energy guard", "escape after N = 1 (missed re-stick)"]
+        present = set()
         colors = ["#4c72b0", "#dd8452", "#c44e52", "#8172b3", "#999999"]
         cmap = mcolors.ListedColormap(colors)
         for ax, name in zip(axes[0, :2], READINGS, strict=True):
@@ -97,20 +93,25 @@ def main(quick=False, jobs=1):
             if bad.any():
                 ax.plot(K[bad], V[bad], "o", mfc="white", mec="k", mew=0.3, ms=2.5,
                         label=f"N or outcome changes with rtol 1e-12 → 1e-13 ({bad.sum()} of {bad.size})")
-            for c, text in enumerate(labels[name]):
-                if np.any(cls == c):
-                    ax.plot([], [], "s", color=colors[c], ms=6, label=text)
+            present |= set(np.unique(cls).tolist())
             overlay(ax)
-            ax.set_title(f"paper, {name} reading: how each run ends")
+            ax.set_title(f"paper, {name} reading:\nhow each run ends")
+        axes[0, 0].set_ylabel(V_LABEL)
+        for c, text in enumerate(labels):
+            if c in present:
+                axes[0, 0].plot([], [], "s", color=colors[c], ms=6, label=text)
         ax = axes[0, 2]
         un = results["unilateral"]
         e = np.where((un.outcome_names() == "ratchet-escape") & (un.stop_reason != RUNAWAY), un.restitution, np.nan)
         mesh = ax.pcolormesh(xe, ye, e.reshape(shape), cmap="viridis", shading="flat", rasterized=True)
         ax.contour(kappas, speeds, e.reshape(shape), levels=[1.0], colors="w", linewidths=1.0)
         fig.colorbar(mesh, ax=ax, label="apparent restitution e (white line: e = 1)")
-        overlay(ax, legend=False)
-        ax.set_title("unilateral: restitution of the rebound\n(blank: permanent stick)")
-        ax.plot([], [], "w-", label="e = 1")
+        overlay(ax)
+        ax.set_title("unilateral: restitution e\n(blank: permanent stick)")
+        handles, texts = axes[0, 0].get_legend_handles_labels()
+        order = [texts.index(t) for t in texts if not t.startswith("κ") and not t.startswith("closed")]
+        order += [texts.index(t) for t in texts if t.startswith("κ") or t.startswith("closed")]
+        fig.legend([handles[i] for i in order], [texts[i] for i in order], loc="outside lower center", ncol=2)
         out = save(fig, FIGURES / f"{NAME}.png")
     return out
 

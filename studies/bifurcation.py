@@ -39,19 +39,20 @@ def main(quick=False, jobs=1):
     pr, un = results["printed"], results["unilateral"]
     m = p.reduced_mass
     with style():
-        fig, axes = figure(1, 4, width=13, height=3.6)
+        fig, grid = figure(2, 2, height=5.6)
+        axes = grid.reshape(1, 4)
         ax = axes[0, 0]
         permanent = pr.outcome_names()[pr.stick_point] == "permanent-stick"
         ax.plot(kappas[pr.stick_point[permanent]], pr.stick_delta[permanent] * UM, "o", ms=2.5, color="C0",
                 label="permanent stick point")
         ax.plot(kappas[pr.stick_point[~permanent]], pr.stick_delta[~permanent] * UM, "o", ms=2.5, color="C3",
-                mfc="none", label="transient stick points (then escape)")
+                mfc="none", label="transient (then escape)")
         for value, text in ((kc, "κc"), (k2, "κ2")):
             ax.axvline(value, color="k", ls=":" if text == "κ2" else "--", lw=0.8)
         ax.set_title(f"stick depths (printed = unilateral)\nκc = {kc:.6g}, κ2 = κc (1 + {k2 / kc - 1:.2g})")
         kappa_axis(ax)
         ax.set_ylabel("stick depth δ* (µm)")
-        ax.legend(loc="upper right", fontsize=6)
+        ax.legend(loc="upper right")
 
         ax = axes[0, 1]
         for name, color, marker in (("printed", "C0", "o"), ("unilateral", "C1", "x")):
@@ -66,13 +67,13 @@ def main(quick=False, jobs=1):
         ax.set_ylabel("stick phases N")
         ax.set_yticks(range(0, int(max(pr.n_stick.max(), un.n_stick.max())) + 2))
         ax.set_title("number of stick phases\n(staircase near κc not resolved here)")
-        ax.legend(loc="upper left", fontsize=6)
+        ax.legend(loc="upper left")
 
         ax = axes[0, 2]
         separated = un.outcome_names() == "ratchet-escape"
         runaway_un = un.stop_reason == 2  # STOP_REASONS: horizon, settled, runaway, ...
         ok = separated & ~runaway_un & np.isfinite(un.restitution)
-        ax.plot(kappas[ok], un.restitution[ok], "o", ms=3, color="C1", label="unilateral: apparent restitution")
+        ax.plot(kappas[ok], un.restitution[ok], "o", ms=3, color="C1", label="unilateral")
         top = np.nanmax(un.restitution[ok]) if ok.any() else 1.5
         stopped = runaway_un & (kappas > kc)
         if stopped.any():  # the numerical guard (100 x the initial energy) stopped a run before it separated
@@ -84,7 +85,7 @@ def main(quick=False, jobs=1):
         kappa_axis(ax)
         ax.set_ylabel("restitution e (after the escape)")
         ax.set_title("above κc, unilateral: rebound, e > 1 possible\n(printed: every run above κc runs away)")
-        ax.legend(loc="upper left", fontsize=6)
+        ax.legend(loc="upper left")
 
         ax = axes[0, 3]
         for name, color, marker in (("printed", "C0", "o"), ("unilateral", "C1", "x")):
@@ -94,8 +95,8 @@ def main(quick=False, jobs=1):
         ax.axvline(kc, color="k", ls="--", lw=0.8)
         kappa_axis(ax)
         ax.set_ylabel("dissipated energy (mJ)")
-        ax.set_title("energy lost (paper: no Hertz potential)\nnegative = gained; floor = stopped at 2 E0")
-        ax.legend(loc="lower left", fontsize=6)
+        ax.set_title("energy lost (no Hertz potential for paper)\nnegative = gained; floor: stopped at 2 E0")
+        ax.legend(loc="lower left")
         ax.set_xlabel(KAPPA_LABEL)
         out = save(fig, FIGURES / f"{NAME}.png")
     return out

@@ -34,26 +34,26 @@ def main(quick=False, jobs=1):
     closed_error = kc.closed_form / kc.kappa - 1
     window = np.interp(k2.values, kc.values, kc.kappa)
     with style():
-        fig, axes = figure(1, 2, width=9, height=3.5)
+        fig, axes = figure(1, 2, height=3.3)
         ax = axes[0, 0]
-        ax.loglog(kc.values, kc.kappa, "o-", ms=3, color="C0", label=f"κc, continued (log-log slope {slope:.3f})")
+        ax.loglog(kc.values, kc.kappa, "o-", ms=3, color="C0", label=f"κc, continued (slope {slope:.3f})")
         ax.loglog(k2.values, k2.kappa, "s", ms=3, mfc="none", color="C3", label="κ2 (N = 2 from here on)")
-        ax.loglog(kc.values, kc.closed_form, "k--", lw=0.9, label="closed form (REFERENCE §5)")
+        ax.loglog(kc.values, kc.closed_form, "k--", lw=0.9, label="closed form")
         ax.loglog(kc.values, kc.kappa[0] * (kc.values / kc.values[0]) ** (-2 / 3), ":", color="0.5", lw=0.9,
                   label="∝ v^(−2/3)")
         ax.axvline(13.0, color="C1", ls=":", lw=0.8, label="seed's dust speed 13 m/s")
         ax.set_xlabel(V_LABEL)
         ax.set_ylabel(KAPPA_LABEL)
-        ax.set_title("paper: adding-sliding at κc(v), staircase ends at κ2(v)")
-        ax.legend(loc="lower left", fontsize=6)
+        ax.set_title("paper: adding-sliding at κc(v),\nstaircase ends at κ2(v)")
+        ax.legend(loc="lower left")
         ax = axes[0, 1]
         ax.loglog(kc.values, -closed_error, "k--", lw=0.9, label="1 − closed form / κc")
         ax.loglog(k2.values, k2.kappa / window - 1, "s-", ms=3, mfc="none", color="C3",
-                  label="κ2/κc − 1 (width of the staircase)")
+                  label="κ2/κc − 1 (staircase width)")
         ax.set_xlabel(V_LABEL)
         ax.set_ylabel("relative difference")
-        ax.set_title("closed form error and staircase width")
-        ax.legend(loc="upper right", fontsize=6)
+        ax.set_title("closed form's error and\nthe staircase's width")
+        ax.legend(loc="upper right")
         out = save(fig, FIGURES / f"{NAME}.png")
     return out
 

@@ -30,6 +30,8 @@ RADII = (0.005, 0.01, 0.02, 0.04)          # m
 THICKNESSES = (0.0025, 0.005, 0.01, 0.02)  # m
 SPEEDS_AT = (0.3, 1.0, 13.0)               # m/s
 
+#: One marker per curve of a panel, so the curves read apart in grayscale too.
+MARKERS = "os^v"
 
 def main(quick=False, jobs=1):
     seed = load_case("seed")
@@ -55,13 +57,14 @@ def main(quick=False, jobs=1):
     slope_r1, _ = loglog_fit(at_1.values[at_1.values <= 0.02], at_1.kappa[at_1.values <= 0.02])
     missing = critical_damping(seed.parameters(R1=0.002), "paper")
     with style():
-        fig, axes = figure(1, 4, width=13, height=3.6)
+        fig, grid = figure(2, 2, height=6.0)
+        axes = grid.reshape(1, 4)
         for ax, prefix, values, unit, title in ((axes[0, 0], "R1", RADII, "mm", "κc(v) for ball radii R1"),
                                                  (axes[0, 1], "h", THICKNESSES, "mm", "κc(v) for plate thicknesses h")):
             for i, x in enumerate(values):
                 c = curves[f"{prefix}={x:g}"]
                 slope, _ = loglog_fit(c.values, c.kappa)
-                ax.loglog(c.values, c.kappa, "o-", ms=2.5, color=f"C{i}",
+                ax.loglog(c.values, c.kappa, MARKERS[i] + "-", ms=2.5, color=f"C{i}",
                           label=f"{prefix} = {x * 1e3:g} {unit} (slope {slope:.2f})")
                 ax.loglog(c.values, c.closed_form, "k--", lw=0.7)
             ax.plot([], [], "k--", lw=0.7, label="closed form")
@@ -70,11 +73,11 @@ def main(quick=False, jobs=1):
             ax.set_title(title)
             if prefix == "R1":
                 ax.set_ylim(top=1e19)  # room for the legend above the curves
-            ax.legend(loc="upper right" if prefix == "R1" else "lower left", fontsize=6)
+            ax.legend(loc="upper right")
         ax = axes[0, 2]
         for i, v in enumerate(SPEEDS_AT):
             c = curves[f"v={v:g}"]
-            ax.loglog(c.values * 1e3, c.kappa, "o-", ms=2.5, color=f"C{i}", label=f"v = {v:g} m/s")
+            ax.loglog(c.values * 1e3, c.kappa, MARKERS[i] + "-", ms=2.5, color=f"C{i}", label=f"v = {v:g} m/s")
             ax.loglog(c.values * 1e3, c.closed_form, "k--", lw=0.7)
         ax.plot([], [], "k--", lw=0.7, label="closed form")
         ax.set_xticks([3, 5, 10, 20, 50])
@@ -82,18 +85,21 @@ def main(quick=False, jobs=1):
         ax.minorticks_off()
         ax.set_xlabel("ball radius R1 (mm)")
         ax.set_ylabel(KAPPA_LABEL)
-        ax.set_title(f"κc(R1): slope {slope_r1:.2f} at 1 m/s (R1 ≤ 20 mm)")
-        ax.legend(loc="upper right", fontsize=6)
+        ax.set_title(f"κc(R1): slope {slope_r1:.2f} at 1 m/s\n(R1 ≤ 20 mm)")
+        ax.legend(loc="upper right")
         ax = axes[0, 3]
-        for key, c in curves.items():
-            style_ = "-" if key.startswith("R1") else ("--" if key.startswith("h") else ":")
-            ax.loglog(ratio[key], np.abs(c.closed_form / c.kappa - 1), style_, lw=1,
-                      label=key.replace("R1=", "R1 = ").replace("h=", "h = ").replace("v=", "over R1, v = "))
+        families = {"R1": ("-", RADII, "κc(v) at each R1"), "h": ("--", THICKNESSES, "κc(v) at each h"),
+                    "v": (":", SPEEDS_AT, "κc(R1) at each v")}
+        for prefix, (line, values, label) in families.items():
+            for i, x in enumerate(values):  # the colours of the other panels
+                c = curves[f"{prefix}={x:g}"]
+                ax.loglog(ratio[f"{prefix}={x:g}"], np.abs(c.closed_form / c.kappa - 1), line, color=f"C{i}", lw=1.1)
+            ax.plot([], [], line, color="k", lw=1.1, label=label)
         ax.xaxis.set_minor_formatter(NullFormatter())
         ax.set_xlabel("Hertz contact time / plate period")
         ax.set_ylabel("|closed form / κc − 1|")
-        ax.set_title("closed form: exact for a slow plate")
-        ax.legend(loc="lower right", fontsize=5, ncol=2)
+        ax.set_title("closed form: exact for a slow plate\n(colours as in the other panels)")
+        ax.legend(loc="lower right")
         out = save(fig, FIGURES / f"{NAME}.png")
     summary = {"claim": claim(__doc__), "R1_2mm_v1_status": missing.status, "R1_2mm_v1_message": missing.message,
                "kappa_c_R1_slope_v1": slope_r1}

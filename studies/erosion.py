@@ -79,12 +79,13 @@ def main(quick=False, jobs=1):
                       "validity": validity(c.parameters(), c.plate, c.projectile)})
 
     with style():
-        fig, axes = figure(1, 4, width=13, height=3.6)
+        fig, grid = figure(2, 2, height=6.0)
+        axes = grid.reshape(1, 4)
         ax = axes[0, 0]
         for i, v in enumerate((30.0, 60.0, 90.0, 120.0)):
             sl = slice(i * n_d, (i + 1) * n_d)
             ax.loglog(sizes * 1e6, by_d["closed_force"][sl], "-", color=f"C{i}", lw=0.9)
-            ax.loglog(sizes[::3] * 1e6, by_d["force"][sl][::3], "o", color=f"C{i}", ms=3, mfc="none",
+            ax.loglog(sizes[::3] * 1e6, by_d["force"][sl][::3], "os^v"[i], color=f"C{i}", ms=3.5, mfc="none",
                       label=f"v = {v:g} m/s")
         ax.plot([], [], "k-", lw=0.9, label="Hertz closed form")
         ax.plot([], [], "ko", ms=3, mfc="none", label="simulated (abrate)")
@@ -92,37 +93,38 @@ def main(quick=False, jobs=1):
         ax.set_xlabel("grain diameter D (µm)")
         ax.set_ylabel("peak contact force (N)")
         ax.set_title("peak force ∝ D² v^1.2")
-        ax.legend(loc="upper left", fontsize=6)
+        ax.legend(loc="upper left")
 
         ax = axes[0, 1]
-        for i, d in enumerate(DIAMETERS):
+        for i in range(len(DIAMETERS)):
             sl = slice(i * n_v, (i + 1) * n_v)
-            ax.loglog(speeds, by_v["pressure"][sl] / 1e6, "o" if i == 0 else "x", ms=3, mfc="none", color=f"C{i}",
-                      label=f"D = {d * 1e6:g} µm")
+            sizes_text = f"simulated, D = {DIAMETERS[0] * 1e6:g}-{DIAMETERS[-1] * 1e6:g} µm"
+            ax.loglog(speeds, by_v["pressure"][sl] / 1e6, "os^v"[i], ms=3.5, mfc="none", color=f"C{i}",
+                      label=sizes_text if i == 0 else None)
         ax.loglog(speeds, by_v["closed_pressure"][:n_v] / 1e6, "k-", lw=0.9, label="Hertz closed form")
         ax.axhline(limit / 1e6, color="C3", ls="--", lw=1, label=f"first yield 1.6 Y = {limit / 1e6:.0f} MPa")
         ax.axvline(v_yield, color="C3", ls=":", lw=0.8)
-        ax.axvspan(60, 120, color="0.85", zorder=0, label="blade-tip speeds 60-120 m/s")
-        ax.annotate(f"elastic below\n{v_yield:.2g} m/s", (v_yield, limit / 1e6), (0.12, 500), fontsize=6,
+        ax.axvspan(60, 120, color="0.85", zorder=0, label="blade-tip speeds")
+        ax.annotate(f"elastic below\n{v_yield:.2g} m/s", (v_yield, limit / 1e6), (2.0, 85),
                     arrowprops={"arrowstyle": "->", "lw": 0.6})
         ax.set_xlabel(V_LABEL)
         log_ticks(ax.yaxis, [100, 200, 500, 1000])
         ax.set_ylabel("peak pressure p0 (MPa)")
         ax.set_title("peak pressure ∝ v^0.4, any size")
-        ax.legend(loc="lower right", fontsize=6)
+        ax.legend(loc="upper left")
 
         ax = axes[0, 2]
         for i, v in enumerate((30.0, 60.0, 90.0, 120.0)):
             sl = slice(i * n_d, (i + 1) * n_d)
             ax.loglog(sizes * 1e6, by_d["closed_time"][sl] * 1e9, "-", color=f"C{i}", lw=0.9)
-            ax.loglog(sizes[::3] * 1e6, by_d["time"][sl][::3] * 1e9, "o", color=f"C{i}", ms=3, mfc="none",
+            ax.loglog(sizes[::3] * 1e6, by_d["time"][sl][::3] * 1e9, "os^v"[i], color=f"C{i}", ms=3.5, mfc="none",
                       label=f"v = {v:g} m/s")
         log_ticks(ax.xaxis, [50, 100, 200, 400])
         log_ticks(ax.yaxis, [200, 500, 1000, 2000])
         ax.set_xlabel("grain diameter D (µm)")
         ax.set_ylabel("contact time (ns)")
         ax.set_title("contact time ∝ D v^−0.2")
-        ax.legend(loc="upper left", fontsize=6)
+        ax.legend(loc="upper left")
 
         ax = axes[0, 3]
         D, V = np.meshgrid(sizes * 1e6, speeds)
@@ -133,7 +135,7 @@ def main(quick=False, jobs=1):
         ax.axhline(v_yield, color="w", lw=1.2, label="p0 = 1.6 Y (first yield)")
         ax.axhline(v_radius, color="C2", lw=1.2, ls="--", label=f"contact radius = {CONTACT_RATIO_LIMIT:g} R1")
         ax.plot(case.geometry.R1 * 2e6, case.impact["v"], "*", color="C0", ms=9, mec="w",
-                label=f"{CASE}: p0 = {this['pressure_to_first_yield']:.1f} × 1.6 Y")
+                label=f"{CASE}: {this['pressure_to_first_yield']:.1f} × 1.6 Y")
         dust = load_case("dust-gelcoat")
         ax.plot(dust.geometry.R1 * 2e6, dust.impact["v"], "D", color="C9", ms=5, mec="w", label="dust-gelcoat")
         ax.set_xscale("log")
@@ -143,7 +145,7 @@ def main(quick=False, jobs=1):
         ax.set_ylabel(V_LABEL)
         ax.grid(False)
         ax.set_title("elastic validity (sand on gelcoat)")
-        ax.legend(loc="lower left", fontsize=5.5, frameon=True, facecolor="white", framealpha=0.85)
+        ax.legend(loc="lower left", frameon=True, facecolor="white", framealpha=0.85)
         out = save(fig, FIGURES / f"{NAME}.png")
 
     data = {}

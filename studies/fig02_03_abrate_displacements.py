@@ -24,7 +24,7 @@ def main(quick=False, jobs=1):
     runs = {k: simulate(p, law, t_end, save=times) for k, law in laws.items()}
     data = {"t": (times, "s")}
     with style():
-        fig, axes = figure(2, 2, width=7.5, height=5.0)
+        fig, axes = figure(2, 2, height=5.0)
         for row, (name, tr) in enumerate(runs.items()):
             for col, window in enumerate((0.3e-3, t_end)):
                 ax = axes[row, col]
@@ -34,11 +34,12 @@ def main(quick=False, jobs=1):
                 values = np.concatenate([tr.x1[shown], tr.x2[shown], tr.delta[shown]]) * UM
                 pad = 0.05 * np.ptp(values)
                 ax.set_ylim(values.min() - pad, values.max() + pad)
-                ax.set_title(f"Abrate, {name} contact, v = 1 m/s, {window * MS:g} ms")
+                ax.set_title(f"Abrate, {name} contact, {window * MS:g} ms")
             data[f"{name}/x1"] = (tr.x1, "m")
             data[f"{name}/x2"] = (tr.x2, "m")
             data[f"{name}/force"] = (tr.force, "N")
-        axes[0, 0].legend(loc="best")
+        axes[0, 0].legend(loc="lower left")
+        fig.suptitle("v = 1 m/s")
         out = save(fig, ROOT / f"{NAME}.png")
     save_h5(ROOT / "data" / f"{NAME}.h5", data, {"v": 1.0, "law": "abrate", "claim": __doc__.strip()})
     return out

@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 
 from phaseimpact import ContactLaw, seed_parameters, simulate
-from phaseimpact.plotting import UM, figure, plot_hysteresis, save, save_h5, style
+from phaseimpact.plotting import COLUMN_WIDTH, UM, figure, plot_hysteresis, save, save_h5, style
 from phaseimpact.quantities import impact_quantities
 
 ROOT = Path(__file__).resolve().parents[1] / "figures"
@@ -24,9 +24,9 @@ def main(quick=False, jobs=1):
     q = impact_quantities(tr)
     d = np.linspace(0, tr.delta.max(), 200)
     with style():
-        fig, axes = figure(1, 1, width=4.5, height=3.2)
+        fig, axes = figure(1, 1, width=COLUMN_WIDTH, height=2.8)
         ax = axes[0, 0]
-        plot_hysteresis(ax, tr, label="Abrate (undamped), v = 1 m/s", color="C0", lw=2.5, alpha=0.6)
+        plot_hysteresis(ax, tr, label="Abrate, undamped, v = 1 m/s", color="C0", lw=2.5, alpha=0.6)
         ax.plot(d * UM, p.K * d**p.alpha, "k--", lw=0.9, label=r"Hertz $K\delta^{1.5}$")
         ax.set_title(f"Undamped contact: loop area {q.loop_area:.2e} J")
         ax.legend()

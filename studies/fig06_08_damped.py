@@ -27,9 +27,9 @@ def main(quick=False, jobs=1):
     times = np.linspace(0.0, t_end, 1501 if quick else 6001)
     data = {"t": (times, "s"), "kappa": (np.array(KAPPAS), "N s/m^2.5")}
     with style():
-        fig, axes = figure(3, 2, width=7.5, height=7.5)
+        fig, axes = figure(3, 2, height=7.6)
         for col, law in enumerate(LAWS):
-            name = "paper (printed = unilateral here)" if law == "paper" else law
+            name = "paper" if law == "paper" else law
             for i, kappa in enumerate(KAPPAS):
                 tr = simulate(p.replace(kappa=kappa), law, t_end, save=times)
                 ls = ("-", "--", ":")[i]
@@ -45,13 +45,19 @@ def main(quick=False, jobs=1):
             ax = axes[0, col]
             ax.set_xlabel("time t (ms)")
             ax.set_ylabel("displacement (µm)")
-            ax.set_title(f"{name}\nx1 (blue), x2 (orange), x1 − x2 (green)")
+            ax.set_title(f"{name}: displacements")
+            # each quantity named at its line's end: the colours need not be told apart (grayscale)
+            for key, values in (("$x_1$", tr.x1), ("$x_2$", tr.x2), (r"$x_1 - x_2$", tr.delta)):
+                ax.annotate(key, (tr.t[-1] * MS, values[-1] * UM), xytext=(3, 0), textcoords="offset points",
+                            va="center", ha="left")
+            ax.set_xlim(0, 0.38)
             axes[1, col].set_title(f"{name}: contact force")
             axes[2, col].set_title(f"{name}: hysteresis loop")
             if law == "hunt-crossley":  # the flight after the separation (P = 0) is not part of the loop
                 axes[2, col].set_xlim(-3, 40)
             for r in range(3):
                 axes[r, col].legend(loc="best")
+        fig.suptitle("v = 1 m/s; the printed and unilateral readings of paper coincide here")
         out = save(fig, ROOT / f"{NAME}.png")
     save_h5(ROOT / "data" / f"{NAME}.h5", data, {"v": 1.0, "claim": " ".join(__doc__.split())})
     return out

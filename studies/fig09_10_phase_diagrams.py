@@ -56,7 +56,8 @@ def main(quick=False, jobs=1):
     printed, unilateral = READINGS["printed"], READINGS["unilateral"]
     data = {"kappa_c": (np.array([kc]), "N s/m^2.5"), "kappa_2": (np.array([k2]), "N s/m^2.5")}
     with style():
-        fig, axes = figure(2, 4, width=13, height=6.4)
+        fig, grid = figure(4, 2, height=9.4)
+        axes = grid.reshape(2, 4)
         for ax, kappa in zip(axes[0], KAPPAS, strict=True):
             tr = run(p.replace(kappa=kappa), printed)
             phase(ax, tr, color="C0", lw=0.9, label="printed: " + short(tr))
@@ -77,7 +78,7 @@ def main(quick=False, jobs=1):
             else:
                 title += f",\npermanent; {ending(tr)}"
             ax.set_title(title)
-            ax.legend(loc="center left" if kappa > kc else "lower left", fontsize=6)
+            ax.legend(loc="center left" if kappa > kc else "lower left")
 
         # Fig. 10: just below and just above kappa_c.
         below = run(p.replace(kappa=kc * (1 + BELOW)), printed)
@@ -87,19 +88,14 @@ def main(quick=False, jobs=1):
         _, d_below, _ = below.stick_points()
         mark_points(ax, np.column_stack([d_below, np.zeros_like(d_below)]), label="stick point (permanent)")
         ax.set_title(f"Fig. 10: κ = κc (1 − 1e-4)\n{below.n_stick} stick point, {outcome_of(below)}")
-        ax.legend(loc="lower left", fontsize=6)
+        ax.legend(loc="lower left")
         ax = axes[1, 1]
         phase(ax, above, color="C3", lw=0.6)
         t_st, d_st, _ = above.stick_points()
         mark_points(ax, np.column_stack([d_st, np.zeros_like(d_st)]), label="stick points")
         ax.set_title(f"Fig. 10: κ = κc (1 + 1e-4), printed\n{above.n_stick} stick points, escape at "
                      f"{above.t_run * MS:.3g} ms, runaway")
-        ax.legend(loc="lower right", fontsize=6)
-        inset = ax.inset_axes([0.22, 0.5, 0.24, 0.34])
-        inset.plot(np.arange(1, len(d_st) + 1), (d_st - d_st[0]) * 1e9, "o", ms=2, color="C3")
-        inset.set_xlabel("stick phase k", fontsize=6, labelpad=1)
-        inset.set_ylabel("δ*ₖ − δ*₁ (nm)", fontsize=6, labelpad=1)
-        inset.tick_params(labelsize=5)
+        ax.legend(loc="lower right")
         data["fig10_below/delta"] = (below.delta, "m")
         data["fig10_below/deltadot"] = (below.deltadot, "m/s")
         data["fig10_above/delta"] = (above.delta, "m")
@@ -112,15 +108,15 @@ def main(quick=False, jobs=1):
         exact = simulate(p.replace(kappa=kappa), "paper", 2e-4, save=np.linspace(0, 2e-4, 2001))
         ax = axes[1, 2]
         ax.plot(exact.t * MS, exact.deltadot, "k", lw=1.2, label="exact (events)")
-        for step, color in ((4e-7, "C1"), (1e-7, "C4")):
+        for step, color, line in ((4e-7, "C1", "-"), (1e-7, "C4", "--")):
             rk4 = simulate(p.replace(kappa=kappa), "paper", 2e-4, integrator="rk4", step=step, save="steps")
-            ax.plot(rk4.t * MS, rk4.deltadot, color=color, lw=0.6, label=f"seed RK4, h = {step:g} s")
+            ax.plot(rk4.t * MS, rk4.deltadot, color=color, ls=line, lw=0.8, label=f"seed RK4, h = {step:g} s")
         ax.set_xlim(0.04, 0.12)
         ax.set_ylim(-0.02, 0.05)
         ax.set_xlabel("time t (ms)")
         ax.set_ylabel(r"$\dot\delta$ (m/s)")
         ax.set_title("κ = 1e9: the seed's RK4 chatters\nwhere the exact solution sticks")
-        ax.legend(loc="upper right", fontsize=6)
+        ax.legend(loc="upper right")
 
         # The ratchet and the escape of the run above kappa_c, over its whole length.
         ax = axes[1, 3]
@@ -132,7 +128,7 @@ def main(quick=False, jobs=1):
         ax.set_xlabel("time t (ms)")
         ax.set_ylabel("δ − δ*₁ (nm)")
         ax.set_title("κ = κc (1 + 1e-4): δ* ratchets\noutwards, then escapes (off the axis)")
-        ax.legend(loc="upper left", fontsize=6)
+        ax.legend(loc="upper left")
         data["fig10_above/t"] = (above.t, "s")
         out = save(fig, FIGURES / f"{NAME}.png")
     save_h5(FIGURES / "data" / f"{NAME}.h5", data,

@@ -20,7 +20,7 @@ from _plots import READINGS, claim, log_ticks
 from phaseimpact import ContactLaw, seed_parameters, simulate
 from phaseimpact.continuation import critical_damping, sweep
 from phaseimpact.model import hunt_crossley_restitution
-from phaseimpact.plotting import figure, save, save_h5, style
+from phaseimpact.plotting import COLUMN_WIDTH, figure, save, save_h5, style
 
 RUNAWAY = 2  # index of "runaway" in the stop reasons
 
@@ -34,7 +34,8 @@ def main(quick=False, jobs=1):
     kappas = np.geomspace(1e8, 1e13, 25 if quick else 81)
     data = {"kappa": (kappas, "N s/m^2.5")}
     with style():
-        fig, axes = figure(1, 3, width=11, height=3.4)
+        fig, axes = figure(3, 1, width=COLUMN_WIDTH, height=8.4)
+        axes = axes.reshape(1, 3)
         ax = axes[0, 0]
         for (name, law), color, ls in zip((("paper, printed", READINGS["printed"]),
                                             ("paper, unilateral", READINGS["unilateral"]),
@@ -45,7 +46,7 @@ def main(quick=False, jobs=1):
             force = np.where(result.stop_reason == RUNAWAY, np.nan, result.max_force)
             best = int(np.nanargmin(force))
             ax.loglog(kappas, force, color=color, ls=ls,
-                      label=f"{name}: min {force[best]:.4g} N at κ = {kappas[best]:.3g}")
+                      label=f"{name}: {force[best]:.4g} N at {kappas[best]:.3g}")
             ax.plot(kappas[best], result.max_force[best], "o", color=color, mfc="none")
             data[f"{name.replace(', ', '_')}/max_force"] = (result.max_force, "N")
             data[f"{name.replace(', ', '_')}/runaway"] = (result.stop_reason == RUNAWAY, "1")
@@ -54,7 +55,7 @@ def main(quick=False, jobs=1):
         log_ticks(ax.yaxis, [4000, 6000, 10000, 20000, 40000])
         ax.set_ylabel("maximum contact force (N)")
         ax.set_title("plate, v = 1 m/s: optimum damping\n(runs stopped as runaways omitted)")
-        ax.legend(loc="upper left")
+        ax.legend(loc="upper left", title="minimum force at κ")
 
         ax = axes[0, 1]
         free = p.replace(target="free")
@@ -73,13 +74,14 @@ def main(quick=False, jobs=1):
         for name, color in zip(RESTITUTION_LAWS, ("C2", "C3", "C4", "C5", "k"), strict=True):
             measured = [simulate(free, ContactLaw(name, restitution=float(e))).restitution for e in requested]
             label = "exact inverse (hunt-crossley)" if name == "hunt-crossley" else name
-            ax.plot(requested, measured, "o-" if name != "hunt-crossley" else "-", ms=3, color=color, label=label)
+            line = "os^vD"[RESTITUTION_LAWS.index(name)] + "-" if name != "hunt-crossley" else "-"
+            ax.plot(requested, measured, line, ms=3, color=color, label=label)
             data[f"restitution_laws/{name}"] = (np.array(measured, dtype=float), "1")
         ax.plot([0, 1], [0, 1], ":", color="grey", lw=0.8)
         ax.set_xlabel("requested restitution e")
         ax.set_ylabel("measured restitution")
         ax.set_title("restitution laws, free target, v = 1 m/s")
-        ax.legend(loc="upper left")
+        ax.legend(loc="lower right")
         data["restitution_laws/requested"] = (requested, "1")
         out = save(fig, FIGURES / f"{NAME}.png")
     save_h5(FIGURES / "data" / f"{NAME}.h5", data, {"v": 1.0, "claim": claim(__doc__)})

@@ -44,21 +44,22 @@ def main(quick=False, jobs=1):
     counts = np.array([c for c, _ in results]).reshape(len(steps), len(kappas), len(TOLERANCES))
     runaway = np.array([s == "runaway" for _, s in results]).reshape(len(steps), len(kappas))
     with style():
-        fig, axes = figure(1, len(TOLERANCES), width=10, height=3.6)
+        fig, axes = figure(1, len(TOLERANCES), height=3.4)
         for j, tol in enumerate(TOLERANCES):
             ax = axes[0, j]
             ax.semilogx(kappas, exact, "k-o", ms=3, lw=1.5, label="exact (events, until settled)")
             for i, h in enumerate(steps):
-                ax.semilogx(kappas, counts[i, :, j], "o--", ms=3, lw=0.8, label=f"RK4, h = {h:g} s")
+                ax.semilogx(kappas, counts[i, :, j], "s^v"[i] + "--", ms=3, lw=0.8, label=f"RK4, h = {h:g} s")
                 ax.plot(kappas[runaway[i]], counts[i, runaway[i], j], "x", color=f"C{i}", ms=6)
             ax.plot([], [], "kx", label="RK4 run ended in runaway")
             ax.axvline(kc, color="C3", lw=0.8, ls=":", label=f"κc = {kc:.6g}")
             ax.set_xlabel("κ (N s/m$^{2.5}$)")
             ax.set_ylabel("asymptotic points found")
             ax.yaxis.set_major_locator(MaxNLocator(integer=True))
-            ax.set_title(f"seed RK4, distance tolerance {tol:g}")
+            ax.set_title(f"distance tolerance {tol:g}")
         handles, labels = axes[0, 0].get_legend_handles_labels()
-        fig.legend(handles, labels, loc="outside lower center", ncol=6, fontsize=7)
+        fig.legend(handles, labels, loc="outside lower center", ncol=3)
+        fig.suptitle("Asymptotic points counted on the seed's RK4 output")
         out = save(fig, FIGURES / f"{NAME}.png")
     save_h5(FIGURES / "data" / f"{NAME}.h5",
             {"kappa": (kappas, "N s/m^2.5"), "step": (np.array(steps), "s"), "tolerance": (np.array(TOLERANCES), "1"),

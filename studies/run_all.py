@@ -29,6 +29,7 @@ STUDIES = (
     "erosion",
     "plastic",
     "train",
+    "train_bifurcations",
     "max_force_vs_kappa",
     "rk4_critical",
     "claims",
@@ -54,7 +55,8 @@ def main() -> int:
         t0 = time.perf_counter()
         module = load(name)
         _cli.redirect(vars(module), args.quick)
-        out = module.main(quick=args.quick, jobs=args.jobs)
+        with _cli.for_print():
+            out = module.main(quick=args.quick, jobs=args.jobs)
         tqdm.write(f"{name:32s} {time.perf_counter() - t0:6.1f} s  -> {Path(out).relative_to(HERE.parent)}")
     print(f"all studies done in {time.perf_counter() - start:.1f} s")
     return 0

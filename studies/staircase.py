@@ -78,7 +78,8 @@ def main(quick=False, jobs=1):
     slopes = [loglog_fit(EXPONENT_EPS[:3], local[:3, j])[0] for j in range(3)]
 
     with style():
-        fig, axes = figure(1, 4, width=13, height=3.6)
+        fig, grid = figure(2, 2, height=5.8)
+        axes = grid.reshape(1, 4)
         ax = axes[0, 0]
         ax.loglog(eps[good], n[good], "-", drawstyle="steps-mid", color="C0", lw=1, label="printed")
         if np.any(missed):
@@ -91,7 +92,7 @@ def main(quick=False, jobs=1):
         ax.set_xlabel("κ/κc − 1")
         ax.set_ylabel("stick phases before the escape N")
         ax.set_title(f"N(κ) above κc = {kc:.6g}")
-        ax.legend(loc="upper right", fontsize=6)
+        ax.legend(loc="upper right")
 
         ax = axes[0, 1]
         near = eps >= 6e-5
@@ -103,30 +104,30 @@ def main(quick=False, jobs=1):
         ax.set_xlabel("(κ/κc − 1) × 1e4")
         ax.set_ylabel("N")
         ax.set_title("the staircase ends at κ2")
-        ax.legend(loc="upper right", fontsize=6)
+        ax.legend(loc="upper right")
 
         ax = axes[0, 2]
         ax.loglog(eps[good], t_run[good] * 1e3, ".", ms=3, color="C0", label="printed")
         ax.loglog(eps_un[ok_un], t_un[ok_un] * 1e3, "x", ms=4, color="C1", label="unilateral")
         ax.loglog(eps[fit], np.exp(intercept) * eps[fit] ** slope * 1e3, "k-", lw=0.8,
-                  label=f"fit for κ/κc − 1 ≤ {FIT_MAX:g}: slope {slope:.3f}")
+                  label=f"fit, κ/κc − 1 ≤ {FIT_MAX:g}: slope {slope:.3f}")
         ax.axvline(k2 / kc - 1, color="k", ls=":", lw=0.8)
         ax.set_xlabel("κ/κc − 1")
         ax.set_ylabel("time to the escape T_run (ms)")
-        ax.set_title(f"T_run diverges at κc (plate period {period * 1e3:.3g} ms)")
-        ax.legend(loc="upper right", fontsize=6)
+        ax.set_title(f"T_run diverges at κc\n(plate period {period * 1e3:.3g} ms)")
+        ax.legend(loc="upper right")
 
         ax = axes[0, 3]
-        for j, (name, ex, color) in enumerate(zip(names, expected, ("C0", "C2", "C4"), strict=True)):
+        for j, (name, ex, color, marker) in enumerate(zip(names, expected, ("C0", "C2", "C4"), "os^", strict=True)):
             y = local[:, j] / local[0, j]
-            ax.loglog(EXPONENT_EPS, y, "o-", ms=3, color=color,
-                      label=f"{name}: local slope {slopes[j]:.3f} (→ {ex:g})")
+            ax.loglog(EXPONENT_EPS, y, marker + "-", ms=3, color=color,
+                      label=f"{name}: slope {slopes[j]:.3f} (→ {ex:g})")
             ax.loglog(EXPONENT_EPS, (EXPONENT_EPS / EXPONENT_EPS[0]) ** ex, ":", color=color, lw=0.8)
         ax.set_xlabel("κ/κc − 1")
-        ax.set_ylabel("relative to its value at the smallest offset")
-        ax.plot([], [], "k:", lw=0.8, label="ε^(3/2), ε^2, ε^(1/2), ε = κ/κc − 1")
+        ax.set_ylabel("relative to the smallest offset's")
+        ax.plot([], [], "k:", lw=0.8, label="ε^(3/2), ε², ε^(1/2); ε = κ/κc − 1")
         ax.set_title("adding-sliding: the first slip")
-        ax.legend(loc="upper left", fontsize=6)
+        ax.legend(loc="upper left")
         out = save(fig, FIGURES / f"{NAME}.png")
     save_h5(FIGURES / "data" / f"{NAME}.h5", {
         "eps": (eps, "1"), "kappa": (kc * (1 + eps), "N s/m^2.5"), "n_stick": (n, "1"), "t_run": (t_run, "s"),

@@ -48,6 +48,10 @@ def outputs(tmp_path_factory):
                   "--fixed-point"],
         "orbit-diagram": ["orbit-diagram", "--law", "hunt-crossley", "--axis", "T=2e-3:3e-3:2", "--transients", "3",
                           "--samples", "2"],
+        "map-continuation": ["map-continuation", "--law", "hunt-crossley", "--kappa", "3e9", "--axis",
+                             "T=0.99e-3:0.975e-3:6"],
+        "basins": ["basins", "--law", "hunt-crossley", "--kappa", "3e9", "--period", "1.0036e-3", "--grid", "2",
+                   "--iterations", "50", "--out", tmp / "b.png"],
     }
     out = {}
     for name, argv in argvs.items():  # in order: plot reads the sweep's archive

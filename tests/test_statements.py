@@ -350,7 +350,7 @@ STATEMENTS = [
     Statement(R, "unilateral separates with e = {} and {})",
               lambda: (computed_run(kappa=1.6e12, reading="unilateral").restitution,
                        claims_md(r"apparent restitution ([\d.]+)"))),
-    Statement(R, "({} stick points, escape at {} ms; inset: the stick depths ratchet outwards by {} nm)",
+    Statement(R, "({} stick points, escape at {} ms, the stick depths ratcheting outwards by {} nm)",
               lambda: (int(h5("fig09_10_phase_diagrams", "n_stick_above")),
                        1e3 * h5("fig09_10_phase_diagrams", "t_run_above"),
                        1e9 * np.ptp(h5("fig09_10_phase_diagrams", "fig10_above/stick_delta")))),
@@ -488,6 +488,12 @@ EXEMPT = {
         "1997": "year", "383": "page (Thornton 1997, J. Appl. Mech. 64:383)"},
     PL: {"1997": "year", "383": "page (Thornton 1997, J. Appl. Mech. 64:383)"},
     TR: {"200": "input (impacts dropped)", "400": "input (values of T)"},
+    "studies/train_bifurcations.py": {
+        "0.9830": "checked by tests/test_train.py::test_a_located_period_doubling_gives_birth_to_a_period_2_orbit",
+        "0.9695": "checked by tests/test_train.py::test_a_located_fold_is_where_the_branch_turns",
+        "0.988": "checked by tests/test_train.py::test_the_period_doubling_is_followed_in_kappa",
+        "0.978": "the study's output (the curve's point at kappa = 4e9)",
+        "1.01": "input (the range of T)"},
     ER: {"1985": "year", "11.4": "Johnson's section", "100": "input (grain size)", "300": "input (grain sizes)",
          "150": "input (speed range)", "120": "input (blade-tip speed range)"},
 }

@@ -9,7 +9,16 @@ from _cli import run
 
 from phaseimpact import seed_parameters
 from phaseimpact.integrate import scales
-from phaseimpact.train import impact_train, lyapunov_exponent, map_fixed_point, orbit_diagram
+from phaseimpact.train import (
+    basins,
+    continue_map_bifurcation,
+    continue_map_orbit,
+    impact_train,
+    lyapunov_exponent,
+    map_fixed_point,
+    map_jacobian,
+    orbit_diagram,
+)
 
 SEED = seed_parameters(v=1.0)
 
@@ -96,3 +105,152 @@ def test_bad_input_is_refused_before_any_work():
     assert code == 2 and "--period" in err
     code, _, err = run(["train", "--law", "abrate", "--period", "0"])
     assert code == 2 and "period" in err
+
+
+# ---------------------------------------------------------------- continuation, bifurcations, basins
+
+HC = "hunt-crossley"
+CASE = SEED.replace(kappa=3e9)  # studies/train.py's case
+PLATE_PERIOD = scales(CASE).plate_period
+
+
+def test_the_continued_impulsive_branch_has_the_analytic_multipliers_and_no_bifurcation():
+    """REFERENCE.md §7's affine map: its multipliers satisfy (1 + mu1)(1 + mu2) = (1 + d)(1 + cos wT) and
+    (1 - mu1)(1 - mu2) = (1 + d)(1 - cos wT), d = det R D, never negative: a multiplier touches -1 or +1
+    (at wT = pi, 2 pi) without crossing, so the analytic map has no bifurcation; the branch followed
+    between those values carries its multipliers and reports none."""
+    p = SEED.replace(Km=0.0, Kb=SEED.Kb / 100, K=SEED.K * 1e4)
+    s = scales(p)
+    branch = continue_map_orbit(p, "abrate", "T", 0.3 * s.plate_period, 0.45 * s.plate_period,
+                                step=0.03 * s.plate_period)
+    assert branch.message == "reached the end of the range" and len(branch.values) >= 6
+    assert branch.points == []
+    ratio = s.contact_time / s.plate_period
+    for value, multipliers in zip(branch.values, branch.multipliers, strict=True):
+        _, analytic, _ = impulsive(p, value)
+        assert np.max(np.abs(np.sort(multipliers.real) - analytic)) < 3 * ratio
+
+
+@pytest.fixture(scope="module")
+def small_branch():
+    """The small-amplitude period-1 orbit just below one plate period, followed down in T."""
+    return continue_map_orbit(CASE, HC, "T", 0.99 * PLATE_PERIOD, 0.975 * PLATE_PERIOD, step=0.003 * PLATE_PERIOD)
+
+
+def test_a_located_period_doubling_gives_birth_to_a_period_2_orbit(small_branch):
+    """Just below the located T a stable period-2 orbit exists apart from the (now unstable) period-1
+    orbit; just above, the period-2 search collapses onto the period-1 orbit."""
+    (pd,) = small_branch.points
+    assert pd.kind == "period-doubling" and round(pd.value / PLATE_PERIOD, 4) == 0.9830  # studies/train_bifurcations
+    assert np.min(np.abs(pd.multipliers + 1)) < 1e-6 and pd.bracket < 1e-9 * PLATE_PERIOD
+    assert small_branch.stable[0] and not small_branch.stable[-1]
+    J, _ = map_jacobian(CASE, HC, pd.value, pd.plate)
+    w, vectors = np.linalg.eig(J)
+    v = vectors[:, np.argmin(np.abs(w + 1))].real
+    scale = np.array([CASE.hertz_indentation, CASE.v])
+    kick = pd.plate + 0.03 * v / np.linalg.norm(v / scale)  # along the flip direction
+    distance = {}
+    for side in (-1, 1):
+        T = pd.value * (1 + side * 1e-3)
+        start = impact_train(CASE, HC, T, 300, plate=kick).plate[-1]
+        two = map_fixed_point(CASE, HC, T, k=2, guess=start)
+        one = map_fixed_point(CASE, HC, T, guess=pd.plate)
+        assert two.converged and one.converged
+        assert one.stable == (side > 0)
+        distance[side] = np.max(np.abs(two.plate - one.plate) / scale)
+        if side < 0:
+            assert two.stable
+    assert distance[-1] > 0.05 and distance[1] < 1e-9
+
+
+@pytest.fixture(scope="module")
+def large_branch():
+    """The large-amplitude period-1 orbit, followed up in T into its fold."""
+    return continue_map_orbit(CASE, HC, "T", 0.9 * PLATE_PERIOD, 0.98 * PLATE_PERIOD, step=0.005 * PLATE_PERIOD)
+
+
+def test_a_located_fold_is_where_the_branch_turns(large_branch):
+    folds = [p for p in large_branch.points if p.kind == "fold"]
+    assert len(folds) == 1
+    fold = folds[0]
+    assert fold.turning and np.min(np.abs(fold.multipliers - 1)) < 1e-6
+    assert round(fold.value / PLATE_PERIOD, 4) == 0.9695  # studies/train_bifurcations.py
+    turn = int(np.argmax(large_branch.values))
+    # the fold lies beyond every point of the branch, by less than the branch's curvature allows over
+    # one step on either side of the turn
+    gap = fold.value - large_branch.values[turn]
+    assert 0 <= gap < 1e-4 * PLATE_PERIOD
+    assert large_branch.stable[:turn].all() and not large_branch.stable[turn + 1:].any()
+    # past the fold no period-1 orbit is near
+    past = map_fixed_point(CASE, HC, fold.value * (1 + 1e-4), guess=fold.plate)
+    assert not past.converged or np.max(np.abs(past.plate - fold.plate) / np.array([CASE.hertz_indentation, 1])) > 1
+
+
+def test_the_period_doubling_is_followed_in_kappa(small_branch):
+    """Each point of the curve is a period-doubling (a multiplier at -1) and agrees with a fresh
+    one-parameter location at that kappa."""
+    (pd,) = small_branch.points
+    curve = continue_map_bifurcation(CASE, HC, small_branch, pd, "kappa", [3e9, 2.5e9, 2e9])
+    assert curve.message == "followed over the whole grid" and np.all(np.isfinite(curve.values))
+    assert np.max(np.abs(np.abs(curve.multipliers + 1).min(axis=1))) < 1e-6
+    assert curve.values[0] == pytest.approx(pd.value, rel=1e-9)
+    assert np.all(np.diff(curve.values) > 0)  # less damping: the doubling moves up towards the multiple
+    assert round(curve.values[-1] / PLATE_PERIOD, 3) == 0.988  # studies/train_bifurcations.py
+    fresh = continue_map_orbit(CASE.replace(kappa=2e9), HC, "T", 0.995 * PLATE_PERIOD, 0.98 * PLATE_PERIOD,
+                               step=0.003 * PLATE_PERIOD)
+    (again,) = [p for p in fresh.points if p.kind == "period-doubling"]
+    assert again.value == pytest.approx(curve.values[-1], rel=1e-9)
+
+
+def test_one_attractor_has_one_basin_over_the_whole_grid():
+    """At 0.4 plate periods (studies/train.py: period-1 orbits only there) every state goes to the
+    period-1 orbit of map_fixed_point."""
+    grid = np.linspace(-2e-4, 2e-4, 3)
+    period = 0.4 * PLATE_PERIOD
+    b = basins(CASE, HC, period, grid, grid * 6e3, n_jobs=2)
+    assert len(b.attractors) == 1 and b.attractors[0].period == 1 and np.all(b.labels == 0)
+    assert b.attractors[0].count == 9 and b.not_converged == 0 == b.no_map
+    fp = map_fixed_point(CASE, HC, period)
+    scale = np.array([CASE.hertz_indentation, CASE.v])
+    assert np.max(np.abs(b.attractors[0].plate[0] - fp.plate) / scale) < 1e-5
+
+
+def test_coexisting_attractors_each_hold_their_basin():
+    """At one plate period the small period-1 orbit (2 contacts an impact) coexists with a large
+    period-2 orbit: both are found, and trains started in each basin end on their attractor."""
+    xs = np.linspace(-60e-6, 60e-6, 4)
+    vs = np.linspace(-0.3, 0.3, 3)
+    one = basins(CASE, HC, PLATE_PERIOD, xs, vs, n_jobs=1)
+    two = basins(CASE, HC, PLATE_PERIOD, xs, vs, n_jobs=2)
+    assert np.array_equal(one.labels, two.labels) and np.array_equal(one.impacts, two.impacts)
+    periods = sorted(a.period for a in one.attractors)
+    assert periods[:2] == [1, 2], periods
+    scale = np.array([CASE.hertz_indentation, CASE.v])
+    for index, attractor in enumerate(one.attractors):
+        fp = map_fixed_point(CASE, HC, PLATE_PERIOD, k=attractor.period, guess=attractor.plate[0])
+        assert fp.converged and fp.stable
+        assert np.max(np.abs(fp.plate - attractor.plate[0]) / scale) < 1e-5
+        i, j = np.argwhere(one.labels == index)[0]
+        train = impact_train(CASE, HC, PLATE_PERIOD, 400, plate=(xs[j], vs[i]))
+        end = train.plate[-attractor.period:]
+        assert min(np.max(np.abs(np.roll(end, s, axis=0) - attractor.plate) / scale)
+                   for s in range(attractor.period)) < 1e-5
+
+
+def test_bad_continuation_and_basin_input_is_refused():
+    with pytest.raises(ValueError, match="stop = 0.001 is out of range"):
+        continue_map_orbit(CASE, HC, "T", 1e-3, 1e-3)
+    with pytest.raises(ValueError, match="start = -1"):
+        continue_map_orbit(CASE, HC, "T", -1, 1e-3)
+    with pytest.raises(ValueError, match="period = None"):
+        continue_map_orbit(CASE, HC, "v", 1.0, 2.0)
+    with pytest.raises(ValueError, match="step = 1"):
+        continue_map_orbit(CASE, HC, "T", 1e-3, 2e-3, step=1)
+    with pytest.raises(ValueError, match="tol = 0.1"):
+        basins(CASE, HC, 1e-3, [0.0], [0.0], tol=0.1)
+    with pytest.raises(ValueError, match="x2dot_values"):
+        basins(CASE, HC, 1e-3, [0.0], [])
+    code, _, err = run(["map-continuation", "--law", HC, "--axis", "kappa=1e9:2e9:5"])
+    assert code == 2 and "period" in err
+    code, _, err = run(["basins", "--law", HC, "--period", "1e-3", "--grid", "0"])
+    assert code == 2 and "grid = '0'" in err
