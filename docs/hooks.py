@@ -2,14 +2,14 @@
 
 * ``cli.md``: the command-line reference, from ``phaseimpact.cli.build_parser()`` (every subcommand's
   usage, description and options with their help text), in place of ``<!-- cli-reference -->``.
-* ``gallery.md``: every ``figures/*.png`` with its caption (README.md's figure table), a link to its
+* ``gallery.md``: every ``figures/*.png`` with its caption (figures/README.md's table), a link to its
   vector PDF (for print) and the command that regenerates it, in place of ``<!-- gallery -->``. The
   PNGs and PDFs are served from ``figures/`` in the built site (added to the build here; never copied
   into ``docs/``).
 * ``reference/phaseimpact.md``: the table of the package's top-level names, in place of
   ``<!-- top-level-names -->``.
 
-A figure without a caption in README.md or without a script that makes it is a warning, so
+A figure without a caption in figures/README.md or without a script that makes it is a warning, so
 ``mkdocs build --strict`` fails on it.
 """
 
@@ -38,8 +38,8 @@ MARKERS = {
     "gallery.md": "<!-- gallery -->",
     "reference/phaseimpact.md": "<!-- top-level-names -->",
 }
-# A row of README.md's figure table: | ![](figures/NAME.png) | caption |
-FIGURE_ROW = re.compile(r"^\|\s*!\[[^\]]*\]\(figures/(?P<name>[\w.-]+)\.png\)\s*\|\s*(?P<caption>.*?)\s*\|\s*$", re.M)
+# A row of figures/README.md's table: | ![](NAME.png) | caption |
+FIGURE_ROW = re.compile(r"^\|\s*!\[[^\]]*\]\((?P<name>[\w.-]+)\.png\)\s*\|\s*(?P<caption>.*?)\s*\|\s*$", re.M)
 
 
 # The figures of this build, listed once (on_files), so the gallery shows exactly the files served.
@@ -114,8 +114,8 @@ def cli_reference() -> str:
 # ------------------------------------------------------------------------------------------------
 
 def captions() -> dict[str, str]:
-    """README.md's figure table: figure name -> caption (Markdown), in the table's order."""
-    return {m["name"]: m["caption"] for m in FIGURE_ROW.finditer((ROOT / "README.md").read_text(encoding="utf-8"))}
+    """figures/README.md's table: figure name -> caption (Markdown), in the table's order."""
+    return {m["name"]: m["caption"] for m in FIGURE_ROW.finditer((FIGURES / "README.md").read_text(encoding="utf-8"))}
 
 
 def figure_command(name: str) -> str | None:
@@ -136,7 +136,7 @@ def gallery() -> str:
     for name in order:
         caption = known.get(name)
         if caption is None:
-            log.warning("gallery: figures/%s.png has no caption in README.md's figure table", name)
+            log.warning("gallery: figures/%s.png has no caption in figures/README.md's table", name)
             caption = ""
         command = figure_command(name)
         if command is None:

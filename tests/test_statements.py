@@ -280,7 +280,7 @@ def heyoka_ratios():
 
 # ------------------------------------------------------------------------------------------------ table
 
-R, D, C, F = "README.md", "docs/physics.md", "figures/claims.md", "docs/findings.md"
+R, D, C, F = "figures/README.md", "docs/physics.md", "figures/claims.md", "docs/findings.md"
 ST, ER, PL, TR = "studies/staircase.py", "studies/erosion.py", "studies/plastic.py", "studies/train.py"
 
 STATEMENTS = [
@@ -340,7 +340,7 @@ STATEMENTS = [
     Statement(F, "has a contact radius of {} R1)", sand_lep_radius_ratio),
     Statement(F, "its peak pressure of {} GPa (reduced mass, plate target) is elastic only for a steel with Y ≥ {} GPa",
               lambda: (cases()["seed"]["peak_pressure_Pa"] / 1e9, cases()["seed"]["peak_pressure_Pa"] / 1.6e9)),
-    # README, figure captions
+    # figures/README.md, the captions
     Statement(R, "the loop area is {} J", lambda: h5("fig04_force_indentation", "loop_area_J")),
     Statement(R, "the force dropping from {} N to the {}–{} N that holds the pair",
               lambda: (undamped_max_force(), first_stick_force(0.0), first_stick_force(3e9))),
