@@ -4,6 +4,8 @@ analysed as a dynamical system."""
 # First: phaseimpact._jit names its cache directory with it.
 __version__ = "0.2.0"
 
+from typing import TYPE_CHECKING
+
 from . import _environment, _lazy
 
 # NumPy's f2py reads SOURCE_DATE_EPOCH once, when it is first imported (SciPy and numba import it),
@@ -36,3 +38,10 @@ __all__ = [
 ]
 
 __getattr__, __dir__ = _lazy.attach(__name__, globals(), _EXPORTS)
+
+if TYPE_CHECKING:  # what the lazy names are, for type checkers (never run)
+    from .checks import check_law
+    from .integrate import Columns, Event, Trajectory, scales, simulate, simulate_many
+    from .model import LAWS, ContactLaw, kappa_for_restitution
+    from .model.userlaw import define_law
+    from .parameters import Geometry, Material, Parameters, derive_parameters, seed_parameters

@@ -59,3 +59,28 @@ def test_wheel_carries_the_physics_notes_archives_cite(tmp_path):
         assert "py.typed" in " ".join(whl.namelist())
     assert notes == (ROOT / "docs" / "physics.md").read_text()
     assert "§5" in notes or "## 5" in notes
+
+
+USER_SCRIPT = """\
+import phaseimpact as pi
+
+trajectory = pi.simulate(pi.seed_parameters(v=1.0), "paper")
+reveal_type(trajectory)
+wrong: str = trajectory.max_force
+"""
+
+
+def test_mypy_sees_the_types_of_the_installed_package(tmp_path):
+    """py.typed ships, and the lazily imported top-level names have their types for a type checker."""
+    wheel = _build("wheel", tmp_path)
+    target = tmp_path / "site"
+    subprocess.run([sys.executable, "-m", "pip", "install", "--quiet", "--no-deps", "--target", str(target),
+                    str(wheel)], check=True, capture_output=True)
+    (tmp_path / "user.py").write_text(USER_SCRIPT)
+    # mypy reads the package from the target (on the interpreter's path), as an installed package: its
+    # types are used only because of py.typed
+    env = {"PATH": "/usr/bin:/bin", "PYTHONPATH": str(target)}
+    done = subprocess.run([sys.executable, "-m", "mypy", "--no-incremental", "user.py"], cwd=tmp_path, env=env,
+                          capture_output=True, text=True)
+    assert 'Revealed type is "phaseimpact.integrate.result.Trajectory"' in done.stdout, done.stdout
+    assert 'expression has type "float", variable has type "str"' in done.stdout, done.stdout
