@@ -1,4 +1,4 @@
-"""HDF5 archives of sweeps, atlases and continued curves: netCDF-4 / CF-1.11 files (conventionally
+"""HDF5 archives of sweeps, atlases, continued curves and trains of impacts: netCDF-4 / CF-1.11 files (conventionally
 ``.nc``) that xarray, netCDF4, cfdm and other CF readers open as labelled arrays, and that plain h5py
 reads just as well.
 
@@ -6,7 +6,8 @@ Layout (``schema_version`` 5). Every variable of the result is in the root group
 ``xarray.open_dataset(path)`` shows them all, with one dimension per axis::
 
     / attrs       Conventions "CF-1.11", title, history, source, references (CF's), schema_version 5,
-                  package_version, kind ("sweep": one axis, "atlas": two or more, "critical-curve"), law
+                  package_version, kind ("sweep": one axis, "atlas": two or more, "critical-curve"; or
+                  one of TRAIN_KINDS: "impact-train", "orbit-diagram", "map-branch", "basins"), law
                   (JSON), contact (its reading of |delta|^alpha), base ("parameters" or "case"), case (JSON:
                   the Case, or the Parameters), parameters (JSON, SI: the base's Parameters), engine, rtol,
                   t_end (s; NaN: each run until its outcome settles), created (ISO 8601 UTC; from
@@ -46,6 +47,41 @@ Layout (``schema_version`` 5). Every variable of the result is in the root group
                                    which), N s m-(1+alpha); NaN where lost
     requested     (k,)  int8       1: asked for, 0: an intermediate step of the continuation
     closed_form, predicted  (k,) float64
+
+    trains of impacts (phaseimpact.train; the case and law are given to save: the results do not carry
+    them; attrs period (s) where one period holds for the whole result, also the header's t_end, NaN
+    otherwise; settings: the call's other arguments):
+    impact-train  arrival (N + 1,) int64 and impact (N,) int64 coordinates (n: the arrival at n period);
+                  x2, x2dot, amplitude (arrival) float64 m, m s-1, m: the plate before each arrival (the
+                  last: after the last impact); peak_force (N), dissipated_energy (J), restitution (1),
+                  energy_in (J) (impact) float64; n_contacts (impact) int64; overlap (impact) int8 flags
+                  no yes; status (impact) int8 flags (the statuses)
+    orbit-diagram attr param; <param> (n,) float64 coordinate (T: s, kappa, v); x2, x2dot, peak_force
+                  (<param>, sample) float64; distinct (<param>,) int64
+    map-branch    attrs param, period_k, message; along point (the branch, in the order followed):
+                  <param> float64 (not a coordinate: it turns back at a fold), x2, x2dot, stable (int8
+                  flags no yes), multiplier_real, multiplier_imag (point, multiplier), contacts (point,
+                  structure) int64 (contacts, stick phases, overlaps per period); along bifurcation:
+                  bifurcation_kind (int8 flags period-doubling fold neimark-sacker grazing), _value,
+                  _x2, _x2dot, _multiplier_real/_imag, _bracket, _test_value, _contacts (bifurcation,
+                  side, structure), _turning (int8 flags no yes)
+    basins        attrs not_converged, no_map; x2dot (ny,), x2 (nx,) coordinates; labels, impacts (x2dot,
+                  x2) int64 (labels: the attractor's index, -1 not converged, -2 a failed run);
+                  attractor_period, attractor_count (attractor) int64; attractor_x2, attractor_x2dot
+                  (orbit_point) float64: the attractors' points, attractor_period rows each, in order
+
+    :func:`to_xarray` also gives, in the same conventions but with no archive kind:
+    trajectory    (a Trajectory; kind "trajectory", the header from its case and law, message) time (n,)
+                  coordinate (s; empty for a summary run); x1, x2, x1dot, x2dot, contact_work, delta,
+                  deltadot, force (time) float64 m, m, m s-1, m s-1, J, m, m s-1, N; mode (time) int64;
+                  along event: event_time, event_kind (int8 flags: the event kinds), event_x1 ...
+                  event_contact_work, event_force, event_mode; 0-d: status, outcome, stop_reason (int8
+                  flags), every summary column (max_force, n_stick, t_run, ...), final_mode;
+                  initial_state, final_state (component,) float64 (attrs components, component_units)
+    transitions   (a list of Transition; kind "transitions", attrs kappa_min, kappa_max from settings)
+                  along transition: kind (int8 flags adding-sliding staircase-end grazing), kappa
+                  (float64, fractional_units), count_below, count_above, extremum (int64, _FillValue -1:
+                  not known)
 
     /extras       SweepResult.extras: arrays as datasets, dicts as groups, the rest as JSON in the
                   group's attribute "json" (a group: the xarray root view leaves it out; open it with
@@ -89,7 +125,9 @@ out (or the file is not an archive of the same grid) a checkpoint rewrites the f
 (phaseimpact 0.1), 2 (groups ``/sweep``, ``/curve``), 3 (this layout with ``_FillValue -1`` on the
 code variables, which made xarray decode them as floats) and 4 (CF-1.8 with int64 variables, a root
 attribute ``dimensions`` that CF 1.9 readers take as a domain variable's, units with fractional
-powers, /extras without netCDF dimensions) still load.
+powers, /extras without netCDF dimensions) still load. Train archives are new kinds of schema 5
+(readers of the other kinds are unaffected); :func:`load` gives back a result equal to the one saved,
+every array bit for bit.
 
 Integrity. Every chunk of every variable carries a Fletcher-32 checksum (HDF5's filter, which
 netCDF-4, h5netcdf and h5py verify on every read); the file format is HDF5 1.8's, whose superblock
@@ -121,15 +159,28 @@ import numpy as np
 
 from . import __version__
 from ._atomic import atomic_path, exclusive, fsync_file, release_reserve, reserve
-from .continuation import CriticalCurve, SweepResult
+from .continuation import CriticalCurve, SweepResult, Transition
 from .continuation.grid import Axis, Grid
 from .integrate import OUTCOMES, STATUSES
 from .integrate import driver as _driver
-from .integrate.result import SUMMARY_COLUMNS
+from .integrate.events import EVENT_KINDS
+from .integrate.result import SUMMARY_COLUMNS, Trajectory
 from .model import ContactLaw
 from .parameters import Parameters
+from .train import (
+    BIFURCATION_KINDS,
+    NO_MAP,
+    NOT_CONVERGED,
+    Attractor,
+    Basins,
+    ImpactTrain,
+    MapBifurcation,
+    MapBranch,
+    OrbitDiagram,
+)
 
-__all__ = ["SCHEMA_VERSION", "KINDS", "CHUNK_POINTS", "Checkpoint", "save", "load", "describe", "same_work",
+__all__ = ["SCHEMA_VERSION", "KINDS", "TRAIN_KINDS", "TRANSITION_KINDS",
+           "CHUNK_POINTS", "Checkpoint", "save", "load", "describe", "same_work",
            "check_overwrite", "kind_of", "created_timestamp", "DamagedArchiveError", "to_xarray", "stick_phases",
            "unit_attributes"]
 
@@ -137,6 +188,9 @@ __all__ = ["SCHEMA_VERSION", "KINDS", "CHUNK_POINTS", "Checkpoint", "save", "loa
 SCHEMA_VERSION = 5
 #: What an archive holds: a sweep (one axis), an atlas (two or more) or a continued curve.
 KINDS = ("sweep", "atlas", "critical-curve")
+#: What an archive of the impact map holds (phaseimpact.train): an ImpactTrain, an OrbitDiagram, a MapBranch
+#: or Basins. Apart from KINDS, whose archives the command line's sweeps complete and resume.
+TRAIN_KINDS = ("impact-train", "orbit-diagram", "map-branch", "basins")
 #: CF 1.9 and later allow int64 variables (the counts and stick rows).
 CONVENTIONS = "CF-1.11"
 #: The global attribute ``references``: where the equations and the outcome classes are defined.
@@ -270,13 +324,13 @@ def kind_of(result) -> str:
 
     Parameters
     ----------
-    result : SweepResult, Grid or CriticalCurve
+    result : SweepResult, Grid, CriticalCurve, ImpactTrain, OrbitDiagram, MapBranch or Basins
         What would be archived.
 
     Returns
     -------
     str
-        One of :data:`KINDS`.
+        One of :data:`KINDS` or :data:`TRAIN_KINDS`.
 
     Raises
     ------
@@ -295,6 +349,8 @@ def kind_of(result) -> str:
     """
     if isinstance(result, CriticalCurve):
         return "critical-curve"
+    if type(result) in _TRAIN_KIND:
+        return _TRAIN_KIND[type(result)]
     grid = result.grid if isinstance(result, SweepResult) else result
     if not isinstance(grid, Grid):
         raise TypeError(f"cannot archive a {type(result).__name__}")
@@ -563,7 +619,7 @@ def _digest(tree) -> str:
 # Writing whole files
 # ------------------------------------------------------------------------------------------------
 
-def save(result: SweepResult | CriticalCurve, path, *, force: bool = False) -> str:
+def save(result, path, *, force: bool = False, params=None, law=None, settings: dict | None = None) -> str:
     """Write ``result`` to ``path`` atomically (temporary file, fsync, rename) under its write lock.
 
     The layout is the module docstring's (netCDF-4 / CF-1.11, schema :data:`SCHEMA_VERSION`); a
@@ -571,14 +627,22 @@ def save(result: SweepResult | CriticalCurve, path, *, force: bool = False) -> s
 
     Parameters
     ----------
-    result : SweepResult or CriticalCurve
-        A sweep, an atlas (complete or partial) or a continued curve.
+    result : SweepResult, CriticalCurve, ImpactTrain, OrbitDiagram, MapBranch or Basins
+        A sweep, an atlas (complete or partial), a continued curve, or a result of
+        :mod:`phaseimpact.train`.
     path : str or path-like
         The archive to write (conventionally ``.nc``: netCDF-4).
     force : bool, default False
         Replace ``path`` even if it exists and is not a phaseimpact archive. Without it such a file
         is refused (``ValueError``); an existing archive is replaced. (The command line also refuses
         an archive of other work: see :func:`check_overwrite`.)
+    params : Parameters or Case, optional
+        A train result's case (it does not carry it; required for one, refused for the others).
+    law : ContactLaw or str, optional
+        A train result's law (required for one, refused for the others).
+    settings : dict, optional
+        A train result's other arguments, stored as the JSON attribute ``settings``: ``rtol`` (the
+        header's ``rtol``), ``period`` (s: an orbit diagram's or branch's over ``kappa`` or ``v``), ...
 
     Returns
     -------
@@ -588,7 +652,8 @@ def save(result: SweepResult | CriticalCurve, path, *, force: bool = False) -> s
     Raises
     ------
     TypeError
-        If ``result`` is neither a SweepResult nor a CriticalCurve.
+        If ``result`` is of another type, or ``params``/``law`` are missing for a train result (or
+        given for a sweep or curve).
     ValueError
         (Before writing anything) for a path that cannot be written or an existing file that is not
         an archive (without ``force``), and :class:`phaseimpact._atomic.PathLockedError` (a
@@ -607,10 +672,21 @@ def save(result: SweepResult | CriticalCurve, path, *, force: bool = False) -> s
     True
     >>> load(path).outcome_names().tolist()
     ['permanent-stick', 'permanent-stick', 'ratchet-escape']
+
+    A train of impacts, with the case and law it was computed with:
+
+    >>> from phaseimpact.train import impact_train
+    >>> p = seed_parameters(kappa=3e9)
+    >>> train = impact_train(p, "hunt-crossley", 3e-3, 3)
+    >>> back = load(save(train, os.path.join(tempfile.mkdtemp(), "train.nc"), params=p, law="hunt-crossley"))
+    >>> bool((back.peak_force == train.peak_force).all()), back.status
+    (True, ['success', 'success', 'success'])
     """
-    if not isinstance(result, (SweepResult, CriticalCurve)):
-        raise TypeError(f"cannot archive a {type(result).__name__}")
-    _write_file(result, os.fspath(path), force=force, spare_rows=0)
+    if not isinstance(result, _ARCHIVED):
+        raise TypeError(f"cannot archive a {type(result).__name__}; allowed: a SweepResult or a CriticalCurve, or "
+                        "an ImpactTrain, OrbitDiagram, MapBranch or Basins")
+    context = _context(result, params, law, settings, required=True)
+    _write_file(result, os.fspath(path), force=force, spare_rows=0, context=context)
     return os.fspath(path)
 
 
@@ -649,7 +725,7 @@ def _as_disk_error(error: Exception) -> OSError | None:
     return OSError(code, os.strerror(code))
 
 
-def _write_file(result, path: str, *, force: bool, spare_rows: int):
+def _write_file(result, path: str, *, force: bool, spare_rows: int, context=None):
     """Write a whole archive atomically; a sweep's stick variables get ``spare_rows`` free rows.
     Returns the sweep's per-point ``(stick_first, stick_count)`` (None for a curve)."""
     created = created_timestamp()  # a bad SOURCE_DATE_EPOCH is refused before anything is written
@@ -661,7 +737,7 @@ def _write_file(result, path: str, *, force: bool, spare_rows: int):
         try:
             with h5py.File(tmp, "w", libver=_LIBVER) as f:
                 _reserve(f, 0)  # the header, attributes and small datasets
-                _write_result(f, result, created, layout, spare_rows)
+                _write_result(f, result, created, layout, spare_rows, context)
                 _reserve(f, 0)  # what the close writes
         except (ValueError, RuntimeError) as error:
             disk = _as_disk_error(error)
@@ -672,51 +748,86 @@ def _write_file(result, path: str, *, force: bool, spare_rows: int):
     return None if layout is None else (layout.first, layout.count)
 
 
-def _write_result(f, result, created: str, layout, spare_rows: int) -> None:
-    if layout is None:
-        _write_curve(f, result, created)
-    else:
+def _write_result(f, result, created: str, layout, spare_rows: int, context=None) -> None:
+    if isinstance(result, SweepResult):
         _write_sweep(f, result, created, layout, spare_rows)
+    elif isinstance(result, CriticalCurve):
+        _write_curve(f, result, created)
+    elif _transitions_of(result):
+        _write_transitions(f, result, created, context)
+    else:
+        _WRITERS[type(result)](f, result, created, context)
     f.attrs[_TEXT_DIGEST] = _texts_digest(f)
 
 
-def to_xarray(result: SweepResult | CriticalCurve):
-    """``result`` as an in-memory :class:`xarray.Dataset`, no file written: the same variables,
-    dimensions, units and attributes as ``xarray.open_dataset`` of the archive :func:`save` writes
-    (it is that archive, built in memory), so code written for one reads the other.
+def to_xarray(result, *, params=None, law=None, settings: dict | None = None):
+    """``result`` as an in-memory :class:`xarray.Dataset`, no file written.
 
-    Example: ``ds = to_xarray(sweep(case, "paper", kappas))``, then ``ds.max_force.plot()``. Needs
-    xarray and h5netcdf (``pip install xarray h5netcdf``).
+    For what :func:`save` archives, the Dataset is the one ``xarray.open_dataset`` gives of that
+    archive (it is that archive, built in memory), variables, dimensions, units and attributes
+    alike, so code written for one reads the other. A trajectory and a list of transitions, which
+    have no archive kind, get a Dataset in the same conventions (CF-1.11 attributes, units as
+    :func:`unit_attributes` gives them, codes as integer flags, the header's attributes); the module
+    docstring gives every layout. Needs xarray and h5netcdf (``pip install xarray h5netcdf``).
 
     Parameters
     ----------
-    result : SweepResult or CriticalCurve
-        What :func:`save` would write.
+    result : SweepResult, CriticalCurve, Trajectory, list of Transition, ImpactTrain, OrbitDiagram, \
+MapBranch or Basins
+        A sweep or atlas, a continued curve, a run of :func:`~phaseimpact.simulate` (with samples
+        or a summary run), what :func:`~phaseimpact.continuation.transitions` returns, or a result of
+        :mod:`phaseimpact.train`.
+    params : Parameters or Case, optional
+        The case of a result that does not carry it (transitions, train results): its header
+        attributes (``parameters``, ``case``, ``base``) and the unit of ``kappa`` (its ``alpha``).
+        Left out, so are they. Refused for a result that carries its own.
+    law : ContactLaw or str, optional
+        Its law, likewise (``law``, ``contact``; the unit of ``kappa``).
+    settings : dict, optional
+        Its other arguments, the JSON attribute ``settings``: ``rtol`` (the header's), ``period``
+        (s), ``kappa_min`` and ``kappa_max`` (transitions: the search interval, also attributes of
+        their own).
 
     Returns
     -------
     xarray.Dataset
-        Loaded in memory: one dimension per axis (or the curve's parameter), the summary columns
-        with their units, the stick phases along ``stick``, the header as attributes.
+        Loaded in memory.
 
     Raises
     ------
     TypeError
-        If ``result`` is neither a SweepResult nor a CriticalCurve.
+        For a result of another type (the message lists the allowed ones), or ``params``, ``law``
+        or ``settings`` given for a result that carries its own.
     ValueError
         When xarray or h5netcdf is not installed.
 
     Examples
     --------
-    >>> from phaseimpact import seed_parameters
+    >>> from phaseimpact import seed_parameters, simulate
     >>> from phaseimpact.archive import to_xarray
     >>> from phaseimpact.continuation import sweep
     >>> ds = to_xarray(sweep(seed_parameters(), "paper", [1e9, 1e12, 1e13]))
     >>> dict(ds.sizes), ds["max_force"].attrs["units"], ds["kappa"].attrs["fractional_units"]
     ({'kappa': 3, 'stick': 4}, 'N', 'N s m-2.5')
+
+    A trajectory: its samples along ``time``, its events along ``event``, its summary as scalars.
+
+    >>> run = to_xarray(simulate(seed_parameters(v=1.0, kappa=3e9), "paper", save="steps"))
+    >>> run.force.attrs["units"], run.sizes["event"], run.outcome.attrs["flag_meanings"].split()[int(run.outcome)]
+    ('N', 3, 'permanent-stick')
+
+    A train of impacts, with its case and law:
+
+    >>> from phaseimpact.train import impact_train
+    >>> p = seed_parameters(kappa=3e9)
+    >>> train = to_xarray(impact_train(p, "hunt-crossley", 3e-3, 3), params=p, law="hunt-crossley")
+    >>> dict(train.sizes), train.peak_force.attrs["units"], train.attrs["kind"]
+    ({'arrival': 4, 'impact': 3}, 'N', 'impact-train')
     """
-    if not isinstance(result, (SweepResult, CriticalCurve)):
-        raise TypeError(f"cannot convert a {type(result).__name__}; allowed: a SweepResult or a CriticalCurve")
+    if not (isinstance(result, _CONVERTED) or _transitions_of(result)):
+        raise TypeError(f"cannot convert a {type(result).__name__}; allowed: a SweepResult or a CriticalCurve, a "
+                        "Trajectory, a list of Transition, or an ImpactTrain, OrbitDiagram, MapBranch or Basins")
+    context = _context(result, params, law, settings, required=False)
     try:
         import xarray
     except ImportError:
@@ -724,7 +835,7 @@ def to_xarray(result: SweepResult | CriticalCurve):
     buffer = io.BytesIO()
     with h5py.File(buffer, "w", libver=_LIBVER) as f:
         _write_result(f, result, created_timestamp(),
-                      _sweep_layout(result) if isinstance(result, SweepResult) else None, 0)
+                      _sweep_layout(result) if isinstance(result, SweepResult) else None, 0, context)
     buffer.seek(0)
     with xarray.open_dataset(buffer, engine="h5netcdf") as ds:
         return ds.load()
@@ -806,20 +917,24 @@ def _texts_digest(f) -> str:
     return h.hexdigest()
 
 
-def _header(f, kind: str, law: ContactLaw, base, t_end, rtol, engine: str, created: str, title: str,
+def _header(f, kind: str, law: ContactLaw | None, base, t_end, rtol, engine: str, created: str, title: str,
             settings=None) -> None:
+    """The root attributes; without ``law`` or ``base`` (an in-memory Dataset of a result that does not carry
+    them, see :func:`to_xarray`) their attributes are left out."""
     f.attrs["Conventions"] = CONVENTIONS
     f.attrs["title"] = title
     f.attrs["history"] = f"{created} phaseimpact {__version__}: written by phaseimpact.archive"
-    f.attrs["source"] = (f"phaseimpact {__version__}: impact simulations ({law.name} contact law, engine "
+    f.attrs["source"] = (f"phaseimpact {__version__}: impact simulations "
+                         f"({law.name if law is not None else 'unnamed'} contact law, engine "
                          f"{engine or 'default'}, rtol {_float(rtol):g})")
     f.attrs["references"] = REFERENCES
     f.attrs["schema_version"] = np.int64(SCHEMA_VERSION)
     f.attrs["package_version"] = __version__
     f.attrs["kind"] = kind
-    f.attrs["law"] = _json(law.as_dict())
-    f.attrs["contact"] = str(law.contact)
-    for key, value in _base_attrs(base).items():
+    if law is not None:
+        f.attrs["law"] = _json(law.as_dict())
+        f.attrs["contact"] = str(law.contact)
+    for key, value in (_base_attrs(base) if base is not None else {}).items():
         f.attrs[key] = value
     f.attrs["engine"] = str(engine)
     f.attrs["rtol"] = _float(rtol)
@@ -1009,6 +1124,417 @@ def _write_curve(f, c: CriticalCurve, created: str) -> None:
     d.attrs["flag_meanings"] = "intermediate requested"
     d.attrs["long_name"] = "asked for (0: an intermediate step of the continuation)"
     d.dims[0].attach_scale(values)
+
+
+# ------------------------------------------------------------------------------------------------
+# Trains of impacts, trajectories and transitions
+# ------------------------------------------------------------------------------------------------
+
+@dataclass(frozen=True)
+class _Context:
+    """What a result that does not carry it was computed with: the case (Parameters or Case), the law
+    and the call's other settings (``rtol``, ``period``, ``kappa_min``, ...); any of them None."""
+
+    base: object = None
+    law: ContactLaw | None = None
+    settings: dict | None = None
+
+
+def _transitions_of(result) -> bool:
+    """``result`` is what :func:`~phaseimpact.continuation.transitions` returns: a list of Transition."""
+    return isinstance(result, (list, tuple)) and all(isinstance(item, Transition) for item in result)
+
+
+def _context(result, params, law, settings, *, required: bool) -> _Context:
+    """The context of a result that does not carry its case (``required``: an archive needs its case and
+    law); a result that carries them (a sweep, a curve, a trajectory) takes none."""
+    from .case import Case
+    from .model import as_law
+
+    given = params is not None or law is not None or settings is not None
+    if isinstance(result, (SweepResult, CriticalCurve, Trajectory)):
+        if given:
+            raise TypeError(f"a {type(result).__name__} carries its own case, law and settings; params=, law= and "
+                            "settings= are for results that do not (transitions, trains of impacts)")
+        return _Context()
+    if params is not None and not isinstance(params, (Parameters, Case)):
+        raise TypeError(f"params has the wrong type ({type(params).__name__}); allowed: Parameters or Case")
+    if settings is not None and not isinstance(settings, dict):
+        raise TypeError(f"settings has the wrong type ({type(settings).__name__}); allowed: a dict")
+    if required and (params is None or law is None):
+        raise TypeError(f"archiving a {type(result).__name__} needs params= and law= (it does not carry the case "
+                        "and law it was computed with)")
+    return _Context(params, None if law is None else as_law(law), None if settings is None else dict(settings))
+
+
+def _period_of(result, context: _Context) -> float:
+    """The time between arrivals (s) when one holds for the whole result; NaN when it varies (over T) or
+    was not given."""
+    if isinstance(result, (ImpactTrain, Basins)):
+        return float(result.period)
+    if getattr(result, "param", None) == "T":
+        return math.nan
+    return _float((context.settings or {}).get("period"))
+
+
+def _parameter_units(name: str, context: _Context) -> str:
+    """Units of a train parameter (``T``, ``kappa``, ``v``) in UDUNITS syntax; kappa's needs the case's
+    exponent (and the law's entry)."""
+    if name == "T":
+        return "s"
+    if context.base is None:
+        return {"v": "m s-1"}.get(name, "N s m-(1+alpha)")
+    return axis_units(name, _base_parameters(context.base).alpha, context.law)
+
+
+def _by(context: _Context) -> str:
+    """`` (<law> law)`` for a title, when the law is known."""
+    return f" ({context.law.name} law)" if context.law is not None else ""
+
+
+def _train_header(f, kind: str, context: _Context, period: float, created: str, title: str) -> None:
+    settings = context.settings or {}
+    _header(f, kind, context.law, context.base, period, settings.get("rtol"), str(settings.get("engine", "")),
+            created, title, context.settings)
+    if not math.isnan(period):
+        f.attrs["period"] = period
+
+
+def _coordinate(f, name: str, values, units: str | None, long_name: str):
+    """A coordinate variable (an HDF5 dimension scale named as its dimension)."""
+    values = np.asarray(values)
+    d = f.create_dataset(name, data=values, **(_CHECKED if values.size else {}))
+    d.make_scale(name)
+    if units is not None:
+        d.attrs.update(unit_attributes(units))
+    d.attrs["long_name"] = long_name if units is None else _long_name(long_name, units)
+    return d
+
+
+def _variable(f, name: str, data, dims=(), *, long_name: str, units: str | None = None, fill: bool = False,
+              flags=None, dtype=None, **attrs):
+    """A variable on the named dimensions (coordinate variables or netCDF dimensions, made on first use
+    with the data's sizes), with a Fletcher-32 checksum where HDF5 allows one (a chunked, non-empty array).
+    ``fill``: ``_FillValue`` NaN (or -1: xarray then reads the integers as floats, NaN where missing);
+    ``flags``: CF flags, the codes 0, 1, ... meaning ``flags``."""
+    data = np.asarray(data, dtype=dtype)
+    d = f.create_dataset(name, data=data, **(_CHECKED if data.ndim and data.size else {}))
+    if fill:
+        d.attrs["_FillValue"] = _fill_of(data.dtype)
+    if units is not None:
+        d.attrs.update(unit_attributes(units))
+    d.attrs["long_name"] = long_name if units is None else _long_name(long_name, units)
+    if flags is not None:
+        d.attrs["flag_values"] = np.arange(len(flags), dtype=data.dtype)
+        d.attrs["flag_meanings"] = " ".join(flags)
+    d.attrs.update(attrs)
+    for i, (dim, n) in enumerate(zip(dims, data.shape, strict=True)):
+        if dim not in f:
+            _dimension(f, dim, n)
+        d.dims[i].attach_scale(f[dim])
+    return d
+
+
+def _codes_of(names, table, what: str) -> np.ndarray:
+    lookup = {name: i for i, name in enumerate(table)}
+    bad = [name for name in names if name not in lookup]
+    if bad:
+        raise ValueError(f"{what} {bad[0]!r} is out of range; allowed: one of {', '.join(table)}")
+    return np.array([lookup[name] for name in names], dtype=np.int8)
+
+
+#: The kinds of :class:`~phaseimpact.continuation.Transition`.
+TRANSITION_KINDS = ("adding-sliding", "staircase-end", "grazing")
+#: The state's components, as a Trajectory's ``y`` holds them: (netCDF name, unit, long name).
+_STATE = (("x1", "m", "projectile displacement"), ("x2", "m", "target displacement"),
+          ("x1dot", "m s-1", "projectile velocity"), ("x2dot", "m s-1", "target velocity"),
+          ("contact_work", "J", "work of the contact force"))
+_YES_NO = ("no", "yes")
+
+
+def _write_trajectory(f, tr: Trajectory, created: str, context: _Context) -> None:
+    found = re.search(r"rtol=([^,\]]+)", tr.integrator)
+    _header(f, "trajectory", tr.law, tr.params, tr.t_end, float(found.group(1)) if found else None, tr.integrator,
+            created, f"phaseimpact trajectory: {tr.law.name} law, {tr.outcome} ({tr.status})")
+    f.attrs["message"] = tr.message
+    _coordinate(f, "time", tr.t, "s", "time")
+    for i, (name, units, long_name) in enumerate(_STATE):
+        _variable(f, name, tr.y[:, i], ("time",), long_name=long_name, units=units)
+    _variable(f, "delta", tr.delta, ("time",), long_name="indentation x1 - x2", units="m")
+    _variable(f, "deltadot", tr.deltadot, ("time",), long_name="relative velocity x1dot - x2dot", units="m s-1")
+    _variable(f, "force", tr.force, ("time",), long_name="contact force", units="N")
+    _variable(f, "mode", tr.mode, ("time",), long_name="mode (paper: +-1 slipping, 0 stuck)")
+
+    _variable(f, "event_time", tr.event_t, ("event",), long_name="time of the event", units="s")
+    _variable(f, "event_kind", tr.event_kind, ("event",), long_name="kind of the event", flags=EVENT_KINDS,
+              dtype=np.int8)
+    for i, (name, units, long_name) in enumerate(_STATE):
+        _variable(f, f"event_{name}", tr.event_y[:, i], ("event",), long_name=f"{long_name} at the event",
+                  units=units)
+    _variable(f, "event_force", tr.event_force, ("event",), long_name="contact force at the event", units="N")
+    _variable(f, "event_mode", tr.event_mode, ("event",), long_name="mode after the event")
+
+    for name, codes, table in (("status", tr.status, STATUSES), ("outcome", tr.outcome, OUTCOMES),
+                               ("stop_reason", tr.stop_reason, STOP_REASONS)):
+        _variable(f, name, _codes_of([codes], table, name)[0], long_name=_LONG_NAMES[name], flags=table)
+    for name, index, dtype, units in SUMMARY_COLUMNS:
+        value = np.asarray(tr.summary[index]).astype(dtype)
+        _variable(f, name, value, long_name=_LONG_NAMES[name], units=units, fill=value.dtype.kind == "f")
+    _variable(f, "final_mode", np.int64(tr.final_mode), long_name="mode at the end of the run")
+    components = {"components": " ".join(name for name, _, _ in _STATE),
+                  "component_units": _json([units for _, units, _ in _STATE]),
+                  "comment": "no units attribute: the components differ in unit (component_units)"}
+    _variable(f, "initial_state", tr.initial_state, ("component",), long_name="state at the start", **components)
+    _variable(f, "final_state", tr.final_state, ("component",), long_name="state at the end", **components)
+
+
+def _write_transitions(f, items, created: str, context: _Context) -> None:
+    settings = context.settings or {}
+    _header(f, "transitions", context.law, context.base, None, settings.get("rtol"), "", created,
+            f"phaseimpact transitions: {len(items)} changes of the long-time count over kappa{_by(context)}")
+    for key in ("kappa_min", "kappa_max"):
+        if key in settings:
+            f.attrs[key] = float(settings[key])
+    units = _parameter_units("kappa", context)
+
+    def count(name):  # None (not confirmed, unbounded) is -1, read by xarray as NaN
+        return np.array([-1 if getattr(t, name) is None else getattr(t, name) for t in items], dtype=np.int64)
+
+    _variable(f, "kind", _codes_of([t.kind for t in items], TRANSITION_KINDS, "kind"), ("transition",),
+              long_name="kind of the transition", flags=TRANSITION_KINDS)
+    _variable(f, "kappa", [t.kappa for t in items], ("transition",), long_name="kappa at the transition",
+              units=units, dtype=float, fill=True)
+    for name, long_name in (("count_below", "long-time count just below"),
+                            ("count_above", "long-time count just above"),
+                            ("extremum", "grazing: the extremum of delta that touches zero")):
+        _variable(f, name, count(name), ("transition",), long_name=long_name, units="1", fill=True)
+
+
+def _write_impact_train(f, r: ImpactTrain, created: str, context: _Context) -> None:
+    n = len(r.peak_force)
+    _train_header(f, "impact-train", context, float(r.period), created,
+                  f"phaseimpact impact train: {n} impacts every {r.period:g} s{_by(context)}")
+    _coordinate(f, "arrival", np.arange(n + 1, dtype=np.int64), None,
+                "arrival n, at n period (the last: after the last impact)")
+    _coordinate(f, "impact", np.arange(n, dtype=np.int64), None, "impact n, at n period")
+    plate = np.asarray(r.plate, dtype=float)
+    _variable(f, "x2", plate[:, 0], ("arrival",), long_name="plate displacement just before the arrival", units="m")
+    _variable(f, "x2dot", plate[:, 1], ("arrival",), long_name="plate velocity just before the arrival",
+              units="m s-1")
+    _variable(f, "amplitude", r.amplitude, ("arrival",), long_name="plate amplitude before the arrival", units="m",
+              dtype=float)
+    for name, units, long_name in (("peak_force", "N", "largest contact force of the impact"),
+                                   ("dissipated_energy", "J", "energy the impact's contact dissipated"),
+                                   ("restitution", "1", "coefficient of restitution (NaN: no separation)"),
+                                   ("energy_in", "J", "kinetic energy the projectile left in the plate and contact")):
+        _variable(f, name, getattr(r, name), ("impact",), long_name=long_name, units=units, dtype=float, fill=True)
+    _variable(f, "n_contacts", r.n_contacts, ("impact",), long_name="contacts of the impact", units="1",
+              dtype=np.int64)
+    _variable(f, "overlap", r.overlap, ("impact",), long_name="projectile still in contact at the next arrival",
+              flags=_YES_NO, dtype=np.int8)
+    _variable(f, "status", _codes_of(r.status, STATUSES, "status"), ("impact",), long_name=_LONG_NAMES["status"],
+              flags=STATUSES)
+
+
+def _write_orbit_diagram(f, r: OrbitDiagram, created: str, context: _Context) -> None:
+    dim = netcdf_name(r.param)
+    values = np.asarray(r.values, dtype=float)
+    _train_header(f, "orbit-diagram", context, _period_of(r, context), created,
+                  f"phaseimpact orbit diagram: {r.plate.shape[1]} samples at {len(values)} values of {r.param}"
+                  f"{_by(context)}")
+    f.attrs["param"] = r.param
+    _coordinate(f, dim, values, _parameter_units(r.param, context), r.param)
+    dims = (dim, "sample")
+    _variable(f, "x2", r.plate[..., 0], dims, long_name="plate displacement just before the sampled impact",
+              units="m", dtype=float)
+    _variable(f, "x2dot", r.plate[..., 1], dims, long_name="plate velocity just before the sampled impact",
+              units="m s-1", dtype=float)
+    _variable(f, "peak_force", r.peak_force, dims, long_name="largest contact force of the sampled impact",
+              units="N", dtype=float, fill=True)
+    _variable(f, "distinct", r.distinct, (dim,), long_name="distinct states among the samples", units="1",
+              dtype=np.int64)
+
+
+def _multipliers(f, prefix: str, values, dims) -> None:
+    values = np.asarray(values, dtype=complex)
+    for part, name in (("real", values.real), ("imag", values.imag)):
+        _variable(f, f"{prefix}multiplier_{part}", np.ascontiguousarray(name), dims,
+                  long_name=f"Floquet multipliers, {'real' if part == 'real' else 'imaginary'} part", units="1")
+
+
+_STRUCTURE = {"structure": "contacts stick_phases overlaps",
+              "comment": "per period of the orbit: contacts, stick phases, projectiles still in contact at the "
+                         "next arrival"}
+
+
+def _write_map_branch(f, r: MapBranch, created: str, context: _Context) -> None:
+    units = _parameter_units(r.param, context)
+    name = netcdf_name(r.param)
+    _train_header(f, "map-branch", context, _period_of(r, context), created,
+                  f"phaseimpact map branch: period-{r.period_k} orbits over {r.param}, {len(r.values)} points, "
+                  f"{len(r.points)} bifurcations{_by(context)}")
+    f.attrs["param"] = r.param
+    f.attrs["period_k"] = np.int64(r.period_k)
+    f.attrs["message"] = str(r.message)
+    # the parameter is no coordinate variable: it turns back at a fold (CF coordinates are monotonic)
+    _variable(f, name, r.values, ("point",), long_name=f"{r.param} along the branch", units=units, dtype=float)
+    plate = np.asarray(r.plate, dtype=float).reshape(-1, 2)
+    _variable(f, "x2", plate[:, 0], ("point",), long_name="plate displacement before the orbit's first impact",
+              units="m")
+    _variable(f, "x2dot", plate[:, 1], ("point",), long_name="plate velocity before the orbit's first impact",
+              units="m s-1")
+    _multipliers(f, "", np.asarray(r.multipliers).reshape(-1, 2), ("point", "multiplier"))
+    _variable(f, "stable", r.stable, ("point",), long_name="every multiplier inside the unit circle",
+              flags=_YES_NO, dtype=np.int8)
+    _variable(f, "contacts", np.asarray(r.contacts).reshape(-1, 3), ("point", "structure"),
+              long_name="contact structure of the orbit", units="1", dtype=np.int64, **_STRUCTURE)
+    points = r.points
+    dims = ("bifurcation",)
+    _variable(f, "bifurcation_kind", _codes_of([p.kind for p in points], BIFURCATION_KINDS, "kind"), dims,
+              long_name="kind of the bifurcation", flags=BIFURCATION_KINDS)
+    _variable(f, "bifurcation_value", [p.value for p in points], dims, long_name=f"{r.param} at the bifurcation",
+              units=units, dtype=float)
+    plate = np.array([p.plate for p in points], dtype=float).reshape(-1, 2)
+    _variable(f, "bifurcation_x2", plate[:, 0], dims, long_name="plate displacement at the bifurcation", units="m")
+    _variable(f, "bifurcation_x2dot", plate[:, 1], dims, long_name="plate velocity at the bifurcation",
+              units="m s-1")
+    _multipliers(f, "bifurcation_", np.array([p.multipliers for p in points], dtype=complex).reshape(-1, 2),
+                 ("bifurcation", "multiplier"))
+    _variable(f, "bifurcation_bracket", [p.bracket for p in points], dims,
+              long_name=f"width of the final bracket in {r.param}", units=units, dtype=float)
+    _variable(f, "bifurcation_test_value", [p.test_value for p in points], dims,
+              long_name="test function at the bifurcation (0: grazing)", units="1", dtype=float)
+    _variable(f, "bifurcation_contacts", np.array([p.contacts for p in points], dtype=np.int64).reshape(-1, 2, 3),
+              ("bifurcation", "side", "structure"), long_name="contact structure on either side", units="1",
+              **_STRUCTURE)
+    _variable(f, "bifurcation_turning", [p.turning for p in points], dims,
+              long_name="fold: the branch turns back in the parameter", flags=_YES_NO, dtype=np.int8)
+
+
+def _write_basins(f, r: Basins, created: str, context: _Context) -> None:
+    _train_header(f, "basins", context, float(r.period), created,
+                  f"phaseimpact basins: {len(r.x2dot_values)} x {len(r.x2_values)} initial states, "
+                  f"{len(r.attractors)} attractors{_by(context)}")
+    f.attrs["not_converged"] = np.int64(r.not_converged)
+    f.attrs["no_map"] = np.int64(r.no_map)
+    _coordinate(f, "x2dot", np.asarray(r.x2dot_values, dtype=float), "m s-1", "initial plate velocity")
+    _coordinate(f, "x2", np.asarray(r.x2_values, dtype=float), "m", "initial plate displacement")
+    _variable(f, "labels", r.labels, ("x2dot", "x2"), long_name="attractor reached from the initial state",
+              dtype=np.int64, comment=f"the attractor's index; {NOT_CONVERGED}: no period repeated, {NO_MAP}: a run "
+                                      "failed")
+    _variable(f, "impacts", r.impacts, ("x2dot", "x2"), long_name="impacts until the orbit repeated", units="1",
+              dtype=np.int64)
+    periods = np.array([a.period for a in r.attractors], dtype=np.int64)
+    _variable(f, "attractor_period", periods, ("attractor",), long_name="impacts per repetition of the attractor",
+              units="1", comment="also its number of rows along orbit_point (the attractors' rows in order)")
+    _variable(f, "attractor_count", [a.count for a in r.attractors], ("attractor",),
+              long_name="initial states of the grid that go to the attractor", units="1", dtype=np.int64)
+    plate = np.concatenate([np.asarray(a.plate, dtype=float).reshape(-1, 2) for a in r.attractors] or
+                           [np.empty((0, 2))])
+    _variable(f, "attractor_x2", plate[:, 0], ("orbit_point",), long_name="plate displacement on the attractor",
+              units="m")
+    _variable(f, "attractor_x2dot", plate[:, 1], ("orbit_point",), long_name="plate velocity on the attractor",
+              units="m s-1")
+
+
+#: Writers of the results that :func:`to_xarray` converts besides sweeps and curves, by type.
+_WRITERS = {Trajectory: _write_trajectory, ImpactTrain: _write_impact_train, OrbitDiagram: _write_orbit_diagram,
+            MapBranch: _write_map_branch, Basins: _write_basins}
+#: The archive kind of each train result.
+_TRAIN_KIND = {ImpactTrain: "impact-train", OrbitDiagram: "orbit-diagram", MapBranch: "map-branch",
+               Basins: "basins"}
+#: What :func:`save` archives, and what :func:`to_xarray` converts (besides a list of Transition); the
+#: TypeErrors of both name them.
+_ARCHIVED = (SweepResult, CriticalCurve, *_TRAIN_KIND)
+_CONVERTED = (SweepResult, CriticalCurve, Trajectory, *_TRAIN_KIND)
+
+
+# -- reading trains back ----------------------------------------------------------------------------
+
+def _checked_codes(f, name: str, table, shape: tuple) -> np.ndarray:
+    codes = _data(f, name, kinds="iu")
+    if codes.shape != shape:
+        raise _Damaged(f"variable {name} has shape {codes.shape}; allowed: {shape}")
+    _out_of_range(name, codes.reshape(-1), (codes.reshape(-1) < 0) | (codes.reshape(-1) >= len(table)),
+                  f"0 to {len(table) - 1} ({', '.join(table)})")
+    return codes
+
+
+def _shaped(f, name: str, shape: tuple, kinds: str = "f") -> np.ndarray:
+    data = _data(f, name, kinds=kinds)
+    if data.shape != shape:
+        raise _Damaged(f"variable {name} has shape {data.shape}; allowed: {shape}")
+    return data
+
+
+def _read_impact_train(f) -> ImpactTrain:
+    n = _data(f, "impact", ndim=1, kinds="iu").shape[0]
+    plate = np.stack([_shaped(f, "x2", (n + 1,)), _shaped(f, "x2dot", (n + 1,))], axis=1)
+    rows = {name: _shaped(f, name, (n,)) for name in ("peak_force", "dissipated_energy", "restitution", "energy_in")}
+    return ImpactTrain(_real_attr(f, "period"), plate, rows["peak_force"], rows["dissipated_energy"],
+                       rows["restitution"], rows["energy_in"], _shaped(f, "n_contacts", (n,), "iu").astype(np.int64),
+                       _shaped(f, "amplitude", (n + 1,)), _checked_codes(f, "overlap", _YES_NO, (n,)).astype(bool),
+                       [STATUSES[c] for c in _checked_codes(f, "status", STATUSES, (n,))])
+
+
+def _read_orbit_diagram(f) -> OrbitDiagram:
+    param = _attr_str(f, "param")
+    values = _checked_axis(param, _data(f, netcdf_name(param), ndim=1), False).values
+    n = len(values)
+    samples = _data(f, "x2", ndim=2, kinds="f").shape[1]
+    plate = np.stack([_shaped(f, "x2", (n, samples)), _shaped(f, "x2dot", (n, samples))], axis=-1)
+    return OrbitDiagram(param, values, plate, _shaped(f, "peak_force", (n, samples)),
+                        _shaped(f, "distinct", (n,), "iu").astype(np.int64))
+
+
+def _complex(f, prefix: str, shape: tuple) -> np.ndarray:
+    out = np.empty(shape, dtype=complex)  # parts set, not summed: re + 1j * im loses a -0.0 and mixes in NaN
+    out.real = _shaped(f, f"{prefix}multiplier_real", shape)
+    out.imag = _shaped(f, f"{prefix}multiplier_imag", shape)
+    return out
+
+
+def _read_map_branch(f) -> MapBranch:
+    param = _attr_str(f, "param")
+    values = _data(f, netcdf_name(param), ndim=1, kinds="f")
+    n = len(values)
+    m = _data(f, "bifurcation_value", ndim=1, kinds="f").shape[0]
+    kinds = _checked_codes(f, "bifurcation_kind", BIFURCATION_KINDS, (m,))
+    turning = _checked_codes(f, "bifurcation_turning", _YES_NO, (m,))
+    plate = np.stack([_shaped(f, "bifurcation_x2", (m,)), _shaped(f, "bifurcation_x2dot", (m,))], axis=1)
+    multipliers = _complex(f, "bifurcation_", (m, 2))
+    contacts = _shaped(f, "bifurcation_contacts", (m, 2, 3), "iu").tolist()
+    bracket, test = _shaped(f, "bifurcation_bracket", (m,)), _shaped(f, "bifurcation_test_value", (m,))
+    points = [MapBifurcation(BIFURCATION_KINDS[kinds[i]], param, float(_shaped(f, "bifurcation_value", (m,))[i]),
+                             plate[i], multipliers[i], float(bracket[i]), float(test[i]),
+                             tuple(tuple(side) for side in contacts[i]), bool(turning[i])) for i in range(m)]
+    return MapBranch(param, _int_attr(f, "period_k"), values,
+                     np.stack([_shaped(f, "x2", (n,)), _shaped(f, "x2dot", (n,))], axis=1), _complex(f, "", (n, 2)),
+                     _checked_codes(f, "stable", _YES_NO, (n,)).astype(bool),
+                     _shaped(f, "contacts", (n, 3), "iu").astype(np.int64), points, _attr_str(f, "message"))
+
+
+def _read_basins(f) -> Basins:
+    xs = _checked_axis("x2", _data(f, "x2", ndim=1), False).values
+    vs = _checked_axis("x2dot", _data(f, "x2dot", ndim=1), False).values
+    shape = (len(vs), len(xs))
+    labels = _shaped(f, "labels", shape, "i").astype(np.int64)
+    periods = _data(f, "attractor_period", ndim=1, kinds="iu").astype(np.int64)
+    counts = _shaped(f, "attractor_count", periods.shape, "iu").astype(np.int64)
+    _out_of_range("labels", labels.reshape(-1), (labels.reshape(-1) < NO_MAP) | (labels.reshape(-1) >= len(periods)),
+                  f"{NO_MAP} to {len(periods) - 1}")
+    _out_of_range("attractor_period", periods, periods < 1, "a positive integer")
+    rows = int(periods.sum())
+    plate = np.stack([_shaped(f, "attractor_x2", (rows,)), _shaped(f, "attractor_x2dot", (rows,))], axis=1)
+    starts = np.concatenate([[0], np.cumsum(periods)])
+    attractors = [Attractor(plate[a:b], int(b - a), int(c)) for a, b, c in zip(starts, starts[1:], counts,
+                                                                                 strict=False)]
+    return Basins(_real_attr(f, "period"), xs, vs, labels, _shaped(f, "impacts", shape, "iu").astype(np.int64),
+                  attractors, _int_attr(f, "not_converged"), _int_attr(f, "no_map"))
+
+
+_READERS = {"impact-train": _read_impact_train, "orbit-diagram": _read_orbit_diagram,
+            "map-branch": _read_map_branch, "basins": _read_basins}
 
 
 # ------------------------------------------------------------------------------------------------
@@ -1606,8 +2132,8 @@ def _checked_header(f, path) -> int:
     if version < 1:
         raise _Damaged(f"attribute schema_version = {version} is out of range; allowed: 1 to {SCHEMA_VERSION}")
     kind = _attr_str(f, "kind")
-    if kind not in KINDS:
-        raise _Damaged(f"attribute kind = {kind!r} is out of range; allowed: one of {', '.join(KINDS)}")
+    if kind not in KINDS + TRAIN_KINDS:
+        raise _Damaged(f"attribute kind = {kind!r} is out of range; allowed: one of {', '.join(KINDS + TRAIN_KINDS)}")
     return version
 
 
@@ -1627,7 +2153,10 @@ def _base(f):
 
 
 def load(path):
-    """Read an archive back: a :class:`SweepResult` (with its :class:`Grid`) or a :class:`CriticalCurve`.
+    """Read an archive back: a :class:`SweepResult` (with its :class:`Grid`), a :class:`CriticalCurve`, or
+    a train result (:class:`~phaseimpact.train.ImpactTrain`, :class:`~phaseimpact.train.OrbitDiagram`,
+    :class:`~phaseimpact.train.MapBranch`, :class:`~phaseimpact.train.Basins`; its case and law are in
+    :func:`describe`).
 
     Points of an archive in progress that are not committed (status -1) come back as not computed,
     whatever else a killed checkpoint left of them. Every chunk's checksum and the content are
@@ -1644,9 +2173,10 @@ def load(path):
 
     Returns
     -------
-    SweepResult or CriticalCurve
-        With its base case, law, axes, ``t_end`` and settings, ready to be completed
-        (``previous=``) or plotted.
+    SweepResult, CriticalCurve, ImpactTrain, OrbitDiagram, MapBranch or Basins
+        A sweep or curve with its base case, law, axes, ``t_end`` and settings, ready to be
+        completed (``previous=``) or plotted; a train result equal to the one saved, every array
+        bit for bit.
 
     Raises
     ------
@@ -1676,6 +2206,10 @@ def _load(path: str):
     with _reading(path) as f:
         version = _checked_header(f, path)
         kind = _attr_str(f, "kind")
+        if kind in TRAIN_KINDS:  # schema 5 on
+            result = _READERS[kind](f)
+            _check_metadata(f)
+            return result
         if version == 1:
             result = _read_sweep_v1(f) if kind == "sweep" else _read_curve_v1(f)
         elif version == 2:
@@ -2003,7 +2537,12 @@ def _describe(path: str) -> dict:
         kind = _attr_str(f, "kind")
         law = _law(f).as_dict()
         params = _json_attr(f, "parameters", dict)
-        if version >= 3:
+        if kind in TRAIN_KINDS:
+            axes = {}
+            if kind == "orbit-diagram":
+                param = _attr_str(f, "param")
+                axes = {param: axis(f, param, netcdf_name(param))}
+        elif version >= 3:
             if kind == "critical-curve":
                 param = _attr_str(f, "param")
                 axes = {param: axis(f, param, _axis_names([param])[0])}
