@@ -1166,8 +1166,32 @@ def cmd_plot(args) -> int:
     curves = [archive.load(path) for path in (args.curve or [])]
     from . import plotting
     from .continuation import CriticalCurve
+    from .train import Basins, OrbitDiagram
 
-    if isinstance(result, CriticalCurve):
+    if archive.kind_of(result) in archive.TRAIN_KINDS:
+        kind = archive.kind_of(result)
+        if kind == "impact-train":
+            raise ValueError(f"archive = {args.archive!r} is an impact train, which plot does not draw; allowed: a "
+                             "sweep, an atlas, a critical curve, an orbit diagram, basins or a map branch (a train's "
+                             "columns: phaseimpact.archive.to_xarray)")
+        if args.contours != "none" or curves:
+            raise ValueError(f"archive = {args.archive!r} is a {kind} archive: --contours and --curve are read only "
+                             "for an atlas; allowed: an atlas archive with them")
+        if isinstance(result, OrbitDiagram):
+            fig = plotting.plot_orbit_diagram(result)
+        elif isinstance(result, Basins):
+            fig = plotting.plot_basins(result)
+        else:
+            with plotting.style():
+                fig, axes = plotting.figure(width=plotting.COLUMN_WIDTH)
+                ax = axes.flat[0]
+                scale, label = {"T": (1e-3, "period T (ms)"), "v": (1.0, "impact speed v (m/s)")}.get(
+                    result.param, (1.0, "damping κ"))
+                plotting.plot_map_branch(ax, result, x_scale=scale)
+                ax.set_xlabel(label)
+                ax.set_ylabel("x2 before impact (µm)")
+                ax.legend(loc="best")
+    elif isinstance(result, CriticalCurve):
         if args.contours != "none" or curves:
             raise ValueError(f"archive = {args.archive!r} is a critical curve: --contours and --curve are read only "
                              "for an atlas; allowed: an atlas archive with them")
@@ -1409,6 +1433,15 @@ def build_parser() -> argparse.ArgumentParser:
     def json_option(p):
         p.add_argument("--json", action="store_true", help="print one JSON object (numbers finite or null)")
 
+    def train_archive_option(p, force=True):
+        p.add_argument("--archive", type=_path("archive"), default=None, metavar="FILE.nc",
+                       help="also write the result as a netCDF-4/CF archive (docs/archive.md; phaseimpact.archive.load "
+                            "reads it back); an existing archive is replaced, another file only with --force "
+                            "(default: none)")
+        if force:
+            p.add_argument("--force", action="store_true",
+                           help="replace --archive even if it is not an archive (default: refuse)")
+
     settable = "Settable with --set NAME=VALUE (SI units): " + "; ".join(
         f"{name} ({unit}): {text}" for name, (unit, text) in SETTABLE.items()) + "."
 
@@ -1614,6 +1647,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--fixed-point", action="store_true", help="also find the period-1 orbit and its multipliers")
     tolerance(p)
     json_option(p)
+    train_archive_option(p)
     p.set_defaults(func=cmd_train)
 
     p = add("orbit-diagram", "the impact map's attractor over T, kappa or v",
@@ -1640,6 +1674,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--force", action="store_true", help="replace --out even if it is not a figure (default: refuse)")
     tolerance(p)
     json_option(p)
+    train_archive_option(p, force=False)
     p.set_defaults(func=cmd_orbit_diagram)
 
     p = add("map-continuation", "a branch of periodic orbits of the impact map over T, kappa or v, with its "
@@ -1669,6 +1704,7 @@ def build_parser() -> argparse.ArgumentParser:
                    help="integrator tolerance (relative), %(type)s; the multipliers come from finite differences "
                         "of the map, so tighter than elsewhere (default: %(default)s)")
     json_option(p)
+    train_archive_option(p)
     p.set_defaults(func=cmd_map_continuation)
 
     p = add("basins", "basins of attraction of the impact map over the plate's initial state",
@@ -1700,8 +1736,32 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--force", action="store_true", help="replace --out even if it is not a figure (default: refuse)")
     tolerance(p)
     json_option(p)
+    train_archive_option(p, force=False)
     p.set_defaults(func=cmd_basins)
     return parser
+
+
+def _check_archive_target(args) -> None:
+    """Before any work: ``--archive`` may replace an archive, another file only with ``--force``."""
+    if args.archive is None or args.force or not os.path.exists(args.archive):
+        return
+    from . import archive
+
+    try:
+        archive.describe(args.archive)
+    except (ValueError, OSError):
+        raise ValueError(f"archive = {args.archive!r} exists and is not a phaseimpact archive; allowed: a new path, "
+                         "an archive to replace, or --force") from None
+
+
+def _save_train_archive(args, setup: Setup, result, **settings) -> None:
+    if args.archive is None:
+        return
+    from . import archive
+
+    with exclusive(args.archive, "archive"):
+        archive.save(result, args.archive, force=getattr(args, "force", False), params=setup.params, law=setup.law,
+                     settings={"rtol": args.rtol, **settings})
 
 
 def cmd_train(args) -> int:
@@ -1709,9 +1769,11 @@ def cmd_train(args) -> int:
     from .train import impact_train, map_fixed_point
 
     setup = _setup(args)
+    _check_archive_target(args)
     p, law = setup.params, setup.law
     _note(f"{args.impacts} impacts of {law.label()}, one every {args.period:g} s")
     train = impact_train(p, law, args.period, args.impacts, rtol=args.rtol)
+    _save_train_archive(args, setup, train, period=args.period, impacts=args.impacts)
     orbit = map_fixed_point(p, law, args.period) if args.fixed_point else None
     out = {**_law_fields(setup), "v": p.v, "kappa": law.kappa(p), "kappa_unit": law.damping_unit(p.alpha),
            "target": p.target, "plate_period": scales(p).plate_period, **train.as_dict(),
@@ -1749,11 +1811,13 @@ def cmd_orbit_diagram(args) -> int:
     if args.out is not None:
         _check_figure_target(args.out, args.force)
     setup = _setup(args)
+    _check_archive_target(args)
     param, values = _train_axis(args, setup)
     _note(f"orbit diagram of {setup.law.label()} over {param}: {len(values)} values x "
           f"{args.transients + args.samples} impacts")
     diagram = orbit_diagram(setup.params, setup.law, param, values, period=args.period,
                             transients=args.transients, samples=args.samples, rtol=args.rtol, n_jobs=args.jobs)
+    _save_train_archive(args, setup, diagram, period=args.period, transients=args.transients, samples=args.samples)
     if args.out is not None:
         with exclusive(args.out, "out"):
             title = f"{setup.law.label()}, {setup.case.name}, v = {setup.params.v:g} m/s"
@@ -1811,6 +1875,7 @@ def cmd_map_continuation(args) -> int:
     from .train import continue_map_orbit
 
     setup = _setup(args)
+    _check_archive_target(args)
     param, values = _train_axis(args, setup)
     if len(values) < 2:
         raise ValueError(f"axis {param!r} has {len(values)} value; allowed: START:STOP:NUM with NUM >= 2 (the "
@@ -1821,6 +1886,7 @@ def cmd_map_continuation(args) -> int:
     branch = continue_map_orbit(p, law, param, start, stop, period=args.period, k=args.k,
                                 step=float(np.max(np.abs(np.diff(values)))), max_points=args.max_points,
                                 xtol=args.xtol, rtol=args.rtol)
+    _save_train_archive(args, setup, branch, period=args.period, k=args.k, xtol=args.xtol)
     out = {**_law_fields(setup), "v": p.v, "kappa": law.kappa(p), "kappa_unit": law.damping_unit(p.alpha),
            "target": p.target, "plate_period": scales(p).plate_period, "period": args.period, "param": param,
            "from": start, "to": stop, "num": len(values), **branch.as_dict(), "case": setup.case.as_dict()}
@@ -1854,6 +1920,7 @@ def cmd_basins(args) -> int:
     if args.out is not None:
         _check_figure_target(args.out, args.force)
     setup = _setup(args)
+    _check_archive_target(args)
     p, law = setup.params, setup.law
     omega = math.sqrt(p.Kb / p.M2) if p.target == "plate" and p.Kb > 0 else None
     if args.x2_max is None and omega is None:
@@ -1865,6 +1932,8 @@ def cmd_basins(args) -> int:
     _note(f"basins of {law.label()} at T = {args.period:g} s: {args.grid} x {args.grid} initial states")
     result = basins(p, law, args.period, xs, vs, iterations=args.iterations, max_period=args.max_period,
                     rtol=args.rtol, n_jobs=args.jobs)
+    _save_train_archive(args, setup, result, period=args.period, iterations=args.iterations,
+                        max_period=args.max_period)
     if args.out is not None:
         with exclusive(args.out, "out"):
             title = f"{law.label()}, {setup.case.name}, v = {p.v:g} m/s, T = {args.period:g} s"

@@ -471,3 +471,38 @@ def test_a_resume_of_other_work_names_what_differs_with_the_asked_value(tmp_path
     assert code == 2 and "t_end none (each run until its outcome settles) (asked 0.01 s)" in err, err
     code, _, err = run([*base[:6], "kappa=1e9:1.0000000001e14:5:log", *base[7:], "--resume"])
     assert code == 2 and "100000000010000.0" in err, err
+
+
+# ------------------------------------------------------------------------------------------------
+# Trains of impacts: --archive and plot
+# ------------------------------------------------------------------------------------------------
+
+def test_train_commands_write_archives_that_load_and_plot(tmp_path, capsys):
+    from phaseimpact.train import ImpactTrain, OrbitDiagram, impact_train
+
+    hc = ["--law", "hunt-crossley", "--kappa", "3e9"]
+    train_nc, diagram_nc = tmp_path / "t.nc", tmp_path / "o.nc"
+    assert main(["train", *hc, "--period", "3e-3", "--impacts", "3", "--archive", str(train_nc)]) == 0
+    assert main(["orbit-diagram", *hc, "--axis", "T=2e-3:3e-3:3", "--transients", "3", "--samples", "2",
+                 "--archive", str(diagram_nc)]) == 0
+    loaded = archive.load(train_nc)
+    direct = impact_train(seed_parameters(kappa=3e9), "hunt-crossley", 3e-3, 3)
+    assert isinstance(loaded, ImpactTrain)
+    assert np.array_equal(loaded.plate, direct.plate) and np.array_equal(loaded.peak_force, direct.peak_force)
+    assert isinstance(archive.load(diagram_nc), OrbitDiagram)
+    assert main(["plot", str(diagram_nc), "--out", str(tmp_path / "o.png")]) == 0
+    assert (tmp_path / "o.png").read_bytes().startswith(b"\x89PNG")
+    capsys.readouterr()
+    assert main(["plot", str(train_nc), "--out", str(tmp_path / "t.png")]) == 2  # a train is not drawn
+    assert "impact train" in capsys.readouterr().err and not (tmp_path / "t.png").exists()
+
+
+def test_train_archive_refuses_a_foreign_file_before_any_work(tmp_path, capsys, monkeypatch):
+    import phaseimpact.train as train_module
+
+    notes = tmp_path / "notes.nc"
+    notes.write_text("my notes")
+    monkeypatch.setattr(train_module, "impact_train", lambda *a, **k: pytest.fail("work started"))
+    assert main(["train", "--law", "hunt-crossley", "--kappa", "3e9", "--period", "3e-3", "--archive",
+                 str(notes)]) == 2
+    assert "not a phaseimpact archive" in capsys.readouterr().err and notes.read_text() == "my notes"
