@@ -64,11 +64,21 @@ def impact_map(params: Parameters, law, period: float, plate, *, rtol: float = 1
     plate : 2 numbers
         ``(x2, x2dot)`` (m, m/s) just before the impact.
     rtol : float
+        The integrator's relative tolerance.
 
     Returns
     -------
     (ndarray, Trajectory)
         The plate's ``(x2, x2dot)`` just before the next arrival, and the run over ``[0, period]``.
+
+    Examples
+    --------
+    One projectile on the plate at rest, the next arriving 3 ms later:
+
+    >>> from phaseimpact import seed_parameters
+    >>> z, run = impact_map(seed_parameters(kappa=3e9), "hunt-crossley", 3e-3, (0.0, 0.0))
+    >>> run.status, f"{run.max_force:.4g} N", f"{z[1]:.3g} m/s"
+    ('success', '4629 N', '0.172 m/s')
     """
     x2, x2dot = (float(plate[0]), float(plate[1]))
     run = simulate(params, law, period, rtol=rtol, initial=(x2, x2, params.v, x2dot), stop_when_settled=False)
@@ -98,6 +108,15 @@ class ImpactTrain:
         The projectile was still in contact when the next one arrived.
     status : list of str
         Each run's status (``success`` or a failure).
+
+    Examples
+    --------
+    From :func:`impact_train`:
+
+    >>> from phaseimpact import seed_parameters
+    >>> train = impact_train(seed_parameters(kappa=3e9), "hunt-crossley", 3e-3, 3)
+    >>> train.plate.shape, train.peak_force.shape, bool(train.overlap.any())
+    ((4, 2), (3,), False)
     """
 
     period: float
@@ -112,6 +131,20 @@ class ImpactTrain:
     status: list
 
     def as_dict(self) -> dict:
+        """The train as JSON-ready lists.
+
+        Returns
+        -------
+        dict
+            ``period`` (s), ``impacts`` (their number) and the attributes as lists (SI units as above).
+
+        Examples
+        --------
+        >>> from phaseimpact import seed_parameters
+        >>> d = impact_train(seed_parameters(kappa=3e9), "hunt-crossley", 3e-3, 2).as_dict()
+        >>> d["impacts"], len(d["plate"]), d["status"]
+        (2, 3, ['success', 'success'])
+        """
         return {"period": self.period, "impacts": len(self.peak_force), "plate": self.plate.tolist(),
                 "amplitude": self.amplitude.tolist(), "peak_force": self.peak_force.tolist(),
                 "dissipated_energy": self.dissipated_energy.tolist(), "restitution": self.restitution.tolist(),
@@ -126,6 +159,7 @@ def impact_train(params: Parameters, law, period: float, impacts: int, *, plate=
     Parameters
     ----------
     params : Parameters
+        The case (``v``, m/s: each projectile's speed).
     law : ContactLaw or str
     period : float
         Time between arrivals, s (> 0).
@@ -133,7 +167,8 @@ def impact_train(params: Parameters, law, period: float, impacts: int, *, plate=
         Number of impacts, 1 to 100000.
     plate : 2 numbers, default (0, 0)
         ``(x2, x2dot)`` (m, m/s) before the first impact.
-    rtol : float
+    rtol : float, default 1e-10
+        The integrator's relative tolerance.
 
     Returns
     -------
@@ -143,6 +178,17 @@ def impact_train(params: Parameters, law, period: float, impacts: int, *, plate=
     ------
     ValueError
         A period or a number of impacts out of range.
+
+    Examples
+    --------
+    Three impacts 3 ms apart (three plate periods) on the seed case's plate, at rest at first:
+
+    >>> from phaseimpact import seed_parameters
+    >>> train = impact_train(seed_parameters(kappa=3e9), "hunt-crossley", 3e-3, 3)
+    >>> [f"{f:.3g}" for f in train.peak_force], [f"{e:.3g}" for e in train.restitution]
+    (['4.63e+03', '4.14e+03', '4.83e+03'], ['0.868', '0.851', '0.88'])
+    >>> [f"{a * 1e6:.3g}" for a in train.amplitude]  # micrometres, before each arrival
+    ['0', '27.6', '55.1', '10']
     """
     law = as_law(law)
     period = _check_period(period, params)
@@ -185,7 +231,18 @@ class MapFixedPoint:
     jacobian_accuracy : float
         Largest change of the Jacobian's entries between two finite-difference steps (relative).
     converged : bool
+        The residual is below 1e-9.
     message : str
+        Empty when converged, else why not.
+
+    Examples
+    --------
+    From :func:`map_fixed_point`:
+
+    >>> from phaseimpact import seed_parameters
+    >>> fp = map_fixed_point(seed_parameters(kappa=3e9), "hunt-crossley", 0.4e-3)
+    >>> fp.period_k, fp.stable, fp.converged
+    (1, True, True)
     """
 
     plate: np.ndarray
@@ -198,6 +255,20 @@ class MapFixedPoint:
     message: str
 
     def as_dict(self) -> dict:
+        """The orbit as JSON-ready numbers.
+
+        Returns
+        -------
+        dict
+            The attributes; ``plate`` as a list (m, m/s), multipliers as ``{re, im, abs}``.
+
+        Examples
+        --------
+        >>> from phaseimpact import seed_parameters
+        >>> d = map_fixed_point(seed_parameters(kappa=3e9), "hunt-crossley", 0.4e-3).as_dict()
+        >>> [f"{m['abs']:.3f}" for m in d["multipliers"]], d["stable"]
+        (['0.450', '0.450'], True)
+        """
         return {"plate": self.plate.tolist(), "period_k": self.period_k,
                 "multipliers": [{"re": float(m.real), "im": float(m.imag), "abs": float(abs(m))}
                                 for m in self.multipliers],
@@ -214,7 +285,40 @@ def _map_k(params, law, period, z, k, rtol):
 def map_jacobian(params: Parameters, law, period: float, plate, *, k: int = 1, rtol: float = 1e-12):
     """The Jacobian of ``P^k`` at ``plate`` by central differences, and its accuracy: the largest
     relative change of an entry between the steps ``JACOBIAN_STEP`` and ``10 JACOBIAN_STEP`` of
-    the state's scales."""
+    the state's scales.
+
+    Parameters
+    ----------
+    params : Parameters
+        The case.
+    law : ContactLaw or str
+    period : float
+        Time between arrivals, s (> 0).
+    plate : 2 numbers
+        ``(x2, x2dot)`` (m, m/s) where the Jacobian is taken.
+    k : int, default 1
+        The power of the map (impacts).
+    rtol : float, default 1e-12
+        The integrator's relative tolerance.
+
+    Returns
+    -------
+    (ndarray, float)
+        The Jacobian, shape (2, 2), in SI units (``d x2'/d x2`` dimensionless, ``d x2'/d x2dot`` in s,
+        ``d x2dot'/d x2`` in 1/s), and its accuracy (relative, in the state's scales).
+
+    Examples
+    --------
+    At the period-1 orbit its eigenvalues are the orbit's Floquet multipliers:
+
+    >>> import numpy as np
+    >>> from phaseimpact import seed_parameters
+    >>> p = seed_parameters(kappa=3e9)
+    >>> fp = map_fixed_point(p, "hunt-crossley", 0.4e-3)
+    >>> J, accuracy = map_jacobian(p, "hunt-crossley", 0.4e-3, fp.plate)
+    >>> J.shape, [f"{abs(m):.3f}" for m in np.linalg.eigvals(J)], bool(accuracy < 1e-6)
+    ((2, 2), ['0.450', '0.450'], True)
+    """
     scale = _state_scale(params)
     z = np.asarray(plate, dtype=float)
 
@@ -250,10 +354,31 @@ def map_fixed_point(params: Parameters, law, period: float, *, k: int = 1, guess
         ``(x2, x2dot)`` to start from; default the state after 50 impacts from rest (a stable
         orbit's neighbourhood).
     rtol : float, default 1e-12
+        The integrator's relative tolerance.
 
     Returns
     -------
     MapFixedPoint
+        ``converged`` False (``message`` says why) when no orbit is found from the guess.
+
+    Raises
+    ------
+    ValueError
+        A period or ``k`` out of range.
+
+    Examples
+    --------
+    Impacts 0.4 ms apart (0.4 plate periods) settle on a stable period-1 orbit; with the Abrate law
+    and 3 ms the period-1 orbit is unstable (a multiplier below -1):
+
+    >>> from phaseimpact import seed_parameters
+    >>> p = seed_parameters(kappa=3e9)
+    >>> fp = map_fixed_point(p, "hunt-crossley", 0.4e-3)
+    >>> fp.converged, fp.stable, f"{fp.plate[0] * 1e6:.3g} um", f"{fp.plate[1]:.3g} m/s"
+    (True, True, '72.6 um', '-0.647 m/s')
+    >>> fa = map_fixed_point(p, "abrate", 3e-3)
+    >>> fa.stable, sorted(f"{m.real:.3g}" for m in fa.multipliers)
+    (False, ['-0.569', '-1.43'])
     """
     from scipy.optimize import root
 
@@ -295,6 +420,15 @@ class OrbitDiagram:
     distinct : ndarray of int, shape (n,)
         Distinct points among the samples (to 1e-6 of the state's scales): 1 on a fixed point,
         ``k`` on a period-``k`` orbit, ``samples`` when irregular (or not settled).
+
+    Examples
+    --------
+    From :func:`orbit_diagram`:
+
+    >>> from phaseimpact import seed_parameters
+    >>> d = orbit_diagram(seed_parameters(kappa=3e9), "hunt-crossley", "T", [0.4e-3], transients=2, samples=3)
+    >>> d.param, d.plate.shape, d.peak_force.shape
+    ('T', (1, 3, 2), (1, 3))
     """
 
     param: str
@@ -317,21 +451,42 @@ def orbit_diagram(params: Parameters, law, param: str, values, *, period: float 
     Parameters
     ----------
     params : Parameters
+        The case.
     law : ContactLaw or str
     param : {"T", "kappa", "v"}
+        The parameter varied: the period between arrivals, the damping or the speed.
     values : sequence of float
         The parameter's values (s, N s/m^(1+alpha) or m/s).
     period : float, optional
         The period (s) when ``param`` is not ``T``.
-    transients, samples : int
-        Impacts dropped, then kept, at each value.
-    rtol : float
-    n_jobs : int
+    transients, samples : int, default 200, 50
+        Impacts dropped (0 to 100000), then kept (1 to 100000), at each value.
+    rtol : float, default 1e-10
+        The integrator's relative tolerance.
+    n_jobs : int, default 1
         Values computed side by side (threads; the result does not depend on it).
 
     Returns
     -------
     OrbitDiagram
+
+    Raises
+    ------
+    ValueError
+        A parameter name, values, period, or number of transients or samples out of range.
+
+    Examples
+    --------
+    Two periods, a handful of impacts each (the transients are far from over: ``distinct`` counts
+    the samples, not yet an orbit's period):
+
+    >>> from phaseimpact import seed_parameters
+    >>> d = orbit_diagram(seed_parameters(kappa=3e9), "hunt-crossley", "T", [0.4e-3, 3e-3], transients=5,
+    ...                   samples=3)
+    >>> d.plate.shape, d.distinct.tolist()
+    ((2, 3, 2), [3, 3])
+    >>> [f"{f:.3g}" for f in d.peak_force[:, 0]]
+    ['8.38e+03', '4.39e+03']
     """
     from .continuation._parallel import map_in_threads
 
@@ -361,7 +516,42 @@ def lyapunov_exponent(params: Parameters, law, period: float, *, plate=None, ite
     """The largest Lyapunov exponent of the impact map (per impact): the mean of ``log |J_n w_n|``
     along the orbit from ``plate`` (default: after 100 impacts from rest), ``w`` renormalised each
     impact; ``J_n`` the map's Jacobian by central differences (:func:`map_jacobian`). Negative on a
-    stable periodic orbit (the log of its largest multiplier's modulus), positive when chaotic."""
+    stable periodic orbit (the log of its largest multiplier's modulus), positive when chaotic.
+
+    Parameters
+    ----------
+    params : Parameters
+        The case.
+    law : ContactLaw or str
+    period : float
+        Time between arrivals, s (> 0).
+    plate : 2 numbers, optional
+        ``(x2, x2dot)`` (m, m/s) to start from; default the state after 100 impacts from rest.
+    iterations : int, default 200
+        Impacts averaged over.
+    rtol : float, default 1e-10
+        The integrator's relative tolerance.
+
+    Returns
+    -------
+    float
+        The exponent, per impact (dimensionless; divide by ``period`` for a rate in 1/s).
+
+    Raises
+    ------
+    ValueError
+        A period out of range.
+
+    Examples
+    --------
+    On the stable period-1 orbit at 0.4 ms it approaches ``log 0.450 = -0.799``:
+
+    >>> from phaseimpact import seed_parameters
+    >>> p = seed_parameters(kappa=3e9)
+    >>> fp = map_fixed_point(p, "hunt-crossley", 0.4e-3)
+    >>> f"{lyapunov_exponent(p, 'hunt-crossley', 0.4e-3, plate=fp.plate, iterations=50):.2f}"
+    '-0.80'
+    """
     law = as_law(law)
     period = _check_period(period, params)
     scale = _state_scale(params)

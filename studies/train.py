@@ -47,7 +47,7 @@ def main(quick=False, jobs=1):
     build = {r: impact_train(params, LAW, r * plate_period, 60) for r in examples}
 
     with style():
-        fig, axes = figure(3, 1, width=6.4, height=8.0)
+        fig, axes = figure(3, 1, height=8.0)
         ax = axes[0, 0]
         ax.plot(np.repeat(ratios, samples), diagram.plate[:, :, 0].ravel() * 1e6, ".", color="k", ms=1.2, mew=0,
                 rasterized=True)
@@ -62,14 +62,14 @@ def main(quick=False, jobs=1):
             ax.axvline(k, color="0.6", lw=0.7, ls=":")
         ax.set_xlabel("T / T_plate")
         ax.set_ylabel("plate amplitude before impact (µm)")
-        ax.legend(loc="upper left", fontsize=6.5)
+        ax.legend(loc="lower center", bbox_to_anchor=(0.5, 1.0), ncols=3)  # above the panel, off the data
         ax = axes[2, 0]
-        for i, r in enumerate(examples):
-            ax.plot(build[r].amplitude * 1e6, f"C{i}.-", ms=3, lw=0.7, label=f"T = {r:g} T_plate")
+        for i, (r, style_) in enumerate(zip(examples, ("o-", "s--", "^:"), strict=True)):
+            ax.plot(build[r].amplitude * 1e6, style_, color=f"C{i}", ms=2.5, lw=0.8, label=f"T = {r:g} T_plate")
         ax.set_xlabel("impact n")
         ax.set_ylabel("plate amplitude before impact n (µm)")
         ax.set_title("build-up from rest")
-        ax.legend(loc="lower right", fontsize=6.5)
+        ax.legend(loc="lower right")
         out = save(fig, FIGURES / f"{NAME}.png")
 
     counts = {"period-1": int(fixed.sum()), "irregular": int(irregular.sum()),

@@ -88,11 +88,14 @@ def main(quick=False, jobs=1):
         ax.set_xlabel("T / T_plate")
         ax.set_ylabel("plate amplitude before impact (µm)")
         ax.set_title("orbits (solid stable, dashed unstable)")
-        ax.legend(loc="lower left", fontsize=8, ncols=2)
+        # the orbits and the located points (marked in both top panels), above the panels, off the data
+        fig.legend(*ax.get_legend_handles_labels(), loc="outside upper center", ncols=3)
         ax = axes[0, 1]
-        for branch, colour in ((large, "k"), (small, "0.4"), (double, "#aa3377")):
+        for branch, colour, name in ((large, "k", "large period-1"), (small, "0.4", "small period-1"),
+                                     (double, "#aa3377", "period-2")):
             for i, ls in ((0, "-"), (1, ":")):
-                ax.plot(branch.values / Tp, branch.multipliers[:, i].real, color=colour, ls=ls, lw=1.0)
+                ax.plot(branch.values / Tp, branch.multipliers[:, i].real, color=colour, ls=ls, lw=1.0,
+                        label=name if i == 0 else None)
         for y in (-1, 1):
             ax.axhline(y, color="0.5", lw=0.7)
         for branch in (large, small, double):
@@ -100,14 +103,16 @@ def main(quick=False, jobs=1):
                 marker, colour, _ = BIFURCATION_MARKERS[p.kind]
                 ax.plot(p.value / Tp, np.clip(p.multipliers.real[np.argmin(np.abs(np.abs(p.multipliers) - 1))], -2, 2),
                         ls="none", marker=marker, color=colour, mec="k", mew=0.6, ms=6.5, zorder=5)
-        ax.set_ylim(-2, 2)
+        ax.plot([], [], color="k", ls=":", lw=1.0, label="2nd multiplier")
+        ax.set_ylim(-2, 2.6)  # room above +1, where no multiplier goes, for the legend
         ax.set_xlim(ratios[0], ratios[-1])
+        ax.legend(loc="upper left", ncols=2)
         ax.set_xlabel("T / T_plate")
         ax.set_ylabel("Floquet multipliers (real part)")
-        ax.set_title("multipliers: a crossing of -1 or +1 is a bifurcation")
+        ax.set_title("a crossing of ±1 is a bifurcation")
         ax = axes[1, 0]
         plot_bifurcation_curves(ax, curves, x_scale=Tp, y_scale=1e9)
-        ax.legend(loc="lower center", fontsize=8)
+        ax.legend(loc="lower center")
         ax.set_xlabel("T / T_plate at the bifurcation")
         ax.set_ylabel("damping κ (1e9 N s/m$^{2.5}$)")
         ax.set_title("followed in κ")

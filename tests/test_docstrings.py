@@ -27,6 +27,7 @@ MODULES = (
     "phaseimpact.analysis",
     "phaseimpact.plotting",
     "phaseimpact.quantities",
+    "phaseimpact.train",
 )
 FLAGS = doctest.ELLIPSIS | doctest.NORMALIZE_WHITESPACE
 

@@ -144,13 +144,10 @@ def _pdf_text_sizes(pdf: bytes) -> list[float]:
     return sizes
 
 
-#: Figures of studies whose owners still set legends below 8 pt (issue 27, figures for print).
-NOT_YET = {"train": "studies/train.py sets 6.5 pt legends", "plastic": "studies/plastic.py sets 6.5-7 pt text"}
 PDFS = sorted(FIGURES.glob("*.pdf"))
 
 
-@pytest.mark.parametrize("pdf", [pytest.param(p, marks=pytest.mark.xfail(reason=NOT_YET[p.stem], strict=False))
-                                 if p.stem in NOT_YET else p for p in PDFS], ids=lambda p: p.stem)
+@pytest.mark.parametrize("pdf", PDFS, ids=lambda p: p.stem)
 def test_committed_figures_print_in_a_journal(pdf):
     """Every PNG has its PDF; each page at most 7.2 in wide and every text at least 8 pt, but for the
     sub- and superscripts of mathtext (0.7 of the text they belong to, as in print)."""
