@@ -1462,9 +1462,9 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser("warmup", help="compile the engine ahead, and say where its cache is",
                        description="Compile every entry of the engine into its cache now (the first command that "
-                                   "integrates would otherwise do it, ~20 s), and say where the cache is: for shared "
-                                   "installs (run it as the install's owner: other users read that cache), containers "
-                                   "and cluster workers. On a warm cache it only loads.")
+                                   "integrates would otherwise do it, about a minute on 2 cores), and say where the "
+                                   "cache is: for shared installs (run it as the install's owner: other users read "
+                                   "that cache), containers and cluster workers. On a warm cache it only loads.")
     json_option(p)
     p.set_defaults(func=cmd_warmup)
 
