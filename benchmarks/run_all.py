@@ -27,9 +27,9 @@ from _common import FIGURES, RESULTS, emit, load, machine  # noqa: E402
 
 #: In run order: peers (heyoka) before work_precision, which draws its points.
 SCRIPTS = ("startup", "trajectory", "throughput", "critical", "peers", "work_precision", "scene_savings", "stress",
-           "stiff", "atlas", "train")
+           "stiff", "atlas", "train", "scale")
 SECTIONS = ("trajectory", "throughput", "critical", "startup", "work_precision", "peers", "stiff", "atlas",
-            "scene_savings", "stress", "train")
+            "scene_savings", "stress", "train", "scale")
 
 
 def _pick(name: str, suffix: str, quick_first: bool = False):

@@ -437,16 +437,17 @@ def pack_batch(params_seq, law: ContactLaw, t_end, rtol: float, initial=None) ->
     C = np.empty((n, N_COEF))
     Y0 = np.empty((n, 5))
     T = np.empty(n)
-    A = np.empty((n, 7))
     S = np.empty(n)
+    indentation, v, M1, contact_time = (np.empty(n) for _ in range(4))
     for i, p in enumerate(params_seq):
         s = scales(p)
         C[i] = pack(p, law)
         Y0[i] = _initial(p, initial)
         T[i] = s.horizon if t_end is None else check_t_end(t_end, s.contact_time)
-        A[i] = _atol(p, rtol, None)
         S[i] = s.max_step
-    return Batch(law, C, Y0, T, A, S)
+        indentation[i], v[i], M1[i], contact_time[i] = s.indentation, p.v, p.M1, s.contact_time
+    # the tolerances of all runs at once: per run they cost more than the rest of the packing
+    return Batch(law, C, Y0, T, state_tolerances(rtol, indentation, v, M1, contact_time), S)
 
 
 def run_batch(batch: Batch, *, rtol: float, settle: bool = True, stop_on=None, n_threads: int = 1,

@@ -1,0 +1,122 @@
+"""Parallel scaling: ``sweep``, ``atlas`` and ``simulate_many`` over 1, 2, 4, ... cores, threads and
+processes, with the parallel efficiency and the serial fraction it implies.
+
+Efficiency at ``n`` workers is ``T(1) / (n T(n))``; the serial fraction is Karp and Flatt's
+``f = (1/S - 1/n) / (1 - 1/n)`` with ``S = T(1) / T(n)`` (Amdahl's law solved for its serial part:
+0 for a perfect scaling, the same ``f`` at every ``n`` when one serial part is all that limits it).
+Seed case, rtol 1e-10, each run until its outcome settles: a ``paper`` sweep of ``N`` kappa in
+[1e8, 1e13], a ``paper`` atlas over (kappa, v), a ``hunt-crossley`` ``simulate_many`` of ``N``
+``Parameters``. The worker counts are 1, 2, 4, ... up to the machine's cores; the contenders take
+turns within each repeat (medians), and every parallel result is checked bit for bit against the
+one-worker result.
+
+    python benchmarks/scale.py [--quick] [--n 8000]
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import statistics
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from _common import emit, load, machine, save_section, save_targets, table, target  # noqa: E402
+
+from phaseimpact import seed_parameters, simulate_many  # noqa: E402
+from phaseimpact.continuation import Axis, atlas, sweep  # noqa: E402
+
+RTOL = 1e-10
+
+
+def worker_counts() -> list[int]:
+    cores = os.cpu_count() or 1
+    counts, n = [], 1
+    while n < cores:
+        counts.append(n)
+        n *= 2
+    return [*counts, cores]
+
+
+def karp_flatt(speed_up: float, n: int) -> float:
+    return float("nan") if n == 1 else (1 / speed_up - 1 / n) / (1 - 1 / n)
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__)
+    ap.add_argument("--quick", action="store_true", help="3 repeats and a quarter of the points")
+    ap.add_argument("--n", type=int, default=8000, help="points of the sweep and of simulate_many")
+    args = ap.parse_args(argv)
+    n_points = args.n // 4 if args.quick else args.n
+    repeats = 3 if args.quick else 5
+    side = int(round(n_points ** 0.5))
+    params = seed_parameters(v=1.0)
+    kappas = np.geomspace(1e8, 1e13, n_points)
+    plist = [params.replace(kappa=float(k)) for k in np.geomspace(1e8, 1e11, n_points)]
+    axes = [Axis("kappa", np.geomspace(1e10, 1e14, side), log=True), Axis("v", np.linspace(0.5, 13.0, side))]
+    counts = worker_counts()
+    start_load = load()
+    emit(f"# Parallel scaling ({n_points} points, rtol {RTOL:g}, workers {counts})\n")
+    emit(machine())
+    emit(start_load + "\n")
+
+    def workloads(n):
+        return {
+            ("sweep", "threads"): lambda: sweep(params, "paper", kappas, n_jobs=n),
+            ("sweep", "loky processes"): lambda: sweep(params, "paper", kappas, n_jobs=n, backend="loky"),
+            ("atlas", "threads"): lambda: atlas(params, "paper", axes, n_jobs=n),
+            ("simulate_many", "threads"): lambda: simulate_many(plist, "hunt-crossley", rtol=RTOL, n_threads=n),
+        }
+
+    contenders = {(what, how, n): fn for n in counts for (what, how), fn in workloads(n).items()}
+    results = {key: fn() for key, fn in contenders.items()}  # warm-up: compiles, starts loky's workers
+    times = {key: [] for key in contenders}
+    for _ in range(repeats):
+        for key, fn in contenders.items():
+            start = time.perf_counter()
+            fn()
+            times[key].append(time.perf_counter() - start)
+    rows, targets = [], []
+    for what, how in workloads(1):
+        one = statistics.median(times[(what, how, 1)])
+        reference = results[(what, how, 1)]
+        for n in counts:
+            t = statistics.median(times[(what, how, n)])
+            speed_up = one / t
+            efficiency = speed_up / n
+            same = _same(reference, results[(what, how, n)])
+            rows.append((what, how, n, f"{t:.3g}", f"{speed_up:.2f}", f"{100 * efficiency:.0f} %",
+                         f"{karp_flatt(speed_up, n):.3f}" if n > 1 else "-", "identical" if same else "DIFFERENT"))
+            emit(f"{what}, {how}, {n}: {t:.3g} s, speed-up {speed_up:.2f}, efficiency {100 * efficiency:.0f} %")
+            if n == 2 and how == "threads":
+                targets.append(target(f"{what}: parallel efficiency at 2 threads", ">= 90 %",
+                                      f"{100 * efficiency:.0f} %", bool(efficiency >= 0.9),
+                                      "python benchmarks/scale.py"))
+    end_load = load()
+    header = ("workload", "workers", "n", "time [s]", "speed-up", "efficiency", "serial fraction (Karp-Flatt)",
+              "result vs 1 worker")
+    text = (f"## Parallel scaling\n\n{machine()}\n\n{start_load} at the start, {end_load} at the end. "
+            f"`python benchmarks/scale.py{' --quick' if args.quick else ''}`\n\n"
+            f"{n_points} points each (the atlas {side} x {side}), median of {repeats}; paper for the sweep and the "
+            "atlas, hunt-crossley for simulate_many. The GPU backend of the scale issue is not built: no GPU "
+            "rows.\n\n" + table(header, rows))
+    emit()
+    emit(text)
+    suffix = "_quick" if args.quick else ""
+    save_section(f"scale{suffix}", text)
+    save_targets(f"scale{suffix}", targets)
+    return 0
+
+
+def _same(a, b) -> bool:
+    """Bit-identical summary columns (a SweepResult or Columns)."""
+    names = ("max_force", "n_stick", "outcome", "t_run") if hasattr(a, "n_stick") else ("max_force",)
+    return all(np.array_equal(np.asarray(getattr(a, c)), np.asarray(getattr(b, c)), equal_nan=True) for c in names)
+
+
+if __name__ == "__main__":
+    sys.exit(main())
