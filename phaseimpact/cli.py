@@ -490,6 +490,13 @@ def _law_fields(setup: Setup) -> dict:
             "restitution": law.restitution}
 
 
+def _case_fields(setup: Setup) -> dict:
+    """The law and the case's speed, damping and target: the head of a single-case command's JSON."""
+    law, p = setup.law, setup.params
+    return {**_law_fields(setup), "v": p.v, "kappa": law.kappa(p), "kappa_unit": law.damping_unit(p.alpha),
+            "target": p.target}
+
+
 # ------------------------------------------------------------------------------------------------
 # Commands
 # ------------------------------------------------------------------------------------------------
@@ -621,9 +628,8 @@ def cmd_simulate(args) -> int:
     trajectory = simulate(p, law, args.t_end, rtol=args.rtol)
     q = impact_quantities(trajectory)
     t_stick, delta_stick, dwell = trajectory.stick_points()
-    out = {**_law_fields(setup), "v": p.v, "kappa": law.kappa(p), "kappa_unit": law.damping_unit(p.alpha),
-           "target": p.target,
-           "status": trajectory.status, "stop_reason": trajectory.stop_reason, "message": trajectory.message,
+    out = {**_case_fields(setup), "status": trajectory.status, "stop_reason": trajectory.stop_reason,
+           "message": trajectory.message,
            "t_end": trajectory.t_end, "t_stop": trajectory.t_stop, **q.as_dict(),
            **_contact_reading(trajectory, setup),
            **({"limiting_pressure": p.limiting_pressure, "yield_velocity": p.yield_velocity}
@@ -671,9 +677,7 @@ def cmd_fixed_points(args) -> int:
     setup = _setup(args)
     law, p = setup.law, setup.params
     found = fixed_points(p, law)
-    out = {**_law_fields(setup), "v": p.v, "kappa": law.kappa(p), "kappa_unit": law.damping_unit(p.alpha),
-           "target": p.target,
-           "equilibria": [e.as_dict() for e in found], "case": setup.case.as_dict()}
+    out = {**_case_fields(setup), "equilibria": [e.as_dict() for e in found], "case": setup.case.as_dict()}
     if args.json:
         _print_json(args, out)
         return EXIT_OK
@@ -1775,8 +1779,7 @@ def cmd_train(args) -> int:
     train = impact_train(p, law, args.period, args.impacts, rtol=args.rtol)
     _save_train_archive(args, setup, train, period=args.period, impacts=args.impacts)
     orbit = map_fixed_point(p, law, args.period) if args.fixed_point else None
-    out = {**_law_fields(setup), "v": p.v, "kappa": law.kappa(p), "kappa_unit": law.damping_unit(p.alpha),
-           "target": p.target, "plate_period": scales(p).plate_period, **train.as_dict(),
+    out = {**_case_fields(setup), "plate_period": scales(p).plate_period, **train.as_dict(),
            "fixed_point": None if orbit is None else orbit.as_dict(), "case": setup.case.as_dict()}
     failed = [s for s in train.status if s != "success"]
     if args.json:
@@ -1792,9 +1795,9 @@ def cmd_train(args) -> int:
         if train.overlap.any():
             print(f"  note: {int(train.overlap.sum())} projectile(s) still in contact when the next one arrived")
         if orbit is not None:
-            mult = ", ".join(f"{m.real:.6g}{m.imag:+.3g}i" for m in orbit.multipliers)
             print(f"  period-1 orbit: x2 = {orbit.plate[0]:.9g} m, x2dot = {orbit.plate[1]:.9g} m/s before each "
-                  f"impact; multipliers {mult} ({'stable' if orbit.stable else 'unstable'})"
+                  f"impact; multipliers {_multiplier_text(orbit.multipliers)} "
+                  f"({'stable' if orbit.stable else 'unstable'})"
                   + ("" if orbit.converged else f"; {orbit.message}"))
     if failed:
         print(f"phaseimpact: {len(failed)} run(s) of the train failed ({failed[0]})", file=sys.stderr)
@@ -1887,8 +1890,7 @@ def cmd_map_continuation(args) -> int:
                                 step=float(np.max(np.abs(np.diff(values)))), max_points=args.max_points,
                                 xtol=args.xtol, rtol=args.rtol)
     _save_train_archive(args, setup, branch, period=args.period, k=args.k, xtol=args.xtol)
-    out = {**_law_fields(setup), "v": p.v, "kappa": law.kappa(p), "kappa_unit": law.damping_unit(p.alpha),
-           "target": p.target, "plate_period": scales(p).plate_period, "period": args.period, "param": param,
+    out = {**_case_fields(setup), "plate_period": scales(p).plate_period, "period": args.period, "param": param,
            "from": start, "to": stop, "num": len(values), **branch.as_dict(), "case": setup.case.as_dict()}
     if args.json:
         _print_json(args, out)
@@ -1938,8 +1940,7 @@ def cmd_basins(args) -> int:
         with exclusive(args.out, "out"):
             title = f"{law.label()}, {setup.case.name}, v = {p.v:g} m/s, T = {args.period:g} s"
             plotting.save(plotting.plot_basins(result, title=title), args.out)
-    out = {"out": args.out, **_law_fields(setup), "v": p.v, "kappa": law.kappa(p),
-           "kappa_unit": law.damping_unit(p.alpha), "target": p.target, "plate_period": scales(p).plate_period,
+    out = {"out": args.out, **_case_fields(setup), "plate_period": scales(p).plate_period,
            "iterations": args.iterations, "max_period": args.max_period, **result.as_dict(),
            "case": setup.case.as_dict()}
     if args.json:

@@ -28,6 +28,15 @@ MODULES = (
     "phaseimpact.plotting",
     "phaseimpact.quantities",
     "phaseimpact.train",
+    "phaseimpact",
+    "phaseimpact.parameters",
+    "phaseimpact.case",
+    "phaseimpact.model",
+    "phaseimpact.model.laws",
+    "phaseimpact.model.userlaw",
+    "phaseimpact.model.restitution",
+    "phaseimpact.checks",
+    "phaseimpact.integrate",
 )
 FLAGS = doctest.ELLIPSIS | doctest.NORMALIZE_WHITESPACE
 
