@@ -1,5 +1,20 @@
 """phaseimpact: Abrate's two-degree-of-freedom impact model and the seed paper's damped variant,
-analysed as a dynamical system."""
+analysed as a dynamical system.
+
+Examples
+--------
+The seed's case (steel ball on a steel plate, SI units) and its closed-form scales; a run of it is
+``simulate(params, "paper")``:
+
+>>> from phaseimpact import LAWS, scales, seed_parameters
+>>> params = seed_parameters(v=1.0, kappa=3e9)
+>>> print(f"M1 = {params.M1:.4g} kg, K = {params.K:.4g} N/m^1.5")
+M1 = 0.2631 kg, K = 2.176e+10 N/m^1.5
+>>> print(f"contact time {scales(params).contact_time:.4g} s")
+contact time 0.000108 s
+>>> LAWS[:3]
+('abrate', 'paper', 'hunt-crossley')
+"""
 
 # First: phaseimpact._jit names its cache directory with it.
 __version__ = "0.2.0"

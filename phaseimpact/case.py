@@ -18,7 +18,7 @@ A case file has this schema (SI units; ``[projectile]`` and ``[plate]`` take the
     h = 0.005
     R1 = 0.005
     R2 = 2000.0
-    [impact]       # v (m/s); optional kappa (N s/m^2.5, default 0), target (plate|rigid|free,
+    [impact]       # v (m/s); optional kappa (the law's unit, default 0), target (plate|rigid|free,
     v = 13.0       # default plate), law (default paper), contact (printed|unilateral, default
                    # printed), restitution (1e-6 <= e <= 1, default none), law_file (a Python
                    # file defining the law with phaseimpact.define_law, relative to the case file)
@@ -110,7 +110,8 @@ SETTABLE = {
     "R1": ("m", "radius of the spherical projectile"),
     "R2": ("m", "radius of curvature of the target surface"),
     "v": ("m/s", "impact speed"),
-    "kappa": ("N s/m^2.5", "damping coefficient (read by paper and hunt-crossley)"),
+    "kappa": ("law's unit", "damping coefficient of a law damped by kappa, in the unit its entry gives "
+                            "(N s/m^2.5 for a Hunt-Crossley-type law on Hertz contact)"),
     "restitution": ("-", "coefficient of restitution (the restitution laws, hunt-crossley)"),
     "target": ("", "what is hit: plate, rigid or free"),
     "law": ("", "contact law"),
@@ -219,8 +220,8 @@ def _impact_from(table) -> dict:
     out = {**_IMPACT_DEFAULTS, **table}
     out["v"] = _number("impact.v", out["v"], "a finite number > 0 (m/s)")
     require_in("impact.v", out["v"], V_RANGE, "m/s")
-    out["kappa"] = _number("impact.kappa", out["kappa"], "a finite number >= 0 (N s/m^2.5)")
-    require("impact.kappa", out["kappa"], f"0 <= impact.kappa <= {KAPPA_MAX:g} (N s/m^2.5)",
+    out["kappa"] = _number("impact.kappa", out["kappa"], "a finite number >= 0 (the law's damping unit)")
+    require("impact.kappa", out["kappa"], f"0 <= impact.kappa <= {KAPPA_MAX:g} (the law's damping unit)",
             math.isfinite(out["kappa"]) and 0 <= out["kappa"] <= KAPPA_MAX)
     for key, choices in (("target", TARGETS), ("law", _laws()), ("contact", CONTACTS)):
         _string(f"impact.{key}", out[key], "one of " + ", ".join(choices))
@@ -292,6 +293,23 @@ class Case:
     impact : dict
         ``v`` (m/s), ``kappa`` (N s/m^2.5), ``target``, ``law``, ``contact`` and ``restitution``
         (``None`` when not given); defaults are filled in for the optional keys. Not hashable.
+
+    Examples
+    --------
+    >>> from phaseimpact.case import load_case
+    >>> case = load_case("hail-laminate")
+    >>> case.name, case.impact["v"], case.impact["law"]
+    ('hail-laminate', 90.0, 'paper')
+    >>> print(f"{case.projectile.E:.3g} Pa, {case.projectile.yield_strength:.3g} Pa, R1 = {case.geometry.R1} m")
+    9.2e+09 Pa, 5.9e+06 Pa, R1 = 0.0075 m
+
+    Built directly, with the defaults of the optional ``[impact]`` keys filled in:
+
+    >>> from phaseimpact.case import Case
+    >>> from phaseimpact.parameters import STEEL, Geometry
+    >>> Case(name="slow", projectile=STEEL, plate=STEEL, geometry=Geometry(R1=0.005), impact={"v": 0.5}).impact
+    {'v': 0.5, 'kappa': 0.0, 'target': 'plate', 'law': 'paper', 'contact': 'printed', 'restitution': None,
+     'law_file': None}
     """
 
     name: str
@@ -322,6 +340,25 @@ class Case:
             ``v``, ``kappa``, ``target``, any name :func:`~phaseimpact.parameters.parameters_with`
             accepts (``R1``, ``plate_E``, ``membrane``, ...), or a dotted material name passed as
             ``**{"plate.E": 1e9}``. They win over the case's values.
+
+        Returns
+        -------
+        Parameters
+            ``M1, M2, K, Kb, Km`` derived from the case's materials and geometry, with its ``v``
+            (m/s), ``kappa`` (N s/m^2.5) and ``target``, the effective radius ``R`` (m) and, with a
+            ``yield_strength``, the ``limiting_pressure`` (Pa).
+
+        Raises
+        ------
+        ValueError
+            For an unknown override (the message lists the allowed names) or a value out of range.
+
+        Examples
+        --------
+        >>> from phaseimpact.case import seed_case
+        >>> p = seed_case().parameters(v=13.0, kappa=1e9, **{"plate.E": 7e10})
+        >>> print(f"v = {p.v:g} m/s, kappa = {p.kappa:g} N s/m^2.5, K = {p.K:.4g} N/m^1.5")
+        v = 13 m/s, kappa = 1e+09 N s/m^2.5, K = 1.088e+10 N/m^1.5
         """
         overrides = dotted_overrides(overrides)
         v = overrides.pop("v", self.impact["v"])
@@ -329,11 +366,52 @@ class Case:
         return parameters_with(self.projectile, self.plate, self.geometry, v=v, **settings)
 
     def with_settings(self, settings) -> Case:
-        """A copy with ``--set`` settings applied; see :func:`apply_settings`."""
+        """A copy with ``--set`` settings applied; see :func:`apply_settings`.
+
+        Parameters
+        ----------
+        settings : iterable of str, str, or Mapping
+            ``["v=13", "plate.E=7e10", ...]`` or ``{"v": 13.0, ...}``: names of :data:`SETTABLE`,
+            values in its SI units.
+
+        Returns
+        -------
+        Case
+            The new, validated case; ``self`` is unchanged.
+
+        Raises
+        ------
+        ValueError
+            Naming the setting, its value and the allowed range.
+
+        Examples
+        --------
+        >>> from phaseimpact.case import seed_case
+        >>> case = seed_case().with_settings(["v=13", "R1=0.005"])
+        >>> case.impact["v"], case.geometry
+        (13.0, Geometry(a=0.1, h=0.005, R1=0.005, R2=2000.0))
+        """
         return apply_settings(self, settings)
 
     def as_dict(self) -> dict:
-        """The case as plain JSON- and TOML-able data in the file schema (``None`` values left out)."""
+        """The case as plain JSON- and TOML-able data in the file schema (``None`` values left out).
+
+        Returns
+        -------
+        dict
+            ``name``, ``description``, ``source`` (str) and the tables ``projectile``, ``plate``,
+            ``geometry``, ``impact`` (dicts, SI units); :func:`case_from_dict` reads it back.
+
+        Examples
+        --------
+        >>> from phaseimpact.case import seed_case
+        >>> d = seed_case().as_dict()
+        >>> list(d)
+        ['name', 'description', 'source', 'projectile', 'plate', 'geometry', 'impact']
+        >>> d["plate"], d["impact"]
+        ({'E': 210000000000.0, 'nu': 0.3, 'rho': 7850.0},
+         {'v': 1.0, 'kappa': 0.0, 'target': 'plate', 'law': 'paper', 'contact': 'printed'})
+        """
         def material(m: Material) -> dict:
             return {k: v for k, v in dataclasses.asdict(m).items() if v is not None}
 
@@ -348,7 +426,36 @@ class Case:
         }
 
     def to_toml(self) -> str:
-        """The case as TOML text that :func:`load_case` reads back to an equal case."""
+        """The case as TOML text that :func:`load_case` reads back to an equal case.
+
+        Returns
+        -------
+        str
+            The file schema of this module's docstring: the text keys, then the tables
+            ``[projectile]``, ``[plate]``, ``[geometry]``, ``[impact]``; one key per line, numbers
+            written in full (SI units), ``None`` values left out.
+
+        Examples
+        --------
+        >>> from phaseimpact.case import seed_case
+        >>> print(seed_case().to_toml())
+        name = "seed"
+        description = "The seed paper's case (eq. 7): 2 cm steel ball on a 10 cm steel plate, 5 mm thick, at 1 m/s"
+        source = "Seed paper eq. 7 (a = 0.1 m, ...; v = 1 m/s is docs/physics.md §1's default (the seed gives no speed)"
+        <BLANKLINE>
+        [projectile]
+        E = 210000000000.0
+        nu = 0.3
+        rho = 7850.0
+        ...
+        [impact]
+        v = 1.0
+        kappa = 0.0
+        target = "plate"
+        law = "paper"
+        contact = "printed"
+        <BLANKLINE>
+        """
         data = self.as_dict()
         lines = [f"{key} = {_toml_value(data[key])}" for key in ("name", "description", "source")]
         for table in _TABLES:
@@ -356,7 +463,28 @@ class Case:
         return "\n".join(lines) + "\n"
 
     def save(self, path) -> Path:
-        """Write :meth:`to_toml` to ``path`` (UTF-8) and return the path."""
+        """Write :meth:`to_toml` to ``path`` (UTF-8) and return the path.
+
+        Parameters
+        ----------
+        path : str or os.PathLike
+            The file to write (replaced if it exists); its folder must exist. Name it ``*.toml``
+            for :func:`load_case` to read it as a file.
+
+        Returns
+        -------
+        pathlib.Path
+            ``path``.
+
+        Examples
+        --------
+        >>> import tempfile
+        >>> from pathlib import Path
+        >>> from phaseimpact.case import load_case, seed_case
+        >>> path = seed_case().with_settings(["v=13"]).save(Path(tempfile.mkdtemp()) / "fast.toml")
+        >>> path.name, load_case(path).impact["v"]
+        ('fast.toml', 13.0)
+        """
         path = Path(path)
         path.write_text(self.to_toml(), encoding="utf-8")
         return path
@@ -381,10 +509,31 @@ def case_from_dict(data, origin: str = "<dict>") -> Case:
         File name or label, put in front of error messages. Also the default ``name``
         (its stem, for a path).
 
+    Returns
+    -------
+    Case
+        The validated case, the optional ``[impact]`` keys filled with their defaults; named
+        ``data["name"]``, else the stem of ``origin`` (``"case"`` for the default origin).
+
     Raises
     ------
     ValueError
         ``"<origin>: ..."`` naming the dotted key, its value and the allowed range.
+
+    Examples
+    --------
+    >>> from phaseimpact.case import case_from_dict, seed_case
+    >>> data = seed_case().as_dict()
+    >>> del data["name"]
+    >>> data["impact"]["v"] = 13.0
+    >>> case = case_from_dict(data, "fast.toml")
+    >>> case.name, case.impact["v"]
+    ('fast', 13.0)
+    >>> data["impact"].update(law="abrate", kappa=1e9)
+    >>> case_from_dict(data, "fast.toml")
+    Traceback (most recent call last):
+        ...
+    ValueError: fast.toml: impact.kappa = 1000000000.0 is not read by law 'abrate' (it is undamped); ...
     """
     try:
         if not isinstance(data, Mapping):
@@ -431,11 +580,35 @@ def load_case(name_or_path) -> Case:
 
     A string without a ``.toml`` suffix and without a path separator is taken as a shipped name.
 
+    Parameters
+    ----------
+    name_or_path : str or os.PathLike
+        A shipped name (:func:`list_cases`), or the path of a case file; a relative
+        ``impact.law_file`` in it is read relative to the file.
+
+    Returns
+    -------
+    Case
+        The validated case (:func:`case_from_dict`); named by its ``name`` key, else by the file's stem.
+
     Raises
     ------
     ValueError
         Unknown name (the message lists the shipped ones), missing file, TOML syntax error (with
         the file name and the parser's message), or any schema error (see :func:`case_from_dict`).
+
+    Examples
+    --------
+    >>> from phaseimpact.case import load_case, seed_case
+    >>> case = load_case("hail-laminate")
+    >>> print(f"{case.impact['v']:g} m/s, plate E = {case.plate.E:.3g} Pa, Y = {case.plate.yield_strength:.3g} Pa")
+    90 m/s, plate E = 1.67e+10 Pa, Y = 1.13e+08 Pa
+    >>> load_case("seed") == seed_case()
+    True
+    >>> load_case("nope")
+    Traceback (most recent call last):
+        ...
+    ValueError: unknown case 'nope'; shipped cases: ..., seed (or give a path to a .toml file)
     """
     text = str(name_or_path)
     is_name = isinstance(name_or_path, str) and not text.endswith(".toml") and "/" not in text and "\\" not in text
@@ -458,14 +631,45 @@ def load_case(name_or_path) -> Case:
 
 
 def list_cases() -> list[dict]:
-    """The shipped cases, ``[{"name", "description", "source"}, ...]``, the seed first."""
+    """The shipped cases, ``[{"name", "description", "source"}, ...]``, the seed first.
+
+    Returns
+    -------
+    list of dict
+        One ``{"name": ..., "description": ..., "source": ...}`` (str) per case file in
+        ``phaseimpact/cases``: ``"seed"`` first, then the others by name.
+
+    Examples
+    --------
+    >>> from phaseimpact.case import list_cases
+    >>> cases = list_cases()
+    >>> cases[0]["name"], "hail-laminate" in [c["name"] for c in cases]
+    ('seed', True)
+    >>> cases[0]["description"]
+    "The seed paper's case (eq. 7): 2 cm steel ball on a 10 cm steel plate, 5 mm thick, at 1 m/s"
+    """
     cases = [load_case(name) for name in _shipped()]
     cases.sort(key=lambda c: (c.name != "seed", c.name))
     return [{"name": c.name, "description": c.description, "source": c.source} for c in cases]
 
 
 def seed_case() -> Case:
-    """The seed's case (eq. 7, steel as docs/physics.md §2 fixes it) at 1 m/s, built without a file."""
+    """The seed's case (eq. 7, steel as docs/physics.md §2 fixes it) at 1 m/s, built without a file.
+
+    Returns
+    -------
+    Case
+        Named ``"seed"``: :data:`~phaseimpact.parameters.STEEL` on :data:`~phaseimpact.parameters.STEEL`,
+        the default :class:`~phaseimpact.parameters.Geometry` (m), ``v = 1`` m/s, law ``paper``
+        undamped; equal to ``load_case("seed")``.
+
+    Examples
+    --------
+    >>> from phaseimpact.case import seed_case
+    >>> case = seed_case()
+    >>> case.name, case.geometry, case.impact["v"]
+    ('seed', Geometry(a=0.1, h=0.005, R1=0.02, R2=2000.0), 1.0)
+    """
     return Case(
         name="seed",
         description="The seed paper's case (eq. 7): 2 cm steel ball on a 10 cm steel plate, 5 mm thick, at 1 m/s",
@@ -487,7 +691,7 @@ _SEED_SOURCE = ("Seed paper eq. 7 (a = 0.1 m, h = 0.005 m, R1 = 0.02 m, R2 = 2e3
 # ---------------------------------------------------------------------------------------------
 
 def _settable_list() -> str:
-    return ", ".join(f"{name} ({unit})" for name, (unit, _) in SETTABLE.items())
+    return ", ".join(f"{name} ({unit})" if unit else name for name, (unit, _) in SETTABLE.items())
 
 
 _ALIASES = {**{f"geometry.{n}": n for n in _GEOMETRY_KEYS}, **{f"impact.{n}": n for n in _IMPACT_SETTINGS}}
@@ -502,11 +706,33 @@ def setting_name(name: str) -> str:
 def parse_setting(text: str) -> tuple[str, float | str]:
     """Parse one ``NAME=VALUE`` (``--set``) into ``(name, value)``; the range is checked later.
 
+    Parameters
+    ----------
+    text : str
+        ``NAME=VALUE``: a name of :data:`SETTABLE` (or the schema's ``geometry.a``, ``impact.v``
+        spellings) and a number in its SI unit, or a word for ``target``, ``law``, ``contact``.
+        Blanks around the name and the value are ignored.
+
+    Returns
+    -------
+    tuple of (str, float or str)
+        The name as :data:`SETTABLE` spells it and the value (a float; a str for the text settings).
+
     Raises
     ------
     ValueError
         Without ``=``, for a name not in :data:`SETTABLE` (the message lists them), or a value that
         is not a number (the text settings ``target``, ``law``, ``contact`` take a word).
+
+    Examples
+    --------
+    >>> from phaseimpact.case import parse_setting
+    >>> parse_setting("plate.E=7e10"), parse_setting("impact.v = 13"), parse_setting("target=rigid")
+    (('plate.E', 70000000000.0), ('v', 13.0), ('target', 'rigid'))
+    >>> parse_setting("v=fast")
+    Traceback (most recent call last):
+        ...
+    ValueError: v = 'fast' is not a number; allowed: a number in m/s
     """
     if not isinstance(text, str) or "=" not in text:
         raise ValueError(f"a setting is NAME=VALUE, got {text!r}; names: {_settable_list()}")
@@ -541,10 +767,26 @@ def apply_settings(case: Case, settings) -> Case:
         strings). Names are the keys of :data:`SETTABLE` (SI units), or the schema's spellings
         (``geometry.a``, ``impact.kappa``). Later settings win.
 
+    Returns
+    -------
+    Case
+        A new case with the settings applied and validated; ``case`` is unchanged.
+
     Raises
     ------
     ValueError
         Naming the setting, its value and the allowed range.
+
+    Examples
+    --------
+    >>> from phaseimpact.case import apply_settings, seed_case
+    >>> case = apply_settings(seed_case(), {"plate.E": 7e10, "geometry.R1": 0.005, "v": 13})
+    >>> case.plate.E, case.geometry.R1, case.impact["v"]
+    (70000000000.0, 0.005, 13.0)
+    >>> apply_settings(seed_case(), ["v=2e4"])
+    Traceback (most recent call last):
+        ...
+    ValueError: v = 20000.0 is out of range; allowed: 1e-06 <= v <= 10000 (m/s)
     """
     if isinstance(settings, Mapping):
         pairs = [(setting_name(name), _setting_value(setting_name(name), raw)) for name, raw in settings.items()]
@@ -615,6 +857,18 @@ def hertz_scales(params: Parameters, plate_material: Material | None = None) -> 
         ``peak_pressure`` (Pa): ``p0 = 3 F / (2 pi a0^2)``. ``m`` is the reduced mass
         (``M1`` for a rigid target). The last two are ``None`` when ``params.R`` is ``None``;
         for ``alpha != 3/2`` they are Hertz estimates only.
+
+    Examples
+    --------
+    >>> from phaseimpact.case import hertz_scales, load_case
+    >>> from phaseimpact.parameters import seed_parameters
+    >>> s = hertz_scales(seed_parameters(v=1.0))
+    >>> print(f"{s['contact_time']:.4g} s, {s['indentation']:.4g} m, {s['peak_force']:.4g} N, "
+    ...       f"{s['peak_pressure']:.4g} Pa")
+    0.000108 s, 3.669e-05 m, 4836 N, 3.146e+09 Pa
+    >>> case = load_case("hail-laminate")
+    >>> print(f"{hertz_scales(case.parameters(), case.plate)['pressure_to_first_yield']:.3g}")
+    7.61
     """
     delta = params.hertz_indentation
     force = params.K * delta**params.alpha
@@ -651,6 +905,25 @@ def hertz_contact(force: float, params: Parameters) -> dict:
     dict
         ``contact_radius`` ``a = (3 F R / (4 E*))^(1/3)`` (m) and ``peak_pressure``
         ``p0 = 3 F / (2 pi a^2)`` (Pa); both 0 for ``F = 0``.
+
+    Raises
+    ------
+    ValueError
+        If ``params.R`` is ``None`` (no effective radius), or ``force`` is negative or not finite.
+
+    Examples
+    --------
+    >>> from phaseimpact.case import hertz_contact
+    >>> from phaseimpact.parameters import seed_parameters
+    >>> c = hertz_contact(4629.0, seed_parameters(v=1.0))
+    >>> print(f"a = {c['contact_radius']:.4g} m, p0 = {c['peak_pressure']:.4g} Pa")
+    a = 0.0008443 m, p0 = 3.101e+09 Pa
+    >>> hertz_contact(0.0, seed_parameters())
+    {'contact_radius': 0.0, 'peak_pressure': 0.0}
+    >>> hertz_contact(4629.0, seed_parameters().replace(R=None))
+    Traceback (most recent call last):
+        ...
+    ValueError: R = None: the contact radius needs the effective radius R (derive the parameters ...)
     """
     if params.R is None:
         raise ValueError("R = None: the contact radius needs the effective radius R (derive the parameters "
@@ -718,6 +991,26 @@ def validity(params: Parameters, plate_material: Material | None,
         ``"ok"``, or the reasons (joined by ``"; "``): peak pressure beyond first yield, a
         contact radius beyond ``CONTACT_RATIO_LIMIT * R``, a geometry outside the plate model.
         Without any yield strength the pressure is not checked.
+
+    Raises
+    ------
+    ValueError
+        If ``params.R`` is ``None`` (no effective radius).
+
+    Examples
+    --------
+    >>> from phaseimpact.case import validity
+    >>> from phaseimpact.parameters import Geometry, Material, seed_parameters
+    >>> params = seed_parameters(v=1.0)
+    >>> validity(params, None)  # no yield strength, no geometry: only a0 / R is checked
+    'ok'
+    >>> mild_steel = Material(E=2.1e11, nu=0.3, rho=7850.0, yield_strength=2.5e8)
+    >>> print(validity(params, mild_steel))
+    peak pressure 3.15e+09 Pa exceeds 1.6 x yield strength 2.5e+08 Pa of the target (first yield at
+    p0 ≈ 1.6 Y, Johnson 1985): elastic Hertz contact is out of its range
+    >>> print(validity(params, None, geometry=Geometry(h=0.03)))
+    plate thickness h = 0.03 m is 0.3 a (thin-plate bending, eq. 5a, needs h <= 0.2 a): the plate
+    model is out of its range
     """
     scales = hertz_scales(params)
     if scales["peak_pressure"] is None:
@@ -730,7 +1023,43 @@ def plastic_contact(force: float, params: Parameters) -> dict:
     """Contact radius and peak pressure under Thornton's elastic-perfectly plastic sphere (Thornton
     1997, eq. 4-9) for a normal force ``force`` (N) on its loading curve: Hertz
     (:func:`hertz_contact`) up to the yield force ``F_y``; beyond, the pressure is capped at the
-    limiting pressure ``p_y`` and the contact grows as ``a^2 = (2 F + F_y) / (2 pi p_y)``."""
+    limiting pressure ``p_y`` and the contact grows as ``a^2 = (2 F + F_y) / (2 pi p_y)``.
+
+    Parameters
+    ----------
+    force : float
+        Normal contact force ``F``, N (>= 0), on the loading curve.
+    params : Parameters
+        ``K`` (N/m^1.5), ``R`` (m) and ``limiting_pressure`` ``p_y`` (Pa; from a
+        ``yield_strength``, see :func:`~phaseimpact.parameters.derive_parameters`).
+
+    Returns
+    -------
+    dict
+        ``contact_radius`` (m) and ``peak_pressure`` (Pa): :func:`hertz_contact`'s while its
+        pressure is at most ``p_y``, else ``sqrt((2 F + F_y) / (2 pi p_y))`` and ``p_y``.
+
+    Raises
+    ------
+    ValueError
+        If ``params.limiting_pressure`` is ``None``; as :func:`hertz_contact` for a missing ``R``
+        or a negative ``force``.
+
+    Examples
+    --------
+    >>> from phaseimpact.case import plastic_contact
+    >>> from phaseimpact.parameters import seed_parameters
+    >>> params = seed_parameters(v=1.0, plate_yield_strength=2.5e8)  # p_y = 1.6 Y = 4e8 Pa
+    >>> for force in (1.0, 4000.0):  # N: elastic (Hertz), then capped
+    ...     c = plastic_contact(force, params)
+    ...     print(f"a = {c['contact_radius']:.4g} m, p0 = {c['peak_pressure']:.4g} Pa")
+    a = 5.066e-05 m, p0 = 1.861e+08 Pa
+    a = 0.001785 m, p0 = 4e+08 Pa
+    >>> plastic_contact(1.0, seed_parameters())
+    Traceback (most recent call last):
+        ...
+    ValueError: limiting_pressure = None: the plastic contact needs the limiting pressure p_y (...)
+    """
     p_y = params.limiting_pressure
     if p_y is None:
         raise ValueError("limiting_pressure = None: the plastic contact needs the limiting pressure p_y (a case with "
@@ -748,7 +1077,38 @@ def plastic_validity(force: float, params: Parameters, geometry: Geometry | None
     """The regime of an impact under Thornton's law (its peak force ``force``, N): elastic below the
     yield velocity ``v_y``, elastic-plastic above (the model's own range: the pressure is capped at
     ``p_y``); then, as :func:`validity`, a contact radius beyond ``CONTACT_RATIO_LIMIT * R`` and a
-    geometry outside the plate model."""
+    geometry outside the plate model.
+
+    Parameters
+    ----------
+    force : float
+        Peak contact force of the run, N (>= 0), e.g. a simulation's ``max_force``.
+    params : Parameters
+        With ``R`` (m) and ``limiting_pressure`` (Pa); ``v`` (m/s) is compared with
+        :attr:`~phaseimpact.parameters.Parameters.yield_velocity`.
+    geometry : Geometry, optional
+        Checked against the plate model as in :func:`validity`.
+
+    Returns
+    -------
+    str
+        The regime, ``"elastic (v = ... v_y, ...)"`` or ``"elastic-plastic (v = ... v_y, ...)"``,
+        followed (after ``"; "``) by any reason the model is out of its range.
+
+    Raises
+    ------
+    ValueError
+        If ``params.limiting_pressure`` or ``params.R`` is ``None`` (no yield velocity).
+
+    Examples
+    --------
+    >>> from phaseimpact.case import plastic_validity
+    >>> from phaseimpact.parameters import seed_parameters
+    >>> print(plastic_validity(4000.0, seed_parameters(v=1.0, plate_yield_strength=2.5e8)))
+    elastic-plastic (v = 174 v_y, v_y = 0.00576 m/s; pressure capped at p_y = 4e+08 Pa: Thornton's range)
+    >>> print(plastic_validity(1.0, seed_parameters(v=0.005, plate_yield_strength=2.5e8)))
+    elastic (v = 0.868 v_y, v_y = 0.00576 m/s: Thornton's law is Hertz here)
+    """
     v_y = params.yield_velocity
     if v_y is None:
         raise ValueError("limiting_pressure = None: the regime needs the limiting pressure p_y (a case with a "
@@ -775,6 +1135,40 @@ def validity_for_force(force: float, params: Parameters, plate_material: Materia
 
     The pressure is Hertz's ``p0 = 3 F / (2 pi a^2)`` with ``a = (3 F R / (4 E*))^(1/3)``
     (:func:`hertz_contact`).
+
+    Parameters
+    ----------
+    force : float
+        Peak contact force, N (>= 0).
+    params : Parameters
+        With the effective radius ``R`` (m).
+    plate_material : Material or None
+        Its ``yield_strength`` ``Y`` (Pa), if given, is checked: ``p0 <= 1.6 Y``.
+    projectile_material : Material, optional
+        The same check for the projectile.
+    geometry : Geometry, optional
+        Checked against the plate model as in :func:`validity`.
+
+    Returns
+    -------
+    str
+        ``"ok"``, or the reasons joined by ``"; "``, as :func:`validity`.
+
+    Raises
+    ------
+    ValueError
+        As :func:`hertz_contact`: ``params.R`` is ``None``, or ``force`` is negative.
+
+    Examples
+    --------
+    >>> from phaseimpact.case import validity_for_force
+    >>> from phaseimpact.parameters import Material, seed_parameters
+    >>> mild_steel = Material(E=2.1e11, nu=0.3, rho=7850.0, yield_strength=2.5e8)
+    >>> validity_for_force(1.0, seed_parameters(v=1.0), mild_steel)
+    'ok'
+    >>> print(validity_for_force(4629.0, seed_parameters(v=1.0), mild_steel))
+    peak pressure 3.1e+09 Pa exceeds 1.6 x yield strength 2.5e+08 Pa of the target ...: elastic Hertz
+    contact is out of its range
     """
     contact = hertz_contact(force, params)
     return _reasons(contact["peak_pressure"], contact["contact_radius"], params, plate_material,

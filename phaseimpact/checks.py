@@ -33,17 +33,77 @@ PLASTIC_CHECK_PRESSURE = 2e9
 
 @dataclass(frozen=True)
 class Verdict:
+    """The outcome of one check of :func:`check_law`.
+
+    Attributes
+    ----------
+    check : str
+        The check's name (``"force"``, ``"partials"``, ``"energy ledger"``, ``"momentum"``,
+        ``"scipy"``, ``"oracle"``).
+    passed : bool or None
+        Whether the law passed; None when the check was skipped (it does not apply, or what it
+        compares against is missing).
+    detail : str
+        What was measured, against what tolerance, or why the check failed or was skipped.
+
+    Examples
+    --------
+    >>> from phaseimpact.checks import Verdict
+    >>> v = Verdict("momentum", True, "relative change 2e-16 (allowed 1e-10)")
+    >>> print(v.line())
+      PASS  momentum       relative change 2e-16 (allowed 1e-10)
+    """
+
     check: str
     passed: bool | None  # None: skipped
     detail: str
 
     def line(self) -> str:
+        """The verdict as one line of a report.
+
+        Returns
+        -------
+        str
+            ``PASS``, ``FAIL`` or ``skip``, the check's name (padded to 14 characters) and the
+            detail, indented by two spaces.
+
+        Examples
+        --------
+        >>> from phaseimpact.checks import Verdict
+        >>> print(Verdict("oracle", None, "tests/oracle.py not found").line())
+          skip  oracle         tests/oracle.py not found
+        """
         mark = "PASS" if self.passed else ("skip" if self.passed is None else "FAIL")
         return f"  {mark}  {self.check:<14} {self.detail}"
 
 
 @dataclass
 class LawReport:
+    """The verdicts of :func:`check_law` on one law; ``str(report)`` is what ``phaseimpact
+    check-law`` prints.
+
+    Attributes
+    ----------
+    law : str
+        The law's label (:meth:`~phaseimpact.model.ContactLaw.label`: name and options).
+    verdicts : list of Verdict
+        One per check, in the order they ran.
+    passed : bool
+        (Property.) No verdict failed (skipped ones do not count).
+
+    Examples
+    --------
+    >>> from phaseimpact.checks import LawReport, Verdict
+    >>> report = LawReport("my-law", [Verdict("force", True, "finite in contact"),
+    ...                               Verdict("momentum", False, "relative change 1e-3")])
+    >>> report.passed
+    False
+    >>> print(report)
+    check-law my-law: FAILED
+      PASS  force          finite in contact
+      FAIL  momentum       relative change 1e-3
+    """
+
     law: str
     verdicts: list = field(default_factory=list)
 
@@ -59,7 +119,32 @@ class LawReport:
 def damping_number(params, law) -> float:
     """The law's dimensionless damping at ``params``: its damping force over its elastic force at
     the impact speed and the undamped Hertz indentation on a rigid target (``kappa v / K`` for
-    ``(K + kappa deltadot) delta^alpha``). None-damped laws: 0."""
+    ``(K + kappa deltadot) delta^alpha``). None-damped laws: 0.
+
+    Parameters
+    ----------
+    params : Parameters
+        The model's parameters: ``kappa`` (N s/m^damping_power), ``K`` (N/m^alpha), ``alpha``,
+        the impact speed ``v`` (m/s) and the projectile's mass ``M1`` (kg) are read.
+    law : ContactLaw or str
+        The law, or a registered law's name.
+
+    Returns
+    -------
+    float
+        The dimensionless damping (proportional to ``kappa``); 0.0 for a law whose damping does
+        not come from ``kappa`` (undamped, or set by a restitution).
+
+    Examples
+    --------
+    >>> from phaseimpact import seed_parameters
+    >>> from phaseimpact.checks import damping_number
+    >>> p = seed_parameters(v=1.0, kappa=1e9)
+    >>> print(f"{damping_number(p, 'hunt-crossley'):.4g} = kappa v / K = {p.kappa * p.v / p.K:.4g}")
+    0.04596 = kappa v / K = 0.04596
+    >>> damping_number(p, "abrate")
+    0.0
+    """
     from .model.laws import as_law, contact_force
     from .model.rhs import pack
 
@@ -76,7 +161,35 @@ def damping_number(params, law) -> float:
 
 def with_damping_number(params, law, a: float):
     """``params`` with ``kappa`` set so that ``law``'s :func:`damping_number` is ``a`` (unchanged
-    for a law whose damping does not come from ``kappa``)."""
+    for a law whose damping does not come from ``kappa``).
+
+    Parameters
+    ----------
+    params : Parameters
+        The model's parameters (its ``kappa`` is replaced).
+    law : ContactLaw or str
+        The law, or a registered law's name.
+    a : float
+        The dimensionless damping wanted (:func:`damping_number`), e.g. 0.05: a damping force
+        5 % of the elastic one.
+
+    Returns
+    -------
+    Parameters
+        ``params`` with the new ``kappa`` (N s/m^damping_power), or ``params`` itself for a law
+        that does not read ``kappa``.
+
+    Examples
+    --------
+    >>> from phaseimpact import seed_parameters
+    >>> from phaseimpact.checks import damping_number, with_damping_number
+    >>> p = seed_parameters(v=1.0)
+    >>> q = with_damping_number(p, "hunt-crossley", 0.05)
+    >>> print(f"kappa = {q.kappa:.4g} N s/m^2.5, a = {damping_number(q, 'hunt-crossley'):.4g}")
+    kappa = 1.088e+09 N s/m^2.5, a = 0.05
+    >>> with_damping_number(p, "abrate", 0.05) is p
+    True
+    """
     unit = damping_number(params.replace(kappa=1.0), law)
     if unit <= 0 or not math.isfinite(unit):
         return params
@@ -276,6 +389,43 @@ def check_law(law, params=None, *, oracle: bool = True) -> LawReport:
 
     ``params`` defaults to the seed plate at ``v = 1`` m/s; the damping (``kappa``) is chosen for
     the law so that its damping force is about 5 % of the elastic one.
+
+    Parameters
+    ----------
+    law : ContactLaw or str
+        The law with its options, or a registered law's name (shipped or user law).
+    params : Parameters, optional
+        The case; default: the seed at ``v = 1`` m/s (a plastic law: with a limiting pressure of
+        :data:`PLASTIC_CHECK_PRESSURE`, Pa). Its ``kappa`` is replaced (:func:`with_damping_number`
+        with 0.05).
+    oracle : bool
+        Also compare with ``tests/oracle.py`` (skipped where the checkout has none).
+
+    Returns
+    -------
+    LawReport
+        One :class:`Verdict` per check (``force``, ``partials``, ``energy ledger``,
+        ``momentum``, ``scipy`` and, with ``oracle``, ``oracle``); a check that raised is a
+        failed verdict with the exception's message. ``report.passed`` when none failed.
+
+    Raises
+    ------
+    ValueError
+        For a name that is not a registered law's (:func:`~phaseimpact.model.as_law`).
+
+    Examples
+    --------
+    >>> from phaseimpact.checks import check_law
+    >>> report = check_law("hunt-crossley", oracle=False)
+    >>> report.passed
+    True
+    >>> print(report)
+    check-law hunt-crossley: passed
+      PASS  force          finite in contact, 0 at delta <= 0
+      PASS  partials       largest relative error ... (<= 1e-5)
+      PASS  energy ledger  gap ... of the impact energy (<= 1e-8); undamped energy constant to ...
+      PASS  momentum       relative change ... (allowed 1e-10)
+      PASS  scipy          rebound speed 0.96773... m/s vs scipy 0.96773... (relative ..., allowed 1e-8); ...
     """
     from .model.laws import as_law
     from .parameters import seed_parameters

@@ -64,7 +64,9 @@ CURVE_PARAMETERS = ("v", "M1", "M2", "K", "Kb", "Km", "alpha")
 PLANES = ("delta,deltadot", "x1,x1dot", "x2,x2dot")
 #: Figure formats ``plot`` and ``portrait`` write, with the first bytes of such a file.
 FIGURE_FORMATS = {".png": (b"\x89PNG",), ".pdf": (b"%PDF",), ".svg": (b"<?xml", b"<svg")}
-KAPPA_UNIT = "N s/m^2.5"
+#: kappa's unit where a message is written before the law is known: each law's entry names its own
+#: (``LawEntry.damping_unit``, e.g. N s/m^2.5 for a Hunt-Crossley-type law on Hertz contact).
+KAPPA_UNIT = "in the law's damping unit"
 #: Version of the ``--json`` contract (``phaseimpact/schemas/cli-<version>.json``): raised when a key
 #: is removed or changes meaning; new keys do not raise it.
 JSON_SCHEMA_VERSION = 1
@@ -561,7 +563,7 @@ def cmd_warmup(args) -> int:
     return EXIT_OK
 
 
-PARAM_UNITS = {"M1": "kg", "M2": "kg", "K": "N/m^1.5", "Kb": "N/m", "Km": "N/m^3", "alpha": "", "kappa": KAPPA_UNIT,
+PARAM_UNITS = {"M1": "kg", "M2": "kg", "K": "N/m^1.5", "Kb": "N/m", "Km": "N/m^3", "alpha": "",
                "v": "m/s", "R": "m", "contact_time": "s", "plate_period": "s", "indentation": "m", "peak_force": "N",
                "contact_radius": "m", "peak_pressure": "Pa", "first_yield_pressure": "Pa",
                "pressure_to_first_yield": "", "hertz_mass": "kg", "limiting_pressure": "Pa",
@@ -574,6 +576,10 @@ def cmd_params(args) -> int:
     setup = _setup(args, law=False)
     p, case = setup.params, setup.case
     out = {k: getattr(p, k) for k in ("M1", "M2", "K", "Kb", "Km", "alpha", "kappa", "v", "target", "R")}
+    from .model import REGISTRY  # kappa's unit is the case's law's (no law: none named)
+
+    entry = REGISTRY.get(case.impact.get("law"))
+    out["kappa_unit"] = entry.damping_unit(p.alpha) if entry is not None else None
     # The Hertz scales are those of the relative motion: the reduced mass M1 M2/(M1+M2) unless the
     # target is rigid (docs/physics.md §4); say which, since a plate's figures differ from a rigid one's.
     out["hertz_mass"] = p.reduced_mass
@@ -591,9 +597,10 @@ def cmd_params(args) -> int:
     else:
         print(f"case {case.name}: {case.description}" if case.description else f"case {case.name}")
         for k, value in out.items():
-            if k in ("case", "validity", "target", "hertz_mass_is"):
+            if k in ("case", "validity", "target", "hertz_mass_is", "kappa_unit"):
                 continue
-            print(f"  {k:>23} = {_fmt(value, PARAM_UNITS.get(k, ''))}".rstrip())
+            unit = out["kappa_unit"] or KAPPA_UNIT if k == "kappa" else PARAM_UNITS.get(k, "")
+            print(f"  {k:>23} = {_fmt(value, unit)}".rstrip())
         print(f"  {'target':>23} = {p.target}")
         print(f"  Hertz scales (contact_time ... peak_pressure) use hertz_mass, the {out['hertz_mass_is']}")
         print(f"  validity: {out['validity']}")
@@ -907,7 +914,8 @@ def _grid_summary(result, out_path, setup: Setup) -> dict:
         failures[name] = failures.get(name, 0) + 1
     axes = [{"name": a.name, "num": len(a.values), "start": float(a.values[0]), "stop": float(a.values[-1]),
              "log": bool(a.log)} for a in result.grid.axes]
-    summary = {"out": out_path, **_law_fields(setup), "points": int(result.grid.size),
+    summary = {"out": out_path, **_law_fields(setup), "kappa_unit": setup.law.damping_unit(setup.params.alpha),
+               "points": int(result.grid.size),
                "computed": int(np.count_nonzero(computed)), "failed": int(np.count_nonzero(failed)),
                "failures": failures, "cut_by_horizon": int(np.count_nonzero(result.cut)),
                "outcomes": result.summary()["outcomes"], "axes": axes,
@@ -946,7 +954,7 @@ def _print_grid_summary(s: dict) -> None:
             print("  the count of stick phases never goes from 1 to 2 on this grid")
         else:
             lo, hi = s["first_split"]
-            print(f"  first split (1 -> 2 stick phases) between kappa = {lo:.6g} and {hi:.6g} {KAPPA_UNIT}")
+            print(f"  first split (1 -> 2 stick phases) between kappa = {lo:.6g} and {hi:.6g} {s['kappa_unit']}")
 
 
 def _finish_grid(args, result, setup: Setup) -> int:
@@ -1391,9 +1399,9 @@ def build_parser() -> argparse.ArgumentParser:
         kmin = _real("kappa-min", 0.0, KAPPA_MAX, low_open=True, unit=KAPPA_UNIT)
         kmax = _real("kappa-max", 0.0, KAPPA_MAX, low_open=True, unit=KAPPA_UNIT)
         p.add_argument("--kappa-min", type=kmin, default=None, required=required,
-                       help=f"lower end of kappa, {KAPPA_UNIT}, 0 < KAPPA_MIN <= {KAPPA_MAX:g}{default_text}")
+                       help=f"lower end of kappa ({KAPPA_UNIT}), 0 < KAPPA_MIN <= {KAPPA_MAX:g}{default_text}")
         p.add_argument("--kappa-max", type=kmax, default=None, required=required,
-                       help=f"upper end of kappa, {KAPPA_UNIT}, KAPPA_MIN < KAPPA_MAX <= {KAPPA_MAX:g}"
+                       help=f"upper end of kappa ({KAPPA_UNIT}), KAPPA_MIN < KAPPA_MAX <= {KAPPA_MAX:g}"
                             + default_text.replace("1e-8", "1e8"))
 
     def samples(p, default):
@@ -1447,7 +1455,7 @@ def build_parser() -> argparse.ArgumentParser:
                            help="replace --archive even if it is not an archive (default: refuse)")
 
     settable = "Settable with --set NAME=VALUE (SI units): " + "; ".join(
-        f"{name} ({unit}): {text}" for name, (unit, text) in SETTABLE.items()) + "."
+        f"{name} ({unit}): {text}" if unit else f"{name}: {text}" for name, (unit, text) in SETTABLE.items()) + "."
 
     def add(name, help_, description):
         return sub.add_parser(name, help=help_, description=description, epilog=settable)
@@ -1624,7 +1632,7 @@ def build_parser() -> argparse.ArgumentParser:
     speed(p)
     target(p)
     p.add_argument("--kappa", dest="kappas", type=_kappa_list, required=True, metavar="K1,K2,...",
-                   help=f"damping coefficients, {KAPPA_UNIT}, 1 to {MAX_PANELS} values in [0, {KAPPA_MAX:g}], "
+                   help=f"damping coefficients ({KAPPA_UNIT}), 1 to {MAX_PANELS} values in [0, {KAPPA_MAX:g}], "
                         "one panel each")
     p.add_argument("--plane", choices=PLANES, default=PLANES[0],
                    help="phase plane: relative motion, projectile or target (default: %(default)s)")

@@ -167,6 +167,16 @@ class Material:
         Yield (or, for brittle and polymeric materials, compressive) strength, Pa
         (:data:`STRENGTH_RANGE`), if known.
         It drives the validity check of elastic Hertz contact (first yield at ``p0 ≈ 1.6 Y``).
+
+    Examples
+    --------
+    >>> from phaseimpact.parameters import Material
+    >>> Material(E=7e10, nu=0.33, rho=2700, yield_strength=2.75e8)  # aluminium; stored as floats
+    Material(E=70000000000.0, nu=0.33, rho=2700.0, yield_strength=275000000.0)
+    >>> Material(E=2.1e14, nu=0.3, rho=7850.0)  # GPa taken for Pa
+    Traceback (most recent call last):
+        ...
+    ValueError: E = 210000000000000.0 is out of range; allowed: 1000 <= E <= 1e+13 (Pa)
     """
 
     E: float
@@ -198,6 +208,14 @@ class Geometry:
         Radius of the spherical projectile, m.
     R2 : float
         Radius of curvature of the target surface, m.
+
+    Examples
+    --------
+    >>> from phaseimpact.parameters import Geometry
+    >>> Geometry()  # the seed's (eq. 7)
+    Geometry(a=0.1, h=0.005, R1=0.02, R2=2000.0)
+    >>> print(f"R = {Geometry(R1=0.005).effective_radius:.6g} m")
+    R = 0.00499999 m
     """
 
     a: float = 0.1
@@ -247,6 +265,18 @@ class Parameters:
         Thornton's limiting contact pressure ``p_y``, Pa, read by the ``thornton`` law only: the
         Hertz peak pressure at first yield, ``1.60 Y`` of the weaker body with a ``yield_strength``
         (:data:`FIRST_YIELD_FACTOR`), filled by :func:`derive_parameters`; ``None`` without one.
+
+    Examples
+    --------
+    Usually derived (:func:`seed_parameters`, :func:`derive_parameters`), but the numbers can be
+    given directly:
+
+    >>> from phaseimpact.parameters import Parameters
+    >>> p = Parameters(M1=0.26, M2=0.31, K=2.2e10, Kb=1.2e7, Km=1.7e11, v=2.0)
+    >>> print(f"{p.reduced_mass:.4g} kg, {p.target_period:.4g} s, {p.hertz_indentation:.4g} m")
+    0.1414 kg, 0.00101 s, 6.35e-05 m
+    >>> p.R is None, p.yield_velocity is None
+    (True, True)
     """
 
     M1: float
@@ -275,7 +305,37 @@ class Parameters:
         _store_floats(self, ("M1", "M2", "K", "Kb", "Km", "alpha", "kappa", "v", "R", "limiting_pressure"))
 
     def replace(self, **changes) -> Parameters:
-        """A copy with ``changes`` applied (and validated); unknown names raise ``ValueError``."""
+        """A copy with ``changes`` applied (and validated); unknown names raise ``ValueError``.
+
+        Parameters
+        ----------
+        **changes
+            New values of any fields (``kappa=1e9``, ``v=13.0``, ``target="rigid"``, ``M1=0.01``,
+            ...), in the units of the attributes (SI). Derived fields are not re-derived: a new
+            ``K`` is taken as given.
+
+        Returns
+        -------
+        Parameters
+            A new, validated instance; ``self`` is unchanged.
+
+        Raises
+        ------
+        ValueError
+            For an unknown name (the message lists the fields) or a value out of range.
+
+        Examples
+        --------
+        >>> from phaseimpact.parameters import seed_parameters
+        >>> p = seed_parameters(v=1.0)
+        >>> q = p.replace(kappa=1e9, v=13.0)
+        >>> q.kappa, q.v, q.M1 == p.M1
+        (1000000000.0, 13.0, True)
+        >>> p.replace(kapa=1e9)
+        Traceback (most recent call last):
+            ...
+        ValueError: unknown parameter 'kapa'; allowed: M1, M2, K, Kb, Km, alpha, kappa, v, target, R, ...
+        """
         _reject_unknown(changes, PARAMETER_NAMES)
         return dataclasses.replace(self, **changes)
 
@@ -315,6 +375,20 @@ class Parameters:
         return ((a + 1) * self.reduced_mass * self.v**2 / (2 * self.K)) ** (1 / (a + 1))
 
     def as_dict(self) -> dict:
+        """The parameters as a plain dict (for JSON; ``None`` stays ``None``).
+
+        Returns
+        -------
+        dict
+            ``{field: value}`` in the order of the attributes (SI units).
+
+        Examples
+        --------
+        >>> from phaseimpact.parameters import seed_parameters
+        >>> d = seed_parameters(v=13.0).as_dict()
+        >>> list(d)[:5], d["v"], d["limiting_pressure"]
+        (['M1', 'M2', 'K', 'Kb', 'Km'], 13.0, None)
+        """
         return dataclasses.asdict(self)
 
 
@@ -356,7 +430,32 @@ def derive_parameters(
     membrane : {"printed", "shivakumar"}
         ``Km`` with ``(1 - nu^2)`` as eq. 5b prints it, or ``(1 - nu)`` as in Shivakumar's table.
     alpha, kappa, v, target
-        Passed through to :class:`Parameters`.
+        Passed through to :class:`Parameters`: contact exponent, damping (N s/m^(1+alpha)),
+        impact speed (m/s), ``"plate"``, ``"rigid"`` or ``"free"``.
+
+    Returns
+    -------
+    Parameters
+        ``M1`` (kg), ``M2`` (kg, a quarter of the plate), ``K`` (N/m^1.5), ``Kb`` (N/m), ``Km``
+        (N/m^3), the effective radius ``R`` (m) and, when a material gives a ``yield_strength``,
+        the ``limiting_pressure`` ``1.6 Y`` (Pa) of the weaker one.
+
+    Raises
+    ------
+    ValueError
+        For an unknown ``membrane`` formula or a value out of range.
+
+    Examples
+    --------
+    A 5 mm steel ball on an aluminium plate at 13 m/s:
+
+    >>> from phaseimpact.parameters import STEEL, Geometry, Material, derive_parameters
+    >>> aluminium = Material(E=7e10, nu=0.33, rho=2700.0, yield_strength=2.75e8)
+    >>> p = derive_parameters(STEEL, aluminium, Geometry(R1=0.005), v=13.0)
+    >>> print(f"M1 = {p.M1:.4g} kg, M2 = {p.M2:.4g} kg, K = {p.K:.4g} N/m^1.5, Kb = {p.Kb:.4g} N/m")
+    M1 = 0.00411 kg, M2 = 0.106 kg, K = 5.525e+09 N/m^1.5, Kb = 4.113e+06 N/m
+    >>> print(f"p_y = {p.limiting_pressure:.4g} Pa")
+    p_y = 4.4e+08 Pa
     """
     require_choice("membrane", membrane, MEMBRANE_FORMULAS)
     g, E, nu = geometry, plate.E, plate.nu
@@ -405,10 +504,25 @@ def parameters_with(
         ``target``, ``alpha``, or a derived value such as ``M1``, which then wins over the
         derivation).
 
+    Returns
+    -------
+    Parameters
+        Derived from the changed materials and geometry (:func:`derive_parameters`), then with the
+        :class:`Parameters` fields given in ``overrides`` replaced.
+
     Raises
     ------
     ValueError
         For an unknown name (the message lists the allowed ones) or a value out of range.
+
+    Examples
+    --------
+    >>> from phaseimpact.parameters import parameters_with
+    >>> p = parameters_with(R1=0.005, plate_E=7e10, kappa=1e9)
+    >>> print(f"M1 = {p.M1:.4g} kg, K = {p.K:.4g} N/m^1.5, kappa = {p.kappa:g} N s/m^2.5")
+    M1 = 0.00411 kg, K = 5.439e+09 N/m^1.5, kappa = 1e+09 N s/m^2.5
+    >>> parameters_with(M1=0.01).M1  # a derived value given wins
+    0.01
     """
     _reject_unknown(overrides, OVERRIDE_NAMES)
     overrides = dict(overrides)
@@ -440,15 +554,31 @@ def seed_parameters(v: float = 1.0, **overrides) -> Parameters:
     :class:`Parameters` field (``kappa=1e9``, ``target="rigid"``, ``M1=...``); see
     :func:`parameters_with`. Dotted names (``"plate.E"``) go through :func:`dotted_overrides`.
 
-    Examples
-    --------
-    >>> seed_parameters(13.0, R1=0.005, plate_E=7e10).v
-    13.0
+    Parameters
+    ----------
+    v : float
+        Impact speed, m/s (:data:`V_RANGE`).
+    **overrides
+        Any of :data:`OVERRIDE_NAMES`, in SI units, as :func:`parameters_with` takes them.
+
+    Returns
+    -------
+    Parameters
+        The seed's parameters (``M1 = 0.2631 kg``, ``K = 2.176e10 N/m^1.5``, ...), changed by the
+        overrides.
 
     Raises
     ------
     ValueError
         For an unknown name (the message lists the allowed names) or a value out of range.
+
+    Examples
+    --------
+    >>> seed_parameters(13.0, R1=0.005, plate_E=7e10).v
+    13.0
+    >>> p = seed_parameters(kappa=3e9)
+    >>> print(f"M1 = {p.M1:.4g} kg, M2 = {p.M2:.4g} kg, K = {p.K:.4g} N/m^1.5")
+    M1 = 0.2631 kg, M2 = 0.3083 kg, K = 2.176e+10 N/m^1.5
     """
     return parameters_with(STEEL, STEEL, Geometry(), v=v, **overrides)
 
@@ -458,10 +588,31 @@ def dotted_overrides(settings: Mapping) -> dict:
 
     Undotted names pass unchanged; ``seed_parameters(**dotted_overrides({"plate.E": 7e10}))``.
 
+    Parameters
+    ----------
+    settings : Mapping
+        ``{name: value}``; dotted names are ``body.field`` with ``body`` ``projectile`` or
+        ``plate`` and ``field`` one of ``E`` (Pa), ``nu``, ``rho`` (kg/m^3), ``yield_strength`` (Pa).
+
+    Returns
+    -------
+    dict
+        The same values under keyword names, in the same order.
+
     Raises
     ------
     ValueError
         For a dotted name whose body or field is unknown.
+
+    Examples
+    --------
+    >>> from phaseimpact.parameters import dotted_overrides
+    >>> dotted_overrides({"plate.E": 7e10, "v": 13.0})
+    {'plate_E': 70000000000.0, 'v': 13.0}
+    >>> dotted_overrides({"plate.G": 2.6e10})
+    Traceback (most recent call last):
+        ...
+    ValueError: unknown parameter 'plate.G'; allowed dotted names: projectile.E, projectile.nu, ...
     """
     out = {}
     for name, value in settings.items():

@@ -146,7 +146,8 @@ def test_help_lists_the_settable_names_with_units():
         assert code == 0 and "--case" in text and "--set" in text
         flat = " ".join(text.split())
         for name, (unit, _) in SETTABLE.items():
-            assert f"{name} ({unit})" in flat, (command, name)
+            assert (f"{name} ({unit})" if unit else f"{name}:") in flat, (command, name)
+        assert "()" not in flat, command  # no empty unit
 
 
 # ------------------------------------------------------------------------------------------------

@@ -7,6 +7,18 @@
                     ``paper`` located on the dense output and restarted exactly at the root
 ``rk4``             the seed's classic fixed-step RK4 on eq. 8 read literally (it chatters)
 ==================  ======================================================================
+
+Examples
+--------
+>>> from phaseimpact import seed_parameters
+>>> from phaseimpact.integrate import INTEGRATORS, simulate
+>>> INTEGRATORS
+('exact', 'rk4')
+>>> tr = simulate(seed_parameters(v=1.0, kappa=1e9), "hunt-crossley")
+>>> tr.status, tr.outcome
+('success', 'rebound')
+>>> print(f"{tr.max_force:.4g} N, e = {tr.restitution:.3f}")
+4760 N, e = 0.924
 """
 
 from .api import INTEGRATORS, RTOL_RANGE, Scales, scales, simulate, simulate_many

@@ -1,5 +1,20 @@
 """All physics, no I/O: contact laws (:mod:`.laws`), equations of motion and energy
-(:mod:`.rhs`), restitution (:mod:`.restitution`)."""
+(:mod:`.rhs`), restitution (:mod:`.restitution`).
+
+Examples
+--------
+The shipped laws, one with its options, and the coefficient array the engine reads:
+
+>>> from phaseimpact import seed_parameters
+>>> from phaseimpact.model import LAWS, ContactLaw, pack
+>>> LAWS[:3]
+('abrate', 'paper', 'hunt-crossley')
+>>> law = ContactLaw("hunt-crossley", restitution=0.8)
+>>> law.label(), law.damping_unit(1.5)
+('hunt-crossley e=0.8', 'N s/m^2.5')
+>>> pack(seed_parameters(v=1.0), law).shape
+(15,)
+"""
 
 from .. import _lazy
 from .laws import CONTACT_READINGS, LAWS, PLAIN, REGISTRY, STUCK, ContactLaw, LawEntry, as_law, law_variants

@@ -368,6 +368,29 @@ def _number_text(x: float) -> str:
     return f"{x:g}"
 
 
+def _hertz_damping_power(alpha: float) -> float:
+    """The default :attr:`LawEntry.damping_power`: ``1 + alpha``, the damping coefficient of
+    ``(K + kappa deltadot) delta^alpha`` being in N s/m^(1 + alpha).
+
+    Parameters
+    ----------
+    alpha : float
+        The contact exponent (1.5 for Hertz).
+
+    Returns
+    -------
+    float
+        The exponent ``p`` of the damping coefficient's unit N s/m^p.
+
+    Examples
+    --------
+    >>> from phaseimpact.model import REGISTRY
+    >>> REGISTRY["hunt-crossley"].damping_power(1.5)
+    2.5
+    """
+    return 1.0 + alpha
+
+
 @dataclass(frozen=True)
 class LawEntry:
     """A registered contact law: everything the package knows about it.
@@ -419,6 +442,15 @@ class LawEntry:
     plastic : bool
         The contact yields (Thornton): pressure, contact radius and validity are read from the
         elastic-plastic model (:func:`phaseimpact.case.plastic_contact`), not from Hertz.
+
+    Examples
+    --------
+    >>> from phaseimpact.model import REGISTRY
+    >>> entry = REGISTRY["kuwabara-kono"]
+    >>> entry.damping, entry.damping_name, entry.options, entry.shipped
+    ('kappa', 'gamma', ('clamp',), True)
+    >>> entry.damping_power(1.5), entry.damping_unit(1.5)
+    (1.5, 'N s/m^1.5')
     """
 
     name: str
@@ -431,7 +463,7 @@ class LawEntry:
     description: str = ""
     options: tuple = ()
     damping_name: str = "kappa"
-    damping_power: object = field(default=lambda alpha: 1.0 + alpha)
+    damping_power: object = field(default=_hertz_damping_power)
     inverse: bool = False
     runaway_factor: float = GUARD_ENERGY_FACTOR
     native: object = None
@@ -445,13 +477,47 @@ class LawEntry:
         return self.native is None
 
     def damping_unit(self, alpha: float) -> str:
-        """The damping coefficient's unit, e.g. ``N s/m^2.5`` (a user law's own, if it gave one)."""
+        """The damping coefficient's unit, e.g. ``N s/m^2.5`` (a user law's own, if it gave one).
+
+        Parameters
+        ----------
+        alpha : float
+            The contact exponent (1.5 for Hertz): the unit is N s/m^``damping_power(alpha)``.
+
+        Returns
+        -------
+        str
+            The unit as text for messages and plots (``N s/m^p``).
+
+        Examples
+        --------
+        >>> from phaseimpact.model import REGISTRY
+        >>> REGISTRY["hunt-crossley"].damping_unit(1.5), REGISTRY["kuwabara-kono"].damping_unit(1.5)
+        ('N s/m^2.5', 'N s/m^1.5')
+        """
         if self.unit is not None:
             return self.unit
         return f"N s/m^{_number_text(self.damping_power(alpha))}"
 
     def damping_udunits(self, alpha: float) -> str:
-        """The same in UDUNITS (archives), e.g. ``N s m-2.5``."""
+        """The same in UDUNITS (archives), e.g. ``N s m-2.5``.
+
+        Parameters
+        ----------
+        alpha : float
+            The contact exponent (1.5 for Hertz).
+
+        Returns
+        -------
+        str
+            The unit in UDUNITS syntax (``N s m-p``), or a user law's own unit text unchanged.
+
+        Examples
+        --------
+        >>> from phaseimpact.model import REGISTRY
+        >>> REGISTRY["hunt-crossley"].damping_udunits(1.5)
+        'N s m-2.5'
+        """
         if self.unit is not None:
             return self.unit
         return f"N s m-{_number_text(self.damping_power(alpha))}"
@@ -461,7 +527,32 @@ REGISTRY: dict[str, LawEntry] = {}
 
 
 def register(entry: LawEntry) -> LawEntry:
-    """Add ``entry`` to :data:`REGISTRY` (replacing a user law of the same name)."""
+    """Add ``entry`` to :data:`REGISTRY` (replacing a user law of the same name).
+
+    Parameters
+    ----------
+    entry : LawEntry
+        The law; its :attr:`~LawEntry.name` is the key (an entry already there under that name is
+        replaced, and :func:`as_law`'s cache of named laws is cleared).
+
+    Returns
+    -------
+    LawEntry
+        ``entry`` itself.
+
+    Examples
+    --------
+    A shipped law's form under a new name (example only: removed again at the end, so that the
+    registry stays the package's):
+
+    >>> from phaseimpact.model import REGISTRY, ContactLaw
+    >>> from phaseimpact.model.laws import HUNT_CROSSLEY, LawEntry, register
+    >>> entry = register(LawEntry("example-hc", HUNT_CROSSLEY, "kappa", False, True, True,
+    ...                           description="Hunt-Crossley under another name"))
+    >>> ContactLaw("example-hc").code == ContactLaw("hunt-crossley").code
+    True
+    >>> del REGISTRY["example-hc"]
+    """
     REGISTRY[entry.name] = entry
     if "_named_law" in globals():
         _named_law.cache_clear()
@@ -532,6 +623,25 @@ class ContactLaw:
     contact : {"printed", "unilateral"}
         Laws with the ``contact`` option (``paper``): the reading of ``|delta|^alpha``
         (docs/physics.md §3).
+
+    Raises
+    ------
+    ValueError
+        For an unknown law name or ``contact`` reading, a restitution out of range or not read by
+        the law (or missing where the law needs one), or an option the law does not allow.
+
+    Examples
+    --------
+    >>> from phaseimpact.model import ContactLaw
+    >>> law = ContactLaw("hunt-crossley", clamp=True)
+    >>> law.label(), law.is_unilateral, law.damping_source
+    ('hunt-crossley clamp', True, 'kappa')
+    >>> ContactLaw("flores", restitution=0.8).damping_source
+    'restitution'
+    >>> ContactLaw("abrate", clamp=True)
+    Traceback (most recent call last):
+        ...
+    ValueError: clamp = True is only allowed for laws 'hunt-crossley', ..., not 'abrate'
     """
 
     name: str = "paper"
@@ -608,7 +718,35 @@ class ContactLaw:
         return self.entry.conservative
 
     def coefficients(self, params: Parameters) -> tuple:
-        """The law's own packed coefficients for ``params`` (:attr:`LawEntry.coefficients`)."""
+        """The law's own packed coefficients for ``params`` (:attr:`LawEntry.coefficients`).
+
+        Parameters
+        ----------
+        params : Parameters
+            The model's parameters.
+
+        Returns
+        -------
+        tuple of float
+            At most :data:`N_LAW` numbers, packed at :data:`LAW_` (``thornton``: the limiting
+            pressure ``p_y``, Pa, and the effective radius ``R``, m); empty for a law without
+            coefficients of its own.
+
+        Raises
+        ------
+        ValueError
+            When ``params`` lack what the law needs (``thornton`` without a limiting pressure).
+
+        Examples
+        --------
+        >>> from phaseimpact import seed_parameters
+        >>> from phaseimpact.model import ContactLaw
+        >>> ContactLaw("hunt-crossley").coefficients(seed_parameters())
+        ()
+        >>> p_y, R = ContactLaw("thornton").coefficients(seed_parameters(limiting_pressure=2e9))
+        >>> print(f"{p_y:.3g} Pa, {R:.4g} m")
+        2e+09 Pa, 0.02 m
+        """
         own = self.entry.coefficients
         return () if own is None else tuple(float(x) for x in own(params))
 
@@ -625,12 +763,50 @@ class ContactLaw:
         return self.entry.damping
 
     def damping_unit(self, alpha: float) -> str:
-        """Unit of the damping coefficient set by ``kappa`` (e.g. ``N s/m^2.5``)."""
+        """Unit of the damping coefficient set by ``kappa`` (e.g. ``N s/m^2.5``).
+
+        Parameters
+        ----------
+        alpha : float
+            The contact exponent (1.5 for Hertz).
+
+        Returns
+        -------
+        str
+            The unit as text (:meth:`LawEntry.damping_unit`).
+
+        Examples
+        --------
+        >>> from phaseimpact.model import ContactLaw
+        >>> ContactLaw("paper").damping_unit(1.5), ContactLaw("kuwabara-kono").damping_unit(1.5)
+        ('N s/m^2.5', 'N s/m^1.5')
+        """
         return self.entry.damping_unit(alpha)
 
     def reads(self, name: str) -> bool:
         """Whether a parameter named ``name`` changes this law's results (``kappa`` is read only
-        by laws whose damping comes from it)."""
+        by laws whose damping comes from it).
+
+        Parameters
+        ----------
+        name : str
+            A parameter's name (``"kappa"``, ``"restitution"``, ``"v"``, ...).
+
+        Returns
+        -------
+        bool
+            False only for ``kappa`` or ``restitution`` when the law's damping does not come from
+            it; True for every other name.
+
+        Examples
+        --------
+        >>> from phaseimpact.model import ContactLaw
+        >>> ContactLaw("hunt-crossley").reads("kappa"), ContactLaw("abrate").reads("kappa")
+        (True, False)
+        >>> law = ContactLaw("flores", restitution=0.8)
+        >>> law.reads("kappa"), law.reads("restitution"), law.reads("v")
+        (False, True, True)
+        """
         if name == "kappa":
             return self.damping_source == "kappa"
         if name == "restitution":
@@ -638,7 +814,30 @@ class ContactLaw:
         return True
 
     def kappa(self, params: Parameters) -> float:
-        """Effective damping coefficient (N s/m^damping_power) of this law for ``params``."""
+        """Effective damping coefficient (N s/m^damping_power) of this law for ``params``.
+
+        Parameters
+        ----------
+        params : Parameters
+            The model's parameters: ``kappa`` is read by a law damped by it; a restitution law
+            reads ``K`` (N/m^alpha) and ``v`` (m/s) for ``kappa = chi(e) K / v``.
+
+        Returns
+        -------
+        float
+            ``params.kappa``, the restitution's damping coefficient (``hunt-crossley`` with a
+            restitution: the exact inverse), or 0.0 for an undamped law.
+
+        Examples
+        --------
+        >>> from phaseimpact import seed_parameters
+        >>> from phaseimpact.model import ContactLaw
+        >>> p = seed_parameters(v=1.0, kappa=1e9)
+        >>> ContactLaw("hunt-crossley").kappa(p), ContactLaw("abrate").kappa(p)
+        (1000000000.0, 0.0)
+        >>> print(f"{ContactLaw('hunt-crossley', restitution=0.8).kappa(p):.4g} N s/m^2.5")
+        8.119e+09 N s/m^2.5
+        """
         source = self.damping_source
         if source is None:
             return 0.0
@@ -650,7 +849,22 @@ class ContactLaw:
         return kappa_for_restitution(self.restitution, params)
 
     def label(self) -> str:
-        """Short description with options, for results and archives."""
+        """Short description with options, for results and archives.
+
+        Returns
+        -------
+        str
+            The name, then the options that differ from the defaults (``paper``: always its
+            ``contact`` reading), e.g. ``"hunt-crossley clamp e=0.8"``.
+
+        Examples
+        --------
+        >>> from phaseimpact.model import ContactLaw
+        >>> ContactLaw("paper").label()
+        'paper contact=printed'
+        >>> ContactLaw("hunt-crossley", restitution=0.8, clamp=True).label()
+        'hunt-crossley clamp e=0.8'
+        """
         parts = [self.name]
         if "contact" in self.entry.options:
             parts.append(f"contact={self.contact}")
@@ -663,12 +877,55 @@ class ContactLaw:
         return " ".join(parts)
 
     def as_dict(self) -> dict:
+        """The law and its options as a plain dict (for JSON and archives).
+
+        Returns
+        -------
+        dict
+            ``{"name", "restitution", "bilateral", "clamp", "contact"}``: the fields, None for no
+            restitution; ``ContactLaw(**law.as_dict())`` gives the law back.
+
+        Examples
+        --------
+        >>> from phaseimpact.model import ContactLaw
+        >>> ContactLaw("hunt-crossley", clamp=True).as_dict()
+        {'name': 'hunt-crossley', 'restitution': None, 'bilateral': False, 'clamp': True, 'contact': 'printed'}
+        """
         return {"name": self.name, "restitution": self.restitution, "bilateral": self.bilateral,
                 "clamp": self.clamp, "contact": self.contact}
 
 
 def as_law(law) -> ContactLaw:
-    """Accept a :class:`ContactLaw` or a law name."""
+    """Accept a :class:`ContactLaw` or a law name.
+
+    Parameters
+    ----------
+    law : ContactLaw or str
+        A law, or the name of a registered law (:data:`REGISTRY`) with its default options.
+
+    Returns
+    -------
+    ContactLaw
+        ``law`` itself, or the named law (one object per name, cached).
+
+    Raises
+    ------
+    ValueError
+        For a name that is not registered (the message lists the registered ones).
+
+    Examples
+    --------
+    >>> from phaseimpact.model import ContactLaw, as_law
+    >>> as_law("hunt-crossley")
+    ContactLaw(name='hunt-crossley', restitution=None, bilateral=False, clamp=False, contact='printed')
+    >>> law = ContactLaw("paper", contact="unilateral")
+    >>> as_law(law) is law, as_law("paper") is as_law("paper")
+    (True, True)
+    >>> as_law("hertz")
+    Traceback (most recent call last):
+        ...
+    ValueError: law = 'hertz' is out of range; allowed: one of abrate, paper, hunt-crossley, ...
+    """
     if isinstance(law, ContactLaw):
         return law
     if isinstance(law, str) and law in REGISTRY:
@@ -683,7 +940,26 @@ def _named_law(name: str) -> ContactLaw:
 
 def law_variants(names=None) -> list[ContactLaw]:
     """Every registered law (or those of ``names``) with every option it allows (for conformance
-    tests)."""
+    tests).
+
+    Parameters
+    ----------
+    names : collection of str, optional
+        The laws to take; default: every law of :data:`REGISTRY` (user laws included).
+
+    Returns
+    -------
+    list of ContactLaw
+        Per law, in the registry's order: the law with its defaults, then one variant per option
+        (``bilateral=True``, ``clamp=True``, ``contact="unilateral"``); a restitution law with
+        ``restitution=0.6``.
+
+    Examples
+    --------
+    >>> from phaseimpact.model import law_variants
+    >>> [law.label() for law in law_variants(["abrate", "hunt-crossley", "flores"])]
+    ['abrate', 'abrate bilateral', 'hunt-crossley', 'hunt-crossley clamp', 'flores e=0.6', 'flores clamp e=0.6']
+    """
     variants = []
     for entry in REGISTRY.values():
         if names is not None and entry.name not in names:

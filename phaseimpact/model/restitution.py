@@ -24,6 +24,26 @@ def hunt_crossley_restitution(a):
 
     ``e = (1 + W0(-(1+a) exp(-(1+a)))) / a``. Next to ``a = 0`` the argument of ``W0`` sits on
     its branch point and rounding costs ``eps/a^2``; there the Taylor series is used instead.
+
+    Parameters
+    ----------
+    a : float or array_like
+        The dimensionless damping ``kappa v0 / K`` (``kappa`` in N s/m^(alpha+1), ``v0`` the
+        impact speed in m/s, ``K`` in N/m^alpha), ``a >= 0``.
+
+    Returns
+    -------
+    numpy.ndarray
+        The coefficient of restitution, of the shape of ``a`` (a 0-d array for a scalar); 1 at
+        ``a = 0``, falling towards ``1/a`` for large ``a``.
+
+    Examples
+    --------
+    >>> from phaseimpact.model import hunt_crossley_restitution
+    >>> print(f"{float(hunt_crossley_restitution(0.1)):.6f}")
+    0.937476
+    >>> hunt_crossley_restitution([0.0, 0.1, 1.0]).round(4)
+    array([1.    , 0.9375, 0.5936])
     """
     from scipy.special import lambertw  # here, not at import: scipy.special costs 0.3 s of start-up
 
@@ -39,6 +59,42 @@ def kappa_for_restitution(e: float, params: Parameters) -> float:
 
     Inverts :func:`hunt_crossley_restitution` (valid for a rigid or free target), for
     ``1e-6 <= e <= 1`` (below that ``a`` exceeds 1e6 and ``e ~ 1/a`` is all that is left).
+
+    Parameters
+    ----------
+    e : float
+        The coefficient of restitution, ``1e-6 <= e <= 1``.
+    params : Parameters
+        The model's parameters: the contact stiffness ``K`` (N/m^alpha) and the impact speed
+        ``v`` (m/s) are read.
+
+    Returns
+    -------
+    float
+        ``kappa`` (N s/m^(alpha+1), N s/m^2.5 for Hertz) with ``kappa v / K`` the root of
+        ``hunt_crossley_restitution(a) = e`` (to a few ulps); 0.0 for ``e = 1``.
+
+    Raises
+    ------
+    TypeError
+        If ``e`` is not a number or ``params`` not :class:`~phaseimpact.Parameters`.
+    ValueError
+        If ``e`` is not finite or outside ``[1e-6, 1]``.
+
+    Examples
+    --------
+    >>> from phaseimpact import seed_parameters
+    >>> from phaseimpact.model import hunt_crossley_restitution, kappa_for_restitution
+    >>> p = seed_parameters(v=1.0)
+    >>> kappa = kappa_for_restitution(0.8, p)
+    >>> print(f"{kappa:.4g} N s/m^2.5, a = {kappa * p.v / p.K:.4g}")
+    8.119e+09 N s/m^2.5, a = 0.3731
+    >>> print(f"{float(hunt_crossley_restitution(kappa * p.v / p.K)):.12f}")
+    0.800000000000
+    >>> kappa_for_restitution(1.5, p)
+    Traceback (most recent call last):
+        ...
+    ValueError: restitution = 1.5 is out of range; allowed: a number with 1e-6 <= e <= 1
     """
     if not is_number(e):
         raise TypeError(f"e = {e!r} has the wrong type ({type(e).__name__}); allowed: a number with 1e-6 <= e <= 1 "
@@ -75,7 +131,32 @@ def attainable_restitution(name: str) -> tuple[float, float]:
 
 def check_attainable(law) -> None:
     """Refuse a restitution law asked for a restitution it cannot deliver (``ValueError`` with the
-    attainable range); any other law passes."""
+    attainable range); any other law passes.
+
+    Parameters
+    ----------
+    law : ContactLaw
+        The law with its options; only a restitution law (one with a damping factor ``chi``)
+        given a ``restitution`` is checked.
+
+    Raises
+    ------
+    ValueError
+        If ``law.restitution`` is below the lowest restitution the law attains
+        (:func:`attainable_restitution`; e.g. 0.663 for ``lankarani-nikravesh``); the message
+        gives the attainable range and points to ``hunt-crossley``'s exact inverse.
+
+    Examples
+    --------
+    >>> from phaseimpact.model import ContactLaw
+    >>> from phaseimpact.model.restitution import check_attainable
+    >>> check_attainable(ContactLaw("lankarani-nikravesh", restitution=0.7))  # passes: returns None
+    >>> check_attainable(ContactLaw("lankarani-nikravesh", restitution=0.2))
+    Traceback (most recent call last):
+        ...
+    ValueError: restitution = 0.2 is out of range for law 'lankarani-nikravesh': ...
+    allowed: 0.663 <= restitution <= 1 with this law, ...
+    """
     if law.restitution is None or law.entry.chi is None:
         return
     lowest, _ = attainable_restitution(law.name)

@@ -61,7 +61,42 @@ X1, X2, V1, V2, WORK = range(5)
 
 def pack(params: Parameters, law: ContactLaw) -> np.ndarray:
     """The packed coefficient array of ``params`` under ``law`` (springs only on a plate; the
-    law's own coefficients; its memory empty)."""
+    law's own coefficients; its memory empty).
+
+    Parameters
+    ----------
+    params : Parameters
+        The model's parameters (masses in kg, ``K`` in N/m^alpha, ``Kb`` in N/m, ``Km`` in N/m^3,
+        the target's kind).
+    law : ContactLaw
+        The law with its options (not a name: :func:`~phaseimpact.model.as_law` makes one).
+
+    Returns
+    -------
+    numpy.ndarray
+        Shape ``(N_COEF,)`` = (15,), float: ``M1, M2, K, Kb, Km`` (the springs 0 unless the target
+        is a plate), the law's effective damping coefficient (:meth:`ContactLaw.kappa`, N
+        s/m^damping_power), ``alpha``, the flags springs and rigid (1.0 or 0.0), the runaway
+        guard factor, then the law's own coefficients (from ``LAW_``) and its memory (from
+        ``MEMORY_``, zeros), each padded with zeros.
+
+    Raises
+    ------
+    ValueError
+        When ``params`` lack what the law needs (:meth:`ContactLaw.coefficients`).
+
+    Examples
+    --------
+    >>> from phaseimpact import seed_parameters
+    >>> from phaseimpact.model import ContactLaw, pack
+    >>> c = pack(seed_parameters(v=1.0, kappa=1e9), ContactLaw("hunt-crossley"))
+    >>> c.shape
+    (15,)
+    >>> print(f"M1 = {c[0]:.4g} kg, K = {c[2]:.4g} N/m^1.5, kappa = {c[5]:.4g} N s/m^2.5")
+    M1 = 0.2631 kg, K = 2.176e+10 N/m^1.5, kappa = 1e+09 N s/m^2.5
+    >>> pack(seed_parameters(target="rigid"), ContactLaw("abrate"))[[3, 4, 7, 8]]  # Kb, Km, springs, rigid
+    array([0., 0., 0., 1.])
+    """
     springs = params.target == "plate"
     own = law.coefficients(params)
     return np.array([params.M1, params.M2, params.K, params.Kb if springs else 0.0,
@@ -319,12 +354,63 @@ def stick_break_distance(code, c, y):
 
 
 def initial_state(v: float) -> np.ndarray:
-    """Seed eq. 6: ``x1 = x2 = 0``, ``x1dot = v``, ``x2dot = 0``, no work done."""
+    """Seed eq. 6: ``x1 = x2 = 0``, ``x1dot = v``, ``x2dot = 0``, no work done.
+
+    Parameters
+    ----------
+    v : float
+        The impact speed, m/s.
+
+    Returns
+    -------
+    numpy.ndarray
+        The state ``(x1, x2, x1dot, x2dot, W)``, shape (5,): displacements in m, velocities in
+        m/s, the contact work in J.
+
+    Examples
+    --------
+    >>> from phaseimpact.model import initial_state
+    >>> initial_state(1.0)
+    array([0., 0., 1., 0., 0.])
+    """
     return np.array([0.0, 0.0, float(v), 0.0, 0.0])
 
 
 def jacobian(y, params: Parameters, law, mode: int = 1) -> np.ndarray:
-    """Exact Jacobian of the mechanical right-hand side ``(x1, x2, x1dot, x2dot)``, shape (4, 4)."""
+    """Exact Jacobian of the mechanical right-hand side ``(x1, x2, x1dot, x2dot)``, shape (4, 4).
+
+    Parameters
+    ----------
+    y : array_like
+        The state ``(x1, x2, x1dot, x2dot, ...)`` (m, m/s); components past the fourth (the work
+        ``W``) are not read.
+    params : Parameters
+        The model's parameters.
+    law : ContactLaw or str
+        The law, or a registered law's name.
+    mode : int
+        The contact's mode: ``+1``/``-1`` slipping (every law but ``paper`` runs in ``+1``),
+        ``STUCK`` (0) for the stuck pair, ``PLAIN`` (2) for the sign read literally.
+
+    Returns
+    -------
+    numpy.ndarray
+        Shape (4, 4): ``J[i, j] = d(dy_i/dt)/dy_j`` with ``y = (x1, x2, x1dot, x2dot)`` (rows 2
+        and 3 in 1/s^2 and 1/s); the target's row is zero on a rigid target.
+
+    Examples
+    --------
+    >>> from phaseimpact import seed_parameters
+    >>> from phaseimpact.model import jacobian
+    >>> p = seed_parameters(v=1.0, kappa=1e9, target="rigid")
+    >>> J = jacobian([1e-5, 0.0, 0.5, 0.0], p, "hunt-crossley")
+    >>> J.shape
+    (4, 4)
+    >>> print(f"dx1''/dx1 = {J[2, 0]:.4g} 1/s^2, dx1''/dx1dot = {J[2, 2]:.4g} 1/s")
+    dx1''/dx1 = -4.013e+08 1/s^2, dx1''/dx1dot = -120.2 1/s
+    >>> J[3].tolist()  # a rigid target does not move
+    [0.0, 0.0, 0.0, 0.0]
+    """
     law = as_law(law)
     c = pack(params, law)
     y = np.asarray(y, dtype=float)

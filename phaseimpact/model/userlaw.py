@@ -53,7 +53,22 @@ _SAMPLES = ((1e-6, 0.5), (1e-5, -0.3), (2e-5, 1.0), (1e-7, 0.0))  # (delta, delt
 
 class UserLawError(ValueError):
     """A user law that the engine cannot run (wrong signature, NaN force, ...): the message says
-    what to fix."""
+    what to fix.
+
+    A :class:`ValueError`: code that catches bad input in general catches it too.
+
+    Examples
+    --------
+    >>> from phaseimpact import define_law
+    >>> from phaseimpact.model.userlaw import UserLawError
+    >>> try:
+    ...     define_law("example-bad", lambda delta: delta)
+    ... except UserLawError as exc:
+    ...     print(exc)
+    force <lambda>(delta) has the wrong signature; allowed: force(delta, deltadot, K, damping, alpha)
+    >>> issubclass(UserLawError, ValueError)
+    True
+    """
 
 
 @dataclass(frozen=True)
@@ -225,10 +240,47 @@ def define_law(name: str, force, *, partials=None, potential=None, unilateral: b
         Whether ``clamp=True`` is allowed (not implemented for user laws: the force function
         clamps itself).
     description : str
+        One line for ``phaseimpact laws`` and archives; default: the force function's module
+        and name.
 
     Returns
     -------
     LawEntry
+        The registered entry (:data:`~phaseimpact.model.laws.REGISTRY`), of form ``NATIVE`` with
+        the compiled function; a law defined again under the same name replaces the earlier one.
+
+    Raises
+    ------
+    UserLawError
+        For a name that is empty, has spaces or is a shipped law's; ``clamp_option=True``; a
+        ``damping``, ``damping_power`` or ``filippov`` out of range; a ``potential`` with
+        ``filippov=True``; a function with the wrong signature, or one that raises or gives a
+        non-finite or non-number value at sample points in contact; a unilateral law whose force
+        is not 0 at ``delta = 0``; functions numba cannot compile. Nothing is registered then.
+
+    Examples
+    --------
+    The Kuwabara-Kono law written by hand runs as the shipped one does (the law is removed
+    again at the end, as this is only an example):
+
+    >>> import math
+    >>> from phaseimpact import define_law, seed_parameters, simulate
+    >>> from phaseimpact.model import REGISTRY
+    >>> def force(delta, deltadot, K, gamma, alpha):
+    ...     return (K * delta + gamma * deltadot) * math.sqrt(delta)
+    >>> entry = define_law("example-kk", force, damping=("gamma", None), damping_power=1.5)
+    >>> entry.name, entry.damping_unit(1.5), entry.conservative
+    ('example-kk', 'N s/m^1.5', False)
+    >>> for name in ("example-kk", "kuwabara-kono"):
+    ...     tr = simulate(seed_parameters(v=1.0, kappa=1e5), name)
+    ...     print(f"{name}: {tr.outcome}, {tr.max_force:.4g} N, e = {tr.restitution:.3f}")
+    example-kk: rebound, 4452 N, e = 0.806
+    kuwabara-kono: rebound, 4452 N, e = 0.806
+    >>> del REGISTRY["example-kk"]
+    >>> define_law("paper", force)
+    Traceback (most recent call last):
+        ...
+    phaseimpact.model.userlaw.UserLawError: name = 'paper' is a shipped law's; allowed: a new name
     """
     if not isinstance(name, str) or not name or any(ch.isspace() for ch in name):
         raise UserLawError(f"name = {name!r} is out of range; allowed: a non-empty name without spaces")
@@ -258,7 +310,43 @@ def define_law(name: str, force, *, partials=None, potential=None, unilateral: b
 
 
 def load_law_file(path) -> list[str]:
-    """Run a Python file that defines laws (``--law-file``); return the names it registered."""
+    """Run a Python file that defines laws (``--law-file``); return the names it registered.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        A Python file that calls :func:`phaseimpact.define_law` (it runs as a module of its own).
+
+    Returns
+    -------
+    list of str
+        The names of the laws the file registered or replaced, in the registry's order.
+
+    Raises
+    ------
+    UserLawError
+        If the file does not exist, fails when run (the message names the exception), or
+        defines no law.
+
+    Examples
+    --------
+    >>> import os
+    >>> import tempfile
+    >>> from phaseimpact.model import REGISTRY
+    >>> from phaseimpact.model.userlaw import load_law_file
+    >>> path = os.path.join(tempfile.mkdtemp(), "laws.py")
+    >>> with open(path, "w") as f:
+    ...     print("import phaseimpact", file=f)
+    ...     print("def force(delta, deltadot, K, kappa, alpha): return K * delta**alpha", file=f)
+    ...     print("phaseimpact.define_law('example-file-law', force)", file=f)
+    >>> load_law_file(path)
+    ['example-file-law']
+    >>> del REGISTRY["example-file-law"]  # an example only: the registry as before
+    >>> load_law_file(os.path.join(os.path.dirname(path), "missing.py"))
+    Traceback (most recent call last):
+        ...
+    phaseimpact.model.userlaw.UserLawError: law file '.../missing.py' does not exist
+    """
     path = os.fspath(path)
     before = {n: e for n, e in REGISTRY.items()}
     if not os.path.isfile(path):
