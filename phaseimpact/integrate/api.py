@@ -468,12 +468,10 @@ def run_batch(batch: Batch, *, rtol: float, settle: bool = True, stop_on=None, n
         _signals.install()
     while True:
         if threads == 1:
-            d.run_block(*args, 0, n, *outputs)
-        else:  # blocks small enough to balance the load; the driver releases the GIL
-            size = max(1, min(256, -(-n // (8 * threads))))
+            d.run_block(*args, 0, n, 1, *outputs)
+        else:  # thread k runs k, k + threads, ...: equal loads (run_block); the driver releases the GIL
             with ThreadPoolExecutor(threads) as pool:
-                list(pool.map(lambda start, size=size: d.run_block(*args, start, min(start + size, n), *outputs),
-                              range(0, n, size)))
+                list(pool.map(lambda start: d.run_block(*args, start, n, threads, *outputs), range(threads)))
         woken = bool(np.any(summary[:, d.S_STATUS] == d.INTERRUPTED))
         if not (woken or _signals.deferred):
             break

@@ -1199,19 +1199,25 @@ def stick_points(ev, t_stop, permanent, out_t, out_delta, out_dwell):
 
 @allocating(python=True, nogil=True)
 def run_block(code, C, Y0, t_end, rtol, ATOL, max_step, settle, stop_kind, stop_count, max_steps, max_events,
-              rk4_step, stiff_after, start, stop, summary, st_t, st_delta, st_dwell, st_count):
-    """Runs ``start..stop-1`` of a batch, without the GIL (callers run blocks in threads; each run's
-    numbers depend on nothing else). Fills ``summary`` (n, N_SUMMARY) and the first ``capacity``
-    stick points of each run; ``st_count`` holds each run's full number of stick points. Threads
-    over blocks, not a compiled parallel loop: that would compile the driver a second time. On
-    Ctrl-C or SIGTERM the rest of the block is left with the status ``interrupted``."""
+              rk4_step, stiff_after, start, stop, step, summary, st_t, st_delta, st_dwell, st_count):
+    """Runs ``start, start + step, ...`` (below ``stop``) of a batch, without the GIL (callers run
+    blocks in threads; each run's numbers depend on nothing else). Fills ``summary`` (n, N_SUMMARY)
+    and the first ``capacity`` stick points of each run; ``st_count`` holds each run's full number
+    of stick points. Threads over blocks, not a compiled parallel loop: that would compile the
+    driver a second time. A thread's block is every ``step``-th run, not a contiguous range: the
+    cost of a run changes smoothly over a sweep or an atlas (up to 100x near kappa_c), so
+    interleaved blocks cost the same to within one run, where contiguous ones left a thread idle
+    while another finished an expensive stretch. On Ctrl-C or SIGTERM the rest of the block is
+    left with the status ``interrupted``."""
     empty = np.empty(0)
     c = np.empty(C.shape[1])
     y0 = np.empty(Y0.shape[1])
     atol = np.empty(ATOL.shape[1])
-    for i in range(start, stop):
-        if (i - start) % POLL_RUNS == POLL_RUNS - 1 and interrupted():
-            for j in range(i, stop):
+    done = 0
+    for i in range(start, stop, step):
+        done += 1
+        if done % POLL_RUNS == 0 and interrupted():
+            for j in range(i, stop, step):
                 summary[j, S_STATUS] = INTERRUPTED
             break
         # the run reads its own copies: a row of the shared batch arrays would share their reference
@@ -1225,7 +1231,7 @@ def run_block(code, C, Y0, t_end, rtol, ATOL, max_step, settle, stop_kind, stop_
         permanent = s[S_OUTCOME] == PERMANENT_STICK
         st_count[i] = stick_points(events, s[S_T_STOP], permanent, st_t[i], st_delta[i], st_dwell[i])
         if s[S_STATUS] == INTERRUPTED:
-            for j in range(i + 1, stop):
+            for j in range(i + step, stop, step):
                 summary[j, S_STATUS] = INTERRUPTED
             break
 
