@@ -35,6 +35,7 @@ MODULES = (
     "phaseimpact.model.laws",
     "phaseimpact.model.userlaw",
     "phaseimpact.model.restitution",
+    "phaseimpact.model.rhs",
     "phaseimpact.checks",
     "phaseimpact.integrate",
 )
