@@ -1219,11 +1219,16 @@ def plot_basins(result, *, ax=None, title: str = ""):
         ax.grid(False)
         total = result.labels.size
         legend = []
+        periods = [a.period for a in result.attractors]
+        seen = {}
         for i, a in enumerate(result.attractors):
+            # coexisting attractors of one period are told apart by a letter (period 2a, period 2b)
+            seen[a.period] = seen.get(a.period, -1) + 1
+            name = f"{a.period}{chr(ord('a') + seen[a.period])}" if periods.count(a.period) > 1 else f"{a.period}"
             style_ = {"ls": "none", "marker": ATTRACTOR_MARKERS[i % len(ATTRACTOR_MARKERS)], "mfc": colours[i + 2],
                       "mec": "k", "mew": 0.9, "ms": 7}
             ax.plot(a.plate[:, 0] * UM, a.plate[:, 1], zorder=5, **style_)
-            legend.append(Line2D([], [], label=f"period {a.period}: basin {100 * a.count / total:.0f}%", **style_))
+            legend.append(Line2D([], [], label=f"period {name}: basin {100 * a.count / total:.0f}%", **style_))
         for count, colour, text in ((result.not_converged, NOT_CONVERGED_COLOUR, "no period found"),
                                     (result.no_map, NO_MAP_COLOUR, "run failed")):
             if count:
