@@ -125,7 +125,7 @@ def test_near_kappa_c_engine_and_oracle_agree(contact):
 
 
 def test_many_runs_equal_single_runs_and_do_not_depend_on_threads():
-    kappas = KAPPA_C * (1 + np.array([-1e-3, 1e-4, 2e-4, 1e-3, 0.5]))
+    kappas = KAPPA_C * (1 + np.array([-1e-3, 1e-4, 2e-4, 5e-5, 1e-3, 0.5]))  # two runs past the buffer
     params = [SEED.replace(kappa=float(k)) for k in kappas]
     one = simulate_many(params, "paper", n_threads=1)
     two = simulate_many(params, "paper", n_threads=2)
@@ -138,6 +138,7 @@ def test_many_runs_equal_single_runs_and_do_not_depend_on_threads():
         assert (tr.t_run or math.nan) == pytest.approx(one.t_run[i], nan_ok=True)
         np.testing.assert_array_equal(tr.stick_points()[1], one.sticks_of(i)[1])
     assert one.n_stick[1] == 42 and len(one.sticks_of(1)[0]) == 42  # more than the 32-point buffer
+    assert one.n_stick[3] > 42 and len(one.stick_t) == one.n_stick.sum()
 
 
 def test_horizon_cut_is_reported():

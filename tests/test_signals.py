@@ -151,6 +151,22 @@ except KeyboardInterrupt as stop:
 """
 
 
+# simulate_many in threads over several packed chunks (api.PACK_CHUNK), run by a runner thread
+MANY_SCRIPT = """
+import sys, time
+from phaseimpact import seed_parameters, simulate_many
+from phaseimpact.integrate import api
+p = seed_parameters(v=1e4, kappa=1e18)
+simulate_many([p], "hunt-crossley", 1e-4)  # loads the compiled engine
+print("running", flush=True)
+start = time.perf_counter()
+try:
+    simulate_many([p] * (3 * api.PACK_CHUNK), "hunt-crossley", 0.05, n_threads=2)  # minutes of compiled work
+except KeyboardInterrupt as stop:
+    print(type(stop).__name__, round(time.perf_counter() - start, 3), flush=True)
+"""
+
+
 @pytest.fixture(scope="module")
 def warm():
     """Load (or compile) the engine in this process, so that the subprocesses start from the cache."""
@@ -158,8 +174,9 @@ def warm():
     simulate_many([seed_parameters(v=1.0, kappa=3e9)], "paper")
 
 
-def test_library_ctrl_c_inside_a_compiled_run_raises_keyboard_interrupt_within_a_second(warm):
-    proc = subprocess.Popen([sys.executable, "-c", LIBRARY_SCRIPT], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+@pytest.mark.parametrize("script", [LIBRARY_SCRIPT, MANY_SCRIPT], ids=["simulate", "simulate_many-threads"])
+def test_library_ctrl_c_inside_a_compiled_run_raises_keyboard_interrupt_within_a_second(warm, script):
+    proc = subprocess.Popen([sys.executable, "-c", script], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
                             text=True, cwd=ROOT)
     try:
         assert proc.stdout.readline().strip() == "running"

@@ -422,17 +422,29 @@ class Batch:
         return len(self.C)
 
 
+#: Runs packed at a time by :func:`simulate_many` (any size gives the same numbers: runs are independent).
+PACK_CHUNK = 2048
+
+
 def pack_batch(params_seq, law: ContactLaw, t_end, rtol: float, initial=None) -> Batch:
     """Pack a sequence of :class:`Parameters` (one law) for :func:`run_batch`."""
     law = as_law(law)
     if isinstance(params_seq, Parameters) or not hasattr(params_seq, "__iter__"):
         raise TypeError(f"params_seq = {params_seq!r} has the wrong type ({type(params_seq).__name__}); allowed: a "
                         "sequence of Parameters")
+    return _pack(_checked_sequence(params_seq), law, t_end, rtol, initial)
+
+
+def _checked_sequence(params_seq) -> list:
     params_seq = list(params_seq)
     if not params_seq:
         raise ValueError("params_seq = [] is out of range; allowed: a non-empty sequence of Parameters")
     for i, p in enumerate(params_seq):
         check_params(p, f"params_seq[{i}]")
+    return params_seq
+
+
+def _pack(params_seq: list, law: ContactLaw, t_end, rtol: float, initial) -> Batch:
     n = len(params_seq)
     C = np.empty((n, N_COEF))
     Y0 = np.empty((n, 5))
@@ -476,14 +488,11 @@ def run_batch(batch: Batch, *, rtol: float, settle: bool = True, stop_on=None, n
         if not (woken or _signals.deferred):
             break
         _signals.check(woken)  # raises for Ctrl-C or SIGTERM; after an old wake-up, runs again
-    parts_t, parts_delta, parts_dwell = [], [], []
-    for i in range(n):
-        k = int(count[i])
-        if k <= capacity:
-            parts_t.append(st[0, i, :k])
-            parts_delta.append(st[1, i, :k])
-            parts_dwell.append(st[2, i, :k])
-            continue
+    # the stick points of every run in run order: each run's first min(count, capacity) from the
+    # buffers (one masked gather: a Python loop over the runs was the serial part of a threaded sweep)
+    kept = np.arange(capacity) < np.minimum(count, capacity)[:, None]
+    points = [st[j][kept] for j in range(3)]
+    for i in np.flatnonzero(count > capacity)[::-1]:  # from the last, so earlier offsets stay valid
         # more stick phases than the buffer holds (near kappa_c): rerun this one for all of them
         while True:
             out = d.run(batch.law.code, batch.C[i], batch.Y0[i], batch.t_end[i], rtol, batch.atol[i],
@@ -493,17 +502,13 @@ def run_batch(batch: Batch, *, rtol: float, settle: bool = True, stop_on=None, n
             if not (woken or _signals.deferred):
                 break
             _signals.check(woken)
+        k = int(count[i])
         full = np.empty((3, k))
         s = out[0]
         d.stick_points(out[1], s[d.S_T_STOP], s[d.S_OUTCOME] == d.PERMANENT_STICK, full[0], full[1], full[2])
-        parts_t.append(full[0])
-        parts_delta.append(full[1])
-        parts_dwell.append(full[2])
-
-    def cat(parts):
-        return np.concatenate(parts) if parts else np.empty(0)
-
-    return Columns.from_summary(summary, count, cat(parts_t), cat(parts_delta), cat(parts_dwell))
+        offset = int(np.minimum(count[:i], capacity).sum())
+        points = [np.concatenate([p[:offset], full[j], p[offset + capacity:]]) for j, p in enumerate(points)]
+    return Columns.from_summary(summary, count, *points)
 
 
 def simulate_many(params_seq, law: ContactLaw | str = "paper", t_end: float | None = None, *,
@@ -569,5 +574,37 @@ def simulate_many(params_seq, law: ContactLaw | str = "paper", t_end: float | No
     _stiff_after(stiff)
     check_bool("stop_when_settled", stop_when_settled)
     _stop_on(stop_on)
-    batch = pack_batch(params_seq, law, t_end, rtol, initial)
-    return run_batch(batch, rtol=rtol, settle=stop_when_settled, stop_on=stop_on, n_threads=n_threads, stiff=stiff)
+    law = as_law(law)
+    if isinstance(params_seq, Parameters) or not hasattr(params_seq, "__iter__"):
+        raise TypeError(f"params_seq = {params_seq!r} has the wrong type ({type(params_seq).__name__}); allowed: a "
+                        "sequence of Parameters")
+    params_seq = _checked_sequence(params_seq)  # every case, before any run
+    if t_end is not None:  # long enough for the case of the longest contact
+        check_t_end(t_end, max(hertz_contact_time(p.alpha, p.hertz_indentation, p.v) for p in params_seq))
+    chunks = [params_seq[i:i + PACK_CHUNK] for i in range(0, len(params_seq), PACK_CHUNK)]
+    options = {"rtol": rtol, "settle": stop_when_settled, "stop_on": stop_on, "n_threads": n_threads, "stiff": stiff}
+    if n_threads == 1 or len(chunks) == 1:
+        return _joined([run_batch(_pack(chunk, law, t_end, rtol, initial), **options) for chunk in chunks])
+    # Packing is Python, serial and a fifth of the work: a second thread packs the next chunks while
+    # this one runs the last in the worker threads (whose compiled runs release the GIL), so the
+    # packing no longer adds to the run time. The runs stay in this thread, where signals arrive.
+    with ThreadPoolExecutor(1) as packer:
+        packed = [packer.submit(_pack, chunk, law, t_end, rtol, initial) for chunk in chunks]
+        try:
+            return _joined([run_batch(batch.result(), **options) for batch in packed])
+        except BaseException:  # Ctrl-C or SIGTERM: the chunks not yet packed are not packed
+            packer.shutdown(cancel_futures=True)
+            raise
+
+
+def _joined(parts: list[Columns]) -> Columns:
+    """The columns of consecutive chunks as one."""
+    if len(parts) == 1:
+        return parts[0]
+
+    def cat(name):
+        return np.concatenate([getattr(part, name) for part in parts])
+
+    values = {name: np.concatenate([part.values[name] for part in parts]) for name in parts[0].values}
+    return Columns(cat("status"), cat("outcome"), cat("stop_reason"), values, cat("stick_count"), cat("stick_t"),
+                   cat("stick_delta"), cat("stick_dwell"))
