@@ -81,10 +81,11 @@ def test_cold_compile_compiles_every_kernel_once_and_none_of_the_helpers(cold_se
     repeated = {name for name in compiled if compiled.count(name) > 1}
     assert not repeated, f"compiled twice (a signature in precompile.py differs from the driver's): {repeated}"
     helper_modules = {f.__module__ for f, _ in precompile.HELPER_PART}
-    here = [name for name in compiled if name.rsplit(".", 1)[0] in helper_modules]
+    helper_late = {f"{f.__module__}.{f.__name__}" for f, _ in precompile.HELPER_LATE_PART}
+    here = [name for name in compiled if name.rsplit(".", 1)[0] in helper_modules or name in helper_late]
     assert not here, f"compiled here although the helper compiles them: {here}"
-    # the entries and this process's part were compiled here (the cache was empty)
-    for function, _ in precompile.LOCAL_PART:
+    # the entries and this process's parts of both phases were compiled here (the cache was empty)
+    for function, _ in precompile.LOCAL_PART + precompile.LOCAL_LATE_PART:
         assert f"{function.__module__}.{function.__name__}" in compiled
     assert "phaseimpact.integrate.driver.run" in compiled
 
@@ -111,3 +112,25 @@ def test_processes_refuses_other_values(monkeypatch, value):
     monkeypatch.setenv(precompile.PROCESSES_VARIABLE, value)
     with pytest.raises(ValueError, match=f"{precompile.PROCESSES_VARIABLE} = '{value}' is out of range"):
         precompile.processes()
+
+
+def _fake_helper(script: str) -> subprocess.Popen:
+    return subprocess.Popen([sys.executable, "-c", script], stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True)
+
+
+def test_phase_two_starts_when_the_helper_is_ready():
+    """The helper's phase 1 line gets the answer that starts its phase 2."""
+    helper = _fake_helper(f"import sys; print({precompile._READY!r}, flush=True); "
+                          f"sys.exit(0 if sys.stdin.readline().strip() == {precompile._GO!r} else 3)")
+    assert precompile._phase_two(helper) is True
+    assert helper.wait(timeout=30) == 0
+
+
+@pytest.mark.parametrize("script", ["import sys; sys.exit(1)", "print('something else', flush=True)"],
+                         ids=["died", "garbled"])
+def test_phase_two_is_skipped_when_the_helper_fails(script):
+    """A helper that ends or answers wrongly: this process compiles the mid-level kernels itself,
+    and the helper is not left waiting for an answer."""
+    helper = _fake_helper(script + "; import sys; sys.stdin.readline()")
+    assert precompile._phase_two(helper) is False
+    helper.wait(timeout=30)  # its stdin was closed: it does not wait for ever

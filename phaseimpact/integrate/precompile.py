@@ -2,16 +2,23 @@
 
 Numba compiles one function at a time under a global lock, so the first call of
 :func:`.driver.run` or :func:`.driver.run_block` on an empty cache compiles the whole call tree in
-one thread (about 24 s on this machine kind) while the other core idles. The Radau IIA kernels
-(:mod:`.radau5`, about 7 s with the law kernels they call) do not depend on the explicit stepper,
-the flight's closed form or the event root finders (about 8 s), and the driver's loop needs both.
+one thread while the other core idles. The Radau IIA kernels (:mod:`.radau5`, with the law
+kernels they call) do not depend on the explicit stepper, the flight's closed form or the event
+root finders, and the driver's mid-level kernels (advance, locate, record, restart) need both.
 
 So when numba is about to compile one of the two entries from scratch (its ``numba:compile`` event
-fires only on a cache miss), a helper process compiles the Radau kernels (:data:`HELPER_PART`)
-while this one compiles the rest (:data:`LOCAL_PART`); both write to numba's disk cache. Once the
-helper is done, the entry's own compile here loads the Radau kernels from that cache. A cached
-kernel keeps its LLVM bitcode for inlining into its callers, so the machine code, and every
-result, is the same however the cache was filled. On a warm cache nothing here runs.
+fires only on a cache miss), the compile runs in two processes and two phases, each process
+writing to numba's disk cache and loading from it what the other wrote:
+
+1. a helper process compiles the Radau kernels (:data:`HELPER_PART`) while this one compiles the
+   rest of the leaves (:data:`LOCAL_PART`);
+2. once both are done (the helper says so on its stdout, this process answers on its stdin), the
+   mid-level kernels are split the same way (:data:`HELPER_LATE_PART`, :data:`LOCAL_LATE_PART`);
+
+then the entry's own compile here loads them all. A cached kernel keeps its LLVM bitcode for
+inlining into its callers, so the machine code, and every result, is the same however the cache
+was filled. On a warm cache nothing here runs. If the helper fails or is late, this process
+compiles what is missing itself.
 
 The argument types below are the ones the driver calls the kernels with:
 ``tests/test_precompile.py`` compiles from an empty cache and checks that no kernel is compiled
@@ -26,6 +33,7 @@ from __future__ import annotations
 
 import functools
 import os
+import select
 import subprocess
 import sys
 import tempfile
@@ -39,7 +47,8 @@ from numba.core import event
 from .._jit import PROCESSES_VARIABLE, cache_info, mark_complete, processes
 from . import dop853, driver, flight, radau5
 
-__all__ = ["HELPER_PART", "LOCAL_PART", "compile_part", "processes", "announce", "warmup", "PROCESSES_VARIABLE"]
+__all__ = ["HELPER_PART", "LOCAL_PART", "HELPER_LATE_PART", "LOCAL_LATE_PART", "compile_part", "processes", "announce",
+           "warmup", "PROCESSES_VARIABLE"]
 
 #: Set in the helper's environment: it compiles silently (its output is read only if it fails).
 _HELPER_VARIABLE = "PHASEIMPACT_COMPILE_HELPER"
@@ -53,6 +62,7 @@ _ARG_TYPES = {
     "V": types.float64[::1],
     "M": types.float64[:, ::1],
     "IV": types.int64[::1],
+    "BV": types.boolean[::1],
 }
 
 # (function, argument types): the roots of each part; numba compiles their callees with them.
@@ -95,9 +105,28 @@ LOCAL_PART = (
     (driver.transition, "I V I V I B"),
     (driver._run_rk4, "I V V F I V I F I"),  # needs no Radau: here, not after the join
 )
+# Phase 2: the mid-level kernels of the driver's loop, which call the kernels of both parts.
+HELPER_LATE_PART = (
+    (driver._locate_events, "I V I I B F F F F V V V V BV V M M V V STIFF V V V V"),
+    (driver._record, "I V I I B I I F F F BV V V V M M V V STIFF V V M I IV V"),
+)
+LOCAL_LATE_PART = (
+    (driver._advance, "I V I I F F V V V V F F F V F F F F F I V V BV M V V V V V STIFF"),
+    (driver._restart, "I V B I I I F F F V V V V V V V V M STIFF F V V F F F V V F"),
+)
+#: The helper's lines on stdout and this process's answer on its stdin.
+_READY, _GO = "phase 1 done", "go"
 
 
-_HELPER = f"import {__name__} as part; part.compile_part(part.HELPER_PART)"
+_HELPER = f"import {__name__} as part; part.helper_main()"
+
+
+def helper_main() -> None:
+    """The helper process: phase 1, then phase 2 once the first process says its phase 1 is done."""
+    compile_part(HELPER_PART)
+    print(_READY, flush=True)
+    if sys.stdin.readline().strip() == _GO:
+        compile_part(HELPER_LATE_PART)
 
 
 def compile_part(part) -> None:
@@ -121,14 +150,32 @@ def _start_helper():
            "PYTHONPATH": os.pathsep.join(filter(None, (root, os.environ.get("PYTHONPATH"))))}
     errors = tempfile.TemporaryFile("w+")  # a file, not a pipe: nothing reads it while this process compiles
     try:
-        helper = subprocess.Popen([sys.executable, "-c", _HELPER], env=env, stdin=subprocess.DEVNULL,
-                                  stdout=subprocess.DEVNULL, stderr=errors, text=True)
+        helper = subprocess.Popen([sys.executable, "-c", _HELPER], env=env, stdin=subprocess.PIPE,
+                                  stdout=subprocess.PIPE, stderr=errors, text=True)
     except OSError as exc:
         errors.close()
         warnings.warn(f"phaseimpact: the compile helper did not start ({exc}); compiling in one process",
                       RuntimeWarning, stacklevel=3)
         return None
     return helper, errors
+
+
+def _phase_two(helper: subprocess.Popen) -> bool:
+    """Wait for the helper's phase 1 and start both processes' phase 2; False if the helper failed
+    or is late (this process then compiles the mid-level kernels with the entry)."""
+    try:
+        ready, _, _ = select.select([helper.stdout], [], [], HELPER_TIMEOUT)
+        if not ready or helper.stdout.readline().strip() != _READY:
+            return False
+        helper.stdin.write(_GO + "\n")
+        return True
+    except OSError:  # the helper is gone
+        return False
+    finally:
+        try:
+            helper.stdin.close()  # without "go" the helper ends after its phase 1
+        except OSError:
+            pass
 
 
 def _join(helper: subprocess.Popen, errors) -> None:
@@ -153,11 +200,11 @@ def announce() -> str:
     """The line a first compile writes on stderr (it depends on where the cache is)."""
     info = cache_info()
     if info.path is None:
-        return (f"phaseimpact: compiling the engine for this process, about 40 s on 2 cores (nothing is "
+        return (f"phaseimpact: compiling the engine for this process, about 35 s on 2 cores (nothing is "
                 f"cached: {info.reason}; set NUMBA_CACHE_DIR to a writable directory to compile once)")
     if not info.writable:
         return f"phaseimpact: compiling part of the engine for this process (the cache {info.path} is read-only)"
-    return f"phaseimpact: compiling the engine once for this machine, about 40 s on 2 cores (cache: {info.path})"
+    return f"phaseimpact: compiling the engine once for this machine, about 35 s on 2 cores (cache: {info.path})"
 
 
 def _is_entry(dispatcher) -> bool:
@@ -183,10 +230,13 @@ class _FirstCompile(event.Listener):
         if self.done or dispatcher not in (driver.run, driver.run_block):
             return
         self.done = True
-        if processes() < 2:
-            return
+        info = cache_info()
+        if processes() < 2 or info.path is None or not info.writable:
+            return  # the helper's work reaches this process through the cache: without one, it is wasted
         helper = _start_helper()
         compile_part(LOCAL_PART)
+        if helper is not None and _phase_two(helper[0]):
+            compile_part(LOCAL_LATE_PART)
         if helper is not None:
             _join(*helper)
 
