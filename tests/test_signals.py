@@ -89,34 +89,31 @@ def test_a_batch_left_by_an_old_byte_is_run_again_and_identical(pipe):
             np.testing.assert_array_equal(getattr(again, name), getattr(reference, name))
 
 
-def test_run_block_marks_the_rest_of_its_block_interrupted(pipe):
+def _interrupted_block(pipe, start: int, step: int) -> np.ndarray:
+    """The statuses after run_block's runs start, start + step, ... of 3 * POLL_RUNS runs, with a
+    byte in the pipe from the beginning (-7: a run the block did not touch)."""
     seq = [seed_parameters(v=1.0, kappa=k) for k in np.geomspace(1e9, 1e14, 3 * d.POLL_RUNS)]
     batch = api.pack_batch(seq, as_law("paper"), None, 1e-10)
     n = len(batch)
-    summary = np.zeros((n, d.N_SUMMARY))
+    summary = np.full((n, d.N_SUMMARY), -7.0)
     st = np.empty((3, n, 32))
     count = np.empty(n, np.int64)
     os.write(pipe, b"\x02")
     d.run_block(batch.law.code, batch.C, batch.Y0, batch.t_end, 1e-10, batch.atol, batch.max_step, True, -1, 0,
-                api.MAX_STEPS, api.MAX_EVENTS, 0.0, api._stiff_after(True), 0, n, 1, summary, *st, count)
-    status = summary[:, d.S_STATUS]
+                api.MAX_STEPS, api.MAX_EVENTS, 0.0, api._stiff_after(True), start, n, step, summary, *st, count)
+    return summary[:, d.S_STATUS]
+
+
+def test_run_block_marks_the_rest_of_its_block_interrupted(pipe):
+    status = _interrupted_block(pipe, 0, 1)
     assert np.all(status[:d.POLL_RUNS - 1] == d.SUCCESS) and np.all(status[d.POLL_RUNS - 1:] == d.INTERRUPTED)
 
 
 def test_an_interleaved_block_marks_only_its_own_runs_interrupted(pipe):
     """A thread's block is every step-th run (run_batch): on Ctrl-C it marks the rest of its own
     runs, and leaves the other threads' runs alone."""
-    seq = [seed_parameters(v=1.0, kappa=k) for k in np.geomspace(1e9, 1e14, 3 * d.POLL_RUNS)]
-    batch = api.pack_batch(seq, as_law("paper"), None, 1e-10)
-    n = len(batch)
-    summary = np.full((n, d.N_SUMMARY), -7.0)  # a row no run wrote
-    st = np.empty((3, n, 32))
-    count = np.empty(n, np.int64)
-    os.write(pipe, b"\x02")
-    d.run_block(batch.law.code, batch.C, batch.Y0, batch.t_end, 1e-10, batch.atol, batch.max_step, True, -1, 0,
-                api.MAX_STEPS, api.MAX_EVENTS, 0.0, api._stiff_after(True), 1, n, 2, summary, *st, count)
-    status = summary[:, d.S_STATUS]
-    mine = np.arange(1, n, 2)
+    status = _interrupted_block(pipe, 1, 2)
+    mine = np.arange(1, len(status), 2)
     first_polled = mine[d.POLL_RUNS - 1]
     assert np.all(status[0::2] == -7.0)
     assert np.all(status[mine[mine < first_polled]] == d.SUCCESS)
