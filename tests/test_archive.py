@@ -745,8 +745,9 @@ def test_sigkill_mid_checkpoint_then_resume_equals_uninterrupted(tmp_path, small
     assert_same_result(archive.load(path), small_atlas)
 
 
-def test_to_xarray_is_the_archive_in_memory(tmp_path, small_atlas):
+def test_to_xarray_is_the_archive_in_memory(tmp_path, small_atlas, monkeypatch):
     """Same variables, dimensions, attributes and values as the archive opened from disk."""
+    monkeypatch.setenv("SOURCE_DATE_EPOCH", "1700000000")  # one time stamp, whatever second each is made in
     path = archive.save(small_atlas, tmp_path / "atlas.h5")
     memory = archive.to_xarray(small_atlas)
     with xr.open_dataset(path, engine="h5netcdf") as disk:
