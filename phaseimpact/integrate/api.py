@@ -429,13 +429,13 @@ PACK_CHUNK = 2048
 def pack_batch(params_seq, law: ContactLaw, t_end, rtol: float, initial=None) -> Batch:
     """Pack a sequence of :class:`Parameters` (one law) for :func:`run_batch`."""
     law = as_law(law)
-    if isinstance(params_seq, Parameters) or not hasattr(params_seq, "__iter__"):
-        raise TypeError(f"params_seq = {params_seq!r} has the wrong type ({type(params_seq).__name__}); allowed: a "
-                        "sequence of Parameters")
     return _pack(_checked_sequence(params_seq), law, t_end, rtol, initial)
 
 
 def _checked_sequence(params_seq) -> list:
+    if isinstance(params_seq, Parameters) or not hasattr(params_seq, "__iter__"):
+        raise TypeError(f"params_seq = {params_seq!r} has the wrong type ({type(params_seq).__name__}); allowed: a "
+                        "sequence of Parameters")
     params_seq = list(params_seq)
     if not params_seq:
         raise ValueError("params_seq = [] is out of range; allowed: a non-empty sequence of Parameters")
@@ -575,9 +575,6 @@ def simulate_many(params_seq, law: ContactLaw | str = "paper", t_end: float | No
     check_bool("stop_when_settled", stop_when_settled)
     _stop_on(stop_on)
     law = as_law(law)
-    if isinstance(params_seq, Parameters) or not hasattr(params_seq, "__iter__"):
-        raise TypeError(f"params_seq = {params_seq!r} has the wrong type ({type(params_seq).__name__}); allowed: a "
-                        "sequence of Parameters")
     params_seq = _checked_sequence(params_seq)  # every case, before any run
     if t_end is not None:  # long enough for the case of the longest contact
         check_t_end(t_end, max(hertz_contact_time(p.alpha, p.hertz_indentation, p.v) for p in params_seq))

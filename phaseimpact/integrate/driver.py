@@ -1205,7 +1205,7 @@ def run_block(code, C, Y0, t_end, rtol, ATOL, max_step, settle, stop_kind, stop_
     and the first ``capacity`` stick points of each run; ``st_count`` holds each run's full number
     of stick points. Threads over blocks, not a compiled parallel loop: that would compile the
     driver a second time. A thread's block is every ``step``-th run, not a contiguous range: the
-    cost of a run changes smoothly over a sweep or an atlas (up to 100x near kappa_c), so
+    cost of a run changes smoothly over a sweep or an atlas (many times over near kappa_c), so
     interleaved blocks cost the same to within one run, where contiguous ones left a thread idle
     while another finished an expensive stretch. On Ctrl-C or SIGTERM the rest of the block is
     left with the status ``interrupted``."""
