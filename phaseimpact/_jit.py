@@ -22,7 +22,7 @@ the result), and generating and optimising a wrapper for each of the engine's ~8
 functions took about 1.5 s of the first-ever compile (one process: 26.6 -> 25.2 s, medians of 3
 cold runs; numba's C-callable wrappers, never used here, are off for all). A function without the
 wrapper must never be called from Python: numba does not check, the call crashes. So every
-function Python code calls (the entries ``run`` and ``run_block``, what a module lists in
+function Python code calls (the entries ``run``, ``run_block`` and ``run_rk4``, what a module lists in
 ``__all__``, what the oracle and the tests call) says ``python=True``, and
 ``tests/test_integrate.py`` finds every call from Python in the package, tests, benchmarks and
 studies and checks that its target has the wrapper.

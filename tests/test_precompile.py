@@ -27,23 +27,26 @@ from phaseimpact.integrate import precompile
 # Runs one cold session: records every phaseimpact function numba compiles in this process, then
 # the numbers of three runs and a batch.
 COLD_SESSION = r"""
-import json
+import gc, json
 from numba.core import event
-compiled = []
+compiled, nested_collecting, depth = [], [], [0]
 class Recorder(event.Listener):
     def on_start(self, ev):
         f = ev.data["dispatcher"].py_func
         if f.__module__.startswith("phaseimpact"):
             compiled.append(f.__module__ + "." + f.__name__)
+        if depth[0]:  # compiled inside another function's compile
+            nested_collecting.append(gc.isenabled())
+        depth[0] += 1
     def on_end(self, ev):
-        pass
+        depth[0] -= 1
 event.register("numba:compile", Recorder())
 from phaseimpact import seed_parameters, simulate, simulate_many
 p = seed_parameters(v=1.0, kappa=3e9)
 runs = [simulate(p, "hunt-crossley", 2e-3), simulate(p.replace(kappa=2e12), "paper", None, stop_on="slip"),
         simulate(p.replace(kappa=1e14, v=5.0), "paper", 2e-3)]
 cols = simulate_many([p, p.replace(kappa=1e12), p.replace(kappa=1e14, v=5.0)], "paper", n_threads=2)
-print(json.dumps({"compiled": compiled,
+print(json.dumps({"compiled": compiled, "nested_collecting": nested_collecting, "collecting_after": gc.isenabled(),
                   "runs": [[float(x) for x in r.summary] + [float(x) for x in r.final_state] for r in runs],
                   "max_force": [float(x) for x in cols.max_force], "t_run": [float(x) for x in cols.t_run]}))
 """
@@ -80,14 +83,22 @@ def test_cold_compile_compiles_every_kernel_once_and_none_of_the_helpers(cold_se
     compiled = cold_session["compiled"]
     repeated = {name for name in compiled if compiled.count(name) > 1}
     assert not repeated, f"compiled twice (a signature in precompile.py differs from the driver's): {repeated}"
-    helper_modules = {f.__module__ for f, _ in precompile.HELPER_PART}
-    helper_late = {f"{f.__module__}.{f.__name__}" for f, _ in precompile.HELPER_LATE_PART}
-    here = [name for name in compiled if name.rsplit(".", 1)[0] in helper_modules or name in helper_late]
+    # the helper's roots, and every Radau kernel (their callees)
+    helper_roots = {f"{f.__module__}.{f.__name__}" for f, _ in precompile.HELPER_PART + precompile.HELPER_LATE_PART}
+    here = [name for name in compiled if name in helper_roots or name.rsplit(".", 1)[0] == precompile.radau5.__name__]
     assert not here, f"compiled here although the helper compiles them: {here}"
     # the entries and this process's parts of both phases were compiled here (the cache was empty)
     for function, _ in precompile.LOCAL_PART + precompile.LOCAL_LATE_PART:
         assert f"{function.__module__}.{function.__name__}" in compiled
     assert "phaseimpact.integrate.driver.run" in compiled
+
+
+def test_cold_compile_pauses_the_garbage_collector_and_gives_it_back(cold_session):
+    """Off while an entry's call tree compiles (every function compiled inside another's compile),
+    on again afterwards."""
+    assert len(cold_session["nested_collecting"]) > 50
+    assert not any(cold_session["nested_collecting"])
+    assert cold_session["collecting_after"] is True
 
 
 def test_cold_compiled_engine_gives_the_same_numbers(cold_session):

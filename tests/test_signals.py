@@ -36,7 +36,7 @@ def _run_args(params, law, t_end):
     law = as_law(law)
     s = api.scales(params)
     return (law.code, pack(params, law), api._initial(params, None), t_end, 1e-10, api._atol(params, 1e-10, None),
-            s.max_step, True, -1, 0, d.SAVE_SUMMARY, np.empty(0), api.MAX_STEPS, api.MAX_EVENTS, 0.0, 1,
+            s.max_step, True, -1, 0, d.SAVE_SUMMARY, np.empty(0), api.MAX_STEPS, api.MAX_EVENTS,
             api._stiff_after(True))
 
 
@@ -58,9 +58,9 @@ def test_a_byte_in_the_pipe_stops_a_compiled_run_at_its_next_look(pipe):
     assert d.STATUSES[int(stopped[d.S_STATUS])] == "interrupted" and d.OUTCOMES[int(stopped[d.S_OUTCOME])] == "failed"
     assert stopped[d.S_NSTEPS] == d.POLL_STEPS  # the first look
     # the RK4 loop looks too
-    rk4 = list(_run_args(seed_parameters(v=1.0, kappa=3e9), "hunt-crossley", 2e-3))
-    rk4[14] = 1e-8  # rk4_step: 2e5 steps
-    stopped = d.run(*rk4)[0]
+    code, c, y0, t_end, *_ = _run_args(seed_parameters(v=1.0, kappa=3e9), "hunt-crossley", 2e-3)
+    os.write(pipe, b"\x02")
+    stopped = d.run_rk4(code, c, y0, t_end, d.SAVE_SUMMARY, np.empty(0), api.MAX_STEPS, 1e-8, 1)[0]  # 2e5 steps
     assert d.STATUSES[int(stopped[d.S_STATUS])] == "interrupted" and stopped[d.S_NSTEPS] == d.POLL_STEPS
 
 
@@ -100,7 +100,7 @@ def _interrupted_block(pipe, start: int, step: int) -> np.ndarray:
     count = np.empty(n, np.int64)
     os.write(pipe, b"\x02")
     d.run_block(batch.law.code, batch.C, batch.Y0, batch.t_end, 1e-10, batch.atol, batch.max_step, True, -1, 0,
-                api.MAX_STEPS, api.MAX_EVENTS, 0.0, api._stiff_after(True), start, n, step, summary, *st, count)
+                api.MAX_STEPS, api.MAX_EVENTS, api._stiff_after(True), start, n, step, summary, *st, count)
     return summary[:, d.S_STATUS]
 
 
@@ -171,10 +171,16 @@ def warm():
     simulate_many([seed_parameters(v=1.0, kappa=3e9)], "paper")
 
 
+def _ctrl_c_as_in_a_terminal():
+    """For the children: Ctrl-C not ignored, as in a terminal's foreground job (a test run started
+    as a background job, ``make test &``, ignores it, and the children would inherit that)."""
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+
 @pytest.mark.parametrize("script", [LIBRARY_SCRIPT, MANY_SCRIPT], ids=["simulate", "simulate_many-threads"])
 def test_library_ctrl_c_inside_a_compiled_run_raises_keyboard_interrupt_within_a_second(warm, script):
     proc = subprocess.Popen([sys.executable, "-c", script], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                            text=True, cwd=ROOT)
+                            text=True, cwd=ROOT, preexec_fn=_ctrl_c_as_in_a_terminal)
     try:
         assert proc.stdout.readline().strip() == "running"
         time.sleep(2.0)  # well inside the run (the arguments are checked in microseconds)
@@ -197,7 +203,8 @@ class Command:
         master, slave = pty.openpty()
         self.lines: list[tuple[float, str]] = []
         self.proc = subprocess.Popen([sys.executable, "-m", "phaseimpact.cli", *map(str, argv)], cwd=cwd,
-                                     stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=slave)
+                                     stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=slave,
+                                     preexec_fn=_ctrl_c_as_in_a_terminal)
         os.close(slave)
         self._reader = threading.Thread(target=self._read, args=(master,), daemon=True)
         self._reader.start()

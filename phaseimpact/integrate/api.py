@@ -382,9 +382,12 @@ def simulate(params: Parameters, law: ContactLaw | str = "paper", t_end: float |
     if not _signals.installed:
         _signals.install()
     while True:
-        out = d.run(law.code, c, y0, horizon, rtol, default_atol if atol is None else _atol(params, rtol, atol),
-                    s.max_step, settle, stop_kind, stop_count, save_kind, times, int(max_steps), MAX_EVENTS,
-                    rk4_step, int(every), stiff_after)
+        if rk4_step:
+            out = d.run_rk4(law.code, c, y0, horizon, save_kind, times, int(max_steps), rk4_step, int(every))
+        else:
+            out = d.run(law.code, c, y0, horizon, rtol, default_atol if atol is None else _atol(params, rtol, atol),
+                        s.max_step, settle, stop_kind, stop_count, save_kind, times, int(max_steps), MAX_EVENTS,
+                        stiff_after)
         woken = out[0][d.S_STATUS] == d.INTERRUPTED
         if not (woken or _signals.deferred):
             break
@@ -473,7 +476,7 @@ def run_batch(batch: Batch, *, rtol: float, settle: bool = True, stop_on=None, n
     st = np.empty((3, n, capacity))
     count = np.empty(n, np.int64)
     args = (batch.law.code, batch.C, batch.Y0, batch.t_end, rtol, batch.atol, batch.max_step, settle, stop_kind,
-            stop_count, MAX_STEPS, MAX_EVENTS, 0.0, stiff_after)
+            stop_count, MAX_STEPS, MAX_EVENTS, stiff_after)
     outputs = (summary, st[0], st[1], st[2], count)
     threads = max(1, min(int(n_threads), n))
     if not _signals.installed:
@@ -497,7 +500,7 @@ def run_batch(batch: Batch, *, rtol: float, settle: bool = True, stop_on=None, n
         while True:
             out = d.run(batch.law.code, batch.C[i], batch.Y0[i], batch.t_end[i], rtol, batch.atol[i],
                         batch.max_step[i], settle, stop_kind, stop_count, d.SAVE_SUMMARY, _NO_TIMES, MAX_STEPS,
-                        MAX_EVENTS, 0.0, 1, stiff_after)
+                        MAX_EVENTS, stiff_after)
             woken = out[0][d.S_STATUS] == d.INTERRUPTED
             if not (woken or _signals.deferred):
                 break

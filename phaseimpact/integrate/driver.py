@@ -2,9 +2,9 @@
 
 Between events the right-hand side of the current mode is smooth and a stepper advances it:
 adaptive DOP853 (:mod:`.dop853`), Radau IIA for the rest of a phase whose DOP853 steps stay at
-their stability limit (:mod:`.radau5`), or the seed's fixed-step RK4 (``rk4_step > 0``; eq. 8
-read literally, no events resolved, so its chattering across ``deltadot = 0`` stays visible:
-:func:`_run_rk4`, a run of its own).
+their stability limit (:mod:`.radau5`); or, in an entry of its own (:func:`run_rk4`), the seed's
+fixed-step RK4 (eq. 8 read literally, no events resolved, so its chattering across ``deltadot = 0``
+stays visible).
 After each step the event table (:mod:`.events`) is checked for crossings (:func:`_advance`
 steps while none fires); each crossing is located by Brent's method on the step's dense output
 (Radau's roots then polished on steps: :func:`_locate_events`); recorded events are logged
@@ -813,11 +813,13 @@ def _open_logs(y, mode, force, save_kind, times):
     return ev, n_ev, smp, n_s, counts, i_time
 
 
-@allocating
-def _run_rk4(code, c, y0, t_end, save_kind, times, max_steps, rk4_step, rk4_every):
-    """The seed's classic RK4 (:func:`run` with ``rk4_step > 0``): eq. 8's plain right-hand side,
-    fixed steps, nothing resolved (a contact or separation is logged where ``delta`` changed sign,
-    its time interpolated linearly). Returns what :func:`run` does."""
+@allocating(python=True, nogil=True)
+def run_rk4(code, c, y0, t_end, save_kind, times, max_steps, rk4_step, rk4_every):
+    """The seed's classic RK4: eq. 8's plain right-hand side, fixed steps ``rk4_step``, nothing
+    resolved (a contact or separation is logged where ``delta`` changed sign, its time interpolated
+    linearly); with ``save_kind`` steps, every ``rk4_every``-th step is kept. Returns what
+    :func:`run` does. An entry of its own, not a branch of :func:`run`: the first compile of a run
+    that does not ask for it leaves it out."""
     y = y0.copy()
     t = 0.0
     mode = np.int64(PLAIN)
@@ -890,18 +892,16 @@ def _run_rk4(code, c, y0, t_end, save_kind, times, max_steps, rk4_step, rk4_ever
 
 @allocating(python=True, nogil=True)  # runs side by side in threads (phaseimpact.train's orbit diagrams)
 def run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count, save_kind, times,
-        max_steps, max_events, rk4_step, rk4_every, stiff_after):
+        max_steps, max_events, stiff_after):
     """Integrate one trajectory. See :func:`phaseimpact.integrate.simulate` for the meaning.
 
     Returns ``(summary, events, samples, y_final)``: the event log (columns ``EV_*``) and the
-    samples (columns ``SMP_*``) trimmed to their lengths. ``rk4_step > 0``: :func:`_run_rk4`.
-    Otherwise adaptive DOP853 (Radau IIA where a phase turns stiff) with events: steps while
-    nothing happens (:func:`_advance`), then on the step where something did, the events located
-    (:func:`_locate_events`), the recorded ones logged (:func:`_record`) and the run restarted at
-    the first that changes the phase (:func:`_restart`).
+    samples (columns ``SMP_*``) trimmed to their lengths. Adaptive DOP853 (Radau IIA where a
+    phase turns stiff) with events: steps while nothing happens (:func:`_advance`), then on the
+    step where something did, the events located (:func:`_locate_events`), the recorded ones
+    logged (:func:`_record`) and the run restarted at the first that changes the phase
+    (:func:`_restart`). The seed's RK4 is :func:`run_rk4`.
     """
-    if rk4_step > 0:
-        return _run_rk4(code, c, y0, t_end, save_kind, times, max_steps, rk4_step, rk4_every)
     c = c.copy()  # the run's own: a law's memory is written into it (model.laws.remember)
     y = y0.copy()
     t = 0.0
@@ -1199,7 +1199,7 @@ def stick_points(ev, t_stop, permanent, out_t, out_delta, out_dwell):
 
 @allocating(python=True, nogil=True)
 def run_block(code, C, Y0, t_end, rtol, ATOL, max_step, settle, stop_kind, stop_count, max_steps, max_events,
-              rk4_step, stiff_after, start, stop, step, summary, st_t, st_delta, st_dwell, st_count):
+              stiff_after, start, stop, step, summary, st_t, st_delta, st_dwell, st_count):
     """Runs ``start, start + step, ...`` (below ``stop``) of a batch, without the GIL (callers run
     blocks in threads; each run's numbers depend on nothing else). Fills ``summary`` (n, N_SUMMARY)
     and the first ``capacity`` stick points of each run; ``st_count`` holds each run's full number
@@ -1226,7 +1226,7 @@ def run_block(code, C, Y0, t_end, rtol, ATOL, max_step, settle, stop_kind, stop_
         _copy(Y0[i], y0)
         _copy(ATOL[i], atol)
         s, events, _, _ = run(code, c, y0, t_end[i], rtol, atol, max_step[i], settle, stop_kind, stop_count,
-                              np.int64(SAVE_SUMMARY), empty, max_steps, max_events, rk4_step, np.int64(1), stiff_after)
+                              np.int64(SAVE_SUMMARY), empty, max_steps, max_events, stiff_after)
         _copy(s, summary[i])
         permanent = s[S_OUTCOME] == PERMANENT_STICK
         st_count[i] = stick_points(events, s[S_T_STOP], permanent, st_t[i], st_delta[i], st_dwell[i])
