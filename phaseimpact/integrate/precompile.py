@@ -237,9 +237,9 @@ class _FirstCompile(event.Listener):
                 gc.disable()
                 self.paused_gc = True
             self.entries_compiling += 1
-        if not self.announced and _is_entry(dispatcher):
-            self.announced = True
-            print(announce(), file=sys.stderr, flush=True)
+            if not self.announced:
+                self.announced = True
+                print(announce(), file=sys.stderr, flush=True)
         if self.done or dispatcher not in (driver.run, driver.run_block):
             return
         self.done = True
