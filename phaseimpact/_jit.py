@@ -81,6 +81,10 @@ COMPLETE = "complete"
 
 #: Environment variable: the number of processes of a first-ever compile (1 or 2).
 PROCESSES_VARIABLE = "PHASEIMPACT_COMPILE_PROCESSES"
+#: True in the console script's process (``phaseimpact ...``), which runs one command and ends: what
+#: a first compile leaves for the garbage collector is frozen there, not collected
+#: (:class:`phaseimpact.integrate.precompile._FirstCompile`).
+ONE_COMMAND = False
 
 
 def processes() -> int:

@@ -11,6 +11,7 @@ anyway; ``pytest --cache-clear`` forgets it).
 
 from __future__ import annotations
 
+import gc
 import hashlib
 import json
 import os
@@ -145,3 +146,31 @@ def test_phase_two_is_skipped_when_the_helper_fails(script):
     helper = _fake_helper(script + "; import sys; sys.stdin.readline()")
     assert precompile._phase_two(helper) is False
     helper.wait(timeout=30)  # its stdin was closed: it does not wait for ever
+
+
+def test_one_command_process_freezes_what_the_compile_left(monkeypatch):
+    """The console script's process (``_jit.ONE_COMMAND``) ends after its command: the objects an
+    entry's compile left are frozen out of the collector's reach instead of collected; a library
+    process (the default) leaves them to the collector."""
+    from types import SimpleNamespace
+
+    from phaseimpact.integrate import driver
+
+    entry = SimpleNamespace(data={"dispatcher": driver.run_rk4})
+    assert precompile._is_entry(driver.run_rk4)
+    for one_command in (False, True):
+        monkeypatch.setattr(_jit, "ONE_COMMAND", one_command)
+        listener = precompile._FirstCompile()
+        listener.done = True  # no helper process: only the collector's pause is under test
+        listener.announced = True
+        before = gc.get_freeze_count()
+        try:
+            listener.on_start(entry)
+            assert not gc.isenabled()
+            made = [[object()] for _ in range(1000)]  # tracked objects made while the entry compiled
+            listener.on_end(entry)
+            assert gc.isenabled()
+            assert (gc.get_freeze_count() >= before + len(made)) is one_command
+        finally:
+            gc.unfreeze()
+            gc.enable()

@@ -45,6 +45,7 @@ from pathlib import Path
 from numba import typeof, types
 from numba.core import event
 
+from .. import _jit
 from .._jit import PROCESSES_VARIABLE, cache_info, mark_complete, processes
 from . import dop853, driver, flight, radau5
 
@@ -78,10 +79,11 @@ HELPER_PART = (
     (radau5.failed, "STIFF"),
     (radau5.reset, "STIFF"),
     (radau5.workspace, "I"),
-    # the Radau kernels alone left this process idle: the logs' kernels too
+    # the Radau kernels alone left this process idle: the logs' kernels and the transitions too
     (driver._summarize, "I V V V I I I F F F IV I M I I"),
     (driver._push_event, "M I F I I V F"),
     (driver._open_logs, "V I F I V"),
+    (driver.transition, "I V I V I B"),
 )
 LOCAL_PART = (
     (dop853.step, "I V I I V V F M V V"),
@@ -102,16 +104,15 @@ LOCAL_PART = (
     (driver.initial_mode, "I V V"),
     (driver.energy_limit_of, "I V V"),
     (driver.restarts, "I I I B"),
-    (driver.transition, "I V I V I B"),
 )
 # Phase 2: the mid-level kernels of the driver's loop, which call the kernels of both parts.
 HELPER_LATE_PART = (
     (driver._locate_events, "I V I I B F F F F V V V V BV V M M V V STIFF V V V V"),
-    (driver._record, "I V I I B I I F F F BV V V V M M V V STIFF V V M I IV V"),
+    (driver._restart, "I V B I I I F F F V V V V V V V V M STIFF F V V F F F V V F"),
 )
 LOCAL_LATE_PART = (
     (driver._advance, "I V I I F F V V V V F F F V F F F F F I V V BV M V V V V V STIFF"),
-    (driver._restart, "I V B I I I F F F V V V V V V V V M STIFF F V V F F F V V F"),
+    (driver._record, "I V I I B I I F F F BV V V V M M V V STIFF V V M I IV V"),
 )
 #: The helper's lines on stdout and this process's answer on its stdin.
 _READY, _GO = "phase 1 done", "go"
@@ -128,6 +129,11 @@ def helper_main() -> None:
     print(_READY, flush=True)
     if sys.stdin.readline().strip() == _GO:
         compile_part(HELPER_LATE_PART)
+    # the first process waits for this one to end: skip the interpreter's teardown, which walks the
+    # compile's millions of objects (about half a second); everything was written and flushed
+    sys.stdout.flush()
+    sys.stderr.flush()
+    os._exit(0)
 
 
 def compile_part(part) -> None:
@@ -201,11 +207,11 @@ def announce() -> str:
     """The line a first compile writes on stderr (it depends on where the cache is)."""
     info = cache_info()
     if info.path is None:
-        return (f"phaseimpact: compiling the engine for this process, about 35 s on 2 cores (nothing is "
+        return (f"phaseimpact: compiling the engine for this process, about 25 s on 2 cores (nothing is "
                 f"cached: {info.reason}; set NUMBA_CACHE_DIR to a writable directory to compile once)")
     if not info.writable:
         return f"phaseimpact: compiling part of the engine for this process (the cache {info.path} is read-only)"
-    return f"phaseimpact: compiling the engine once for this machine, about 35 s on 2 cores (cache: {info.path})"
+    return f"phaseimpact: compiling the engine once for this machine, about 25 s on 2 cores (cache: {info.path})"
 
 
 def _is_entry(dispatcher) -> bool:
@@ -222,7 +228,10 @@ class _FirstCompile(event.Listener):
     The collector: numba's compiler makes millions of small objects, and each of Python's full
     collections walks every object of the process; they took about a tenth of a first compile
     (measured with ``gc.callbacks``). Paused, the compile holds a few hundred MB more at its peak;
-    what it left is collected as usual once the collector runs again."""
+    what it left is collected as usual once the collector runs again, in one collection that walks
+    it all (about half a second). The console script (:data:`phaseimpact._jit.ONE_COMMAND`) runs one
+    command and ends: there the compile's leftovers are frozen (``gc.freeze``) instead, which saves
+    that collection and as long again at the exit, where Python would walk them once more."""
 
     def __init__(self):
         self.done = False
@@ -258,6 +267,8 @@ class _FirstCompile(event.Listener):
             self.entries_compiling -= 1
             if self.entries_compiling == 0 and self.paused_gc:
                 self.paused_gc = False
+                if _jit.ONE_COMMAND:
+                    gc.freeze()
                 gc.enable()
 
 

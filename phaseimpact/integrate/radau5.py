@@ -18,6 +18,11 @@ the driver's interpolant array so that events are located on it like on DOP853's
 
 All state travels in one tuple ``stiff`` made by :func:`workspace`, read by the positions ``WS`` ...
 ``F_START`` (constants: numba indexes the tuple's differently typed members statically).
+
+The small kernels (LU, solves, the Newton iteration) are ordinary compiled functions that LLVM
+inlines or calls as it sees fit, not inlined by numba (``inline="always"``): numba types an inlined
+function again inside each caller, which cost about 3 s more of a first compile in one process, and
+stiff runs take the same time either way (their cost is in the right-hand sides).
 """
 
 from __future__ import annotations
@@ -163,7 +168,7 @@ def jacobian(code, c, mode, side, u, fu, stiff):
     return N_FEEDBACK
 
 
-@kernel(inline="always")
+@kernel
 def _lu(A, piv):
     """In-place LU with partial pivoting (real or complex), the diagonal stored inverted (the
     solves multiply: a complex division costs several multiplications); False when singular."""
@@ -192,7 +197,7 @@ def _lu(A, piv):
     return True
 
 
-@kernel(inline="always")
+@kernel
 def _solve(A, piv, b):
     """Solve ``A x = b`` in place with the factors of :func:`_lu` (the first ``len(A)`` entries of ``b``)."""
     for k in range(N_FEEDBACK):
@@ -211,7 +216,7 @@ def _solve(A, piv, b):
         b[i] = acc * A[i, i]
 
 
-@kernel(inline="always")
+@kernel
 def _factorize(h, stiff):
     """LU of the feedback blocks of ``MU_REAL/h I - J`` and ``MU_COMPLEX/h I - J``; False when singular."""
     ws, lu_real, lu_complex, piv = stiff[WS], stiff[LU_REAL], stiff[LU_COMPLEX], stiff[PIV]
@@ -224,7 +229,7 @@ def _factorize(h, stiff):
     return _lu(lu_real, piv[PIV_REAL]) and _lu(lu_complex, piv[PIV_COMPLEX])
 
 
-@kernel(inline="always")
+@kernel
 def _solve_system(lu, piv, ws, h_over_mu, b):
     """Solve ``(mu/h I - J) x = b`` in place: the feedback block by its LU, the quadrature rows
     (whose columns of ``J`` are zero) by substitution."""
@@ -236,7 +241,7 @@ def _solve_system(lu, piv, ws, h_over_mu, b):
         b[q] = acc * h_over_mu
 
 
-@kernel(inline="always")
+@kernel
 def _norm(ws, row, n_rows, scale_row):
     """RMS of rows ``row..row+n_rows-1`` of ``ws`` on the scale ``ws[scale_row]``; inf when not finite."""
     acc = 0.0
@@ -246,7 +251,7 @@ def _norm(ws, row, n_rows, scale_row):
     return math.sqrt(acc / (n_rows * N_STATE)) if math.isfinite(acc) else math.inf
 
 
-@kernel(inline="always")
+@kernel
 def _collocation(code, c, mode, side, u, h, newton_tol, stiff):
     """Simplified Newton on the collocation system from the guess in ``ws[Z_]``; returns
     ``(converged, iterations, rate, evaluations)`` with the solution in ``ws[Z_]``."""
@@ -303,7 +308,7 @@ def _collocation(code, c, mode, side, u, h, newton_tol, stiff):
     return False, NEWTON_MAXITER, rate, evaluations
 
 
-@kernel(inline="always")
+@kernel
 def _guess(s, h, stiff):
     """Starting stages from the last collocation polynomial when this step starts on it (at its
     end: the next step; at its start: a fresh step to a root inside it); zero otherwise."""
@@ -355,7 +360,7 @@ def _solve_stages(code, c, mode, side, s, u, fu, h, stiff):
         _guess(s, h, stiff)
 
 
-@kernel(inline="always")
+@kernel
 def _finish(code, c, mode, side, s, s_end, h, u, u_new, fu_new, stiff):
     """``u_new``, ``fu_new`` from the converged stages; the polynomial kept for the next guess.
     Returns the contact force at ``u_new``."""
