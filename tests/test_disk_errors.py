@@ -59,6 +59,7 @@ def test_save_on_a_full_disk_names_the_path_and_keeps_the_previous_file(tmp_path
 
 
 def test_reserving_changes_no_byte_of_an_archive(tmp_path, small_sweep, monkeypatch):
+    monkeypatch.setenv("SOURCE_DATE_EPOCH", "1700000000")  # one time stamp, whatever second each is made in
     reserved = tmp_path / "reserved.h5"
     archive.save(small_sweep, reserved)
     monkeypatch.setattr(archive, "reserve", lambda fd, end: None)
