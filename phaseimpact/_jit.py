@@ -257,6 +257,99 @@ def _cache_class():
 
 
 # ------------------------------------------------------------------------------------------------
+# Kernels compiled for linking only
+# ------------------------------------------------------------------------------------------------
+# numba finalises every compiled function as if Python would call it: it links in the LLVM IR of
+# everything the function calls, optimises that whole module and generates its machine code. A
+# kernel (no Python wrapper) is never called but from compiled code, which links its IR and
+# optimises and generates it again in its own module; an entry (``run``) holds the whole engine.
+# So each level of the call tree redid the work of the levels below: of the 20 s that LLVM took in
+# a first-ever compile (one process), 16 s were module passes and machine code of kernels that
+# nothing would run. A kernel's library here keeps its function-level optimisation and its IR for
+# linking, and stops there; the entry that links it optimises the whole and makes the only
+# machine code, as before. The machine code of the entries, and every result, is bit-identical.
+#
+# numba has no public switch for this: the library class below overrides three of its library's
+# internal steps, and :func:`_linked_only_installed` hooks two more (where a function's library is
+# made, and where a cached one is read back). Each is checked first: with a numba that lacks
+# them nothing is changed, and the compile takes its old time (``tests/test_jit.py`` says so).
+
+#: The Python functions compiled as kernels without a Python wrapper (see above).
+_LINKED_ONLY: set = set()
+#: The kind under which a kernel's library is cached (numba's own are "object" and "bitcode").
+_LINKED_ONLY_KIND = "phaseimpact-linked-only"
+
+
+@functools.cache
+def _linked_only_library():
+    from llvmlite import binding
+    from numba.core import codegen
+
+    class LinkedOnlyLibrary(codegen.JITCodeLibrary):
+        """The library of a kernel: optimised function by function, never made machine code."""
+
+        def _optimize_final_module(self):
+            pass  # the entries that link it optimise it with themselves
+
+        def _finalize_final_module(self):
+            self._finalize_dynamic_globals()
+            self._verify_declare_only_symbols()
+            self._finalized = True  # not added to the JIT: no machine code, no symbol
+
+        def serialize_using_object_code(self):
+            self._ensure_finalized()
+            return self.name, _LINKED_ONLY_KIND, self._get_module_for_linking().as_bitcode()
+
+        @classmethod
+        def from_cache(cls, codegen_, name, bitcode):
+            library = cls(codegen_, name)
+            library._final_module = binding.parse_bitcode(bitcode)
+            library._finalize_final_module()
+            return library
+
+    return LinkedOnlyLibrary
+
+
+@functools.cache
+def _linked_only_installed() -> bool:
+    """Hook the kernels' libraries into numba (once); False if this numba lacks what they need."""
+    from numba.core import codegen, typed_passes
+
+    needed = ((codegen.JITCodeLibrary, ("_optimize_final_module", "_finalize_final_module",
+                                         "_finalize_dynamic_globals", "_verify_declare_only_symbols",
+                                         "_get_module_for_linking", "serialize_using_object_code")),
+              (codegen.JITCPUCodegen, ("unserialize_library", "set_env")),
+              (typed_passes.BaseNativeLowering, ("run_pass",)))
+    if not all(hasattr(owner, name) for owner, names in needed for name in names):
+        return False
+    library_class = _linked_only_library()
+    lower, unserialize, set_env = (typed_passes.BaseNativeLowering.run_pass,
+                                   codegen.JITCPUCodegen.unserialize_library, codegen.JITCPUCodegen.set_env)
+
+    def run_pass(self, state):
+        if state.library is None and state.func_id.func in _LINKED_ONLY:
+            state.library = library_class(state.targetctx.codegen(), state.func_id.func_qualname)
+        return lower(self, state)
+
+    def unserialize_library(self, serialized):
+        name, kind, data = serialized
+        if kind == _LINKED_ONLY_KIND:
+            return library_class.from_cache(self, name, data)
+        return unserialize(self, serialized)
+
+    def set_env_where_defined(self, env_name, env):
+        # numba sets a function's environment (what boxes Python objects; kernels use none) at
+        # its symbol's address; a kernel's library defines no symbol
+        if self._engine.get_global_value_address(env_name):
+            set_env(self, env_name, env)
+
+    typed_passes.BaseNativeLowering.run_pass = run_pass
+    codegen.JITCPUCodegen.unserialize_library = unserialize_library
+    codegen.JITCPUCodegen.set_env = set_env_where_defined
+    return True
+
+
+# ------------------------------------------------------------------------------------------------
 # The decorators
 # ------------------------------------------------------------------------------------------------
 
@@ -266,6 +359,8 @@ _pending: list[_Deferred] = []
 def _compile(function, options):
     import numba
 
+    if options["no_cpython_wrapper"] and _linked_only_installed():
+        _LINKED_ONLY.add(function)
     cache = cache_info().path is not None
     dispatcher = numba.njit(cache=False, **options)(function)
     if cache:

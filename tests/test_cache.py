@@ -195,3 +195,56 @@ def test_commands_that_integrate_nothing_import_no_numba(argv):
     out = subprocess.run([sys.executable, "-c", code, *argv], capture_output=True, text=True, timeout=120, cwd=ROOT)
     assert out.returncode == 0, out.stderr
     assert out.stderr.strip().splitlines()[-1] == "NO-NUMPY NO-NUMBA NO-SCIPY"
+
+
+# A kernel and an entry that calls it, in their own module (numba caches by source file).
+LINKED = r"""
+from phaseimpact._jit import kernel
+
+
+@kernel
+def twice(x):
+    return 2.0 * x
+
+
+@kernel(python=True)
+def entry(x):
+    return twice(x) + 1.0
+"""
+# First process: the kernel alone (as the compile helper does); second: the entry, which reads the
+# kernel from the cache and links it.
+LINKED_RUN = r"""
+import json, sys
+from numba import float64
+from phaseimpact import _jit
+import linked
+if sys.argv[1] == "kernel":
+    linked.twice.compile((float64,))
+    library = linked.twice.overloads[(float64,)].library
+    print(json.dumps({"linked_only": isinstance(library, _jit._linked_only_library()),
+                      "kind": library.serialize_using_object_code()[1],
+                      "machine_code": any(library.codegen._engine.is_symbol_defined(f.name)
+                                          for f in library.get_defined_functions())}))
+else:
+    value = linked.entry(3.0)
+    kernel, entry = linked.twice.overloads[(float64,)].library, linked.entry.overloads[(float64,)].library
+    print(json.dumps({"value": value, "kernel_from_cache": linked.twice.stats.cache_hits[(float64,)],
+                      "linked_only": isinstance(kernel, _jit._linked_only_library()),
+                      "entry_linked_only": isinstance(entry, _jit._linked_only_library())}))
+"""
+
+
+def test_a_kernel_is_compiled_for_linking_only_and_read_back_from_the_cache_by_its_callers(tmp_path):
+    """A kernel's library keeps its IR for the entries that link it and makes no machine code of
+    its own (the compile-time saving of phaseimpact/_jit.py); cached, it is read back as such and
+    an entry compiled in another process links it and computes the right value."""
+    assert _jit._linked_only_installed(), "this numba lacks the hooks: kernels compile as whole libraries"
+    (tmp_path / "linked.py").write_text(LINKED)
+    env = {"NUMBA_CACHE_DIR": str(tmp_path / "cache"), "PYTHONPATH": os.pathsep.join((str(tmp_path), str(ROOT)))}
+    first = _run(LINKED_RUN.replace("sys.argv[1]", "'kernel'"), tmp_path, **env)
+    assert first.returncode == 0, first.stderr[-3000:]
+    assert json.loads(first.stdout) == {"linked_only": True, "kind": _jit._LINKED_ONLY_KIND, "machine_code": False}
+    second = _run(LINKED_RUN.replace("sys.argv[1]", "'entry'"), tmp_path, **env)
+    assert second.returncode == 0, second.stderr[-3000:]
+    assert json.loads(second.stdout) == {"value": 7.0, "kernel_from_cache": 1, "linked_only": True,
+                                         "entry_linked_only": False}
