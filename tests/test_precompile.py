@@ -92,6 +92,9 @@ def test_cold_compile_compiles_every_kernel_once_and_none_of_the_helpers(cold_se
     for function, _ in precompile.LOCAL_PART + precompile.LOCAL_LATE_PART:
         assert f"{function.__module__}.{function.__name__}" in compiled
     assert "phaseimpact.integrate.driver.run" in compiled
+    # phase 3: the run loop here, the other entry (simulate_many's) by the helper
+    assert "phaseimpact.integrate.driver._run" in compiled
+    assert "phaseimpact.integrate.driver.run_block" not in compiled
 
 
 def test_cold_compile_pauses_the_garbage_collector_and_gives_it_back(cold_session):
@@ -134,7 +137,7 @@ def test_phase_two_starts_when_the_helper_is_ready():
     """The helper's phase 1 line gets the answer that starts its phase 2."""
     helper = _fake_helper(f"import sys; print({precompile._READY!r}, flush=True); "
                           f"sys.exit(0 if sys.stdin.readline().strip() == {precompile._GO!r} else 3)")
-    assert precompile._phase_two(helper) is True
+    assert precompile._next_phase(helper, precompile._READY, precompile._GO) is True
     assert helper.wait(timeout=30) == 0
 
 
@@ -144,8 +147,27 @@ def test_phase_two_is_skipped_when_the_helper_fails(script):
     """A helper that ends or answers wrongly: this process compiles the mid-level kernels itself,
     and the helper is not left waiting for an answer."""
     helper = _fake_helper(script + "; import sys; sys.stdin.readline()")
-    assert precompile._phase_two(helper) is False
+    assert precompile._next_phase(helper, precompile._READY, precompile._GO) is False
     helper.wait(timeout=30)  # its stdin was closed: it does not wait for ever
+
+
+@pytest.mark.parametrize(("entry", "other"), [("run", "run_block"), ("run_block", "run")])
+def test_phase_three_gives_the_helper_the_other_entry(entry, other):
+    """After the helper's phase 2 (and the run loop here), the helper is named the entry this
+    process does not compile."""
+    from phaseimpact.integrate import driver
+
+    helper = _fake_helper(f"import sys; print({precompile._READY_LATE!r}, flush=True); "
+                          f"sys.exit(0 if sys.stdin.readline().strip() == {other!r} else 3)")
+    assert precompile._next_phase_after_loop(helper, getattr(driver, entry)) is True
+    assert helper.wait(timeout=30) == 0
+
+
+def test_phase_three_is_skipped_when_the_helper_fails():
+    from phaseimpact.integrate import driver
+
+    helper = _fake_helper("import sys; sys.exit(1)")
+    assert precompile._next_phase_after_loop(helper, driver.run) is False
 
 
 def test_one_command_process_freezes_what_the_compile_left(monkeypatch):

@@ -901,7 +901,18 @@ def run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count,
     step where something did, the events located (:func:`_locate_events`), the recorded ones
     logged (:func:`_record`) and the run restarted at the first that changes the phase
     (:func:`_restart`). The seed's RK4 is :func:`run_rk4`.
+
+    The loop is :func:`_run`, which :func:`run_block` calls too: a first compile makes the two
+    entries from it side by side, one in each process (:mod:`.precompile`).
     """
+    return _run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count, save_kind, times,
+                max_steps, max_events, stiff_after)
+
+
+@allocating
+def _run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count, save_kind, times,
+         max_steps, max_events, stiff_after):
+    """:func:`run`'s loop."""
     c = c.copy()  # the run's own: a law's memory is written into it (model.laws.remember)
     y = y0.copy()
     t = 0.0
@@ -1225,8 +1236,8 @@ def run_block(code, C, Y0, t_end, rtol, ATOL, max_step, settle, stop_kind, stop_
         _copy(C[i], c)
         _copy(Y0[i], y0)
         _copy(ATOL[i], atol)
-        s, events, _, _ = run(code, c, y0, t_end[i], rtol, atol, max_step[i], settle, stop_kind, stop_count,
-                              np.int64(SAVE_SUMMARY), empty, max_steps, max_events, stiff_after)
+        s, events, _, _ = _run(code, c, y0, t_end[i], rtol, atol, max_step[i], settle, stop_kind, stop_count,
+                               np.int64(SAVE_SUMMARY), empty, max_steps, max_events, stiff_after)
         _copy(s, summary[i])
         permanent = s[S_OUTCOME] == PERMANENT_STICK
         st_count[i] = stick_points(events, s[S_T_STOP], permanent, st_t[i], st_delta[i], st_dwell[i])

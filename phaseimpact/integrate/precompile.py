@@ -7,18 +7,21 @@ kernels they call) do not depend on the explicit stepper, the flight's closed fo
 root finders, and the driver's mid-level kernels (advance, locate, record, restart) need both.
 
 So when numba is about to compile one of the two entries from scratch (its ``numba:compile`` event
-fires only on a cache miss), the compile runs in two processes and two phases, each process
+fires only on a cache miss), the compile runs in two processes and three phases, each process
 writing to numba's disk cache and loading from it what the other wrote:
 
 1. a helper process compiles the Radau kernels (:data:`HELPER_PART`) while this one compiles the
    rest of the leaves (:data:`LOCAL_PART`);
 2. once both are done (the helper says so on its stdout, this process answers on its stdin), the
    mid-level kernels are split the same way (:data:`HELPER_LATE_PART`, :data:`LOCAL_LATE_PART`);
+3. this process compiles the run loop (:func:`.driver._run`), then the entry it was asked for
+   while the helper compiles the other one (:data:`ENTRIES`: both hold the whole engine, and most
+   of their compile is LLVM's, which no second process can share), and waits for the helper at
+   the end of its entry's compile.
 
-then the entry's own compile here loads them all. A cached kernel keeps its LLVM bitcode for
-inlining into its callers, so the machine code, and every result, is the same however the cache
-was filled. On a warm cache nothing here runs. If the helper fails or is late, this process
-compiles what is missing itself.
+A cached kernel keeps its LLVM bitcode for inlining into its callers, so the machine code, and
+every result, is the same however the cache was filled. On a warm cache nothing here runs. If the
+helper fails or is late, this process compiles what is missing itself.
 
 The argument types below are the ones the driver calls the kernels with:
 ``tests/test_precompile.py`` compiles from an empty cache and checks that no kernel is compiled
@@ -49,8 +52,8 @@ from .. import _jit
 from .._jit import PROCESSES_VARIABLE, cache_info, mark_complete, processes
 from . import dop853, driver, flight, radau5
 
-__all__ = ["HELPER_PART", "LOCAL_PART", "HELPER_LATE_PART", "LOCAL_LATE_PART", "compile_part", "processes", "announce",
-           "warmup", "PROCESSES_VARIABLE"]
+__all__ = ["HELPER_PART", "LOCAL_PART", "HELPER_LATE_PART", "LOCAL_LATE_PART", "LOOP_PART", "ENTRIES", "compile_part",
+           "processes", "announce", "warmup", "PROCESSES_VARIABLE"]
 
 #: Set in the helper's environment: it compiles silently (its output is read only if it fails).
 _HELPER_VARIABLE = "PHASEIMPACT_COMPILE_HELPER"
@@ -114,21 +117,31 @@ LOCAL_LATE_PART = (
     (driver._advance, "I V I I F F V V V V F F F V F F F F F I V V BV M V V V V V STIFF"),
     (driver._record, "I V I I B I I F F F BV V V V M M V V STIFF V V M I IV V"),
 )
-#: The helper's lines on stdout and this process's answer on its stdin.
-_READY, _GO = "phase 1 done", "go"
+# Phase 3: the run loop here, then the two entries, one in each process.
+LOOP_PART = ((driver._run, "I V V F F V F B I I I V I I I"),)
+#: The entries of :mod:`.driver` a first compile makes, by name: the helper compiles the one this
+#: process does not.
+ENTRIES = {"run": "I V V F F V F B I I I V I I I", "run_block": "I M M V F M V B I I I I I I I I M M M M IV"}
+#: The helper's lines on stdout and this process's answer on its stdin (phase 3: the entry's name).
+_READY, _READY_LATE, _GO = "phase 1 done", "phase 2 done", "go"
 
 
 _HELPER = f"import {__name__} as part; part.helper_main()"
 
 
 def helper_main() -> None:
-    """The helper process: phase 1, then phase 2 once the first process says its phase 1 is done
-    (without the cyclic garbage collector, as an entry's compile: see :class:`_FirstCompile`)."""
+    """The helper process: phase 1, then phase 2 once the first process says its phase 1 is done,
+    then the entry the first process names (without the cyclic garbage collector, as an entry's
+    compile: see :class:`_FirstCompile`)."""
     gc.disable()
     compile_part(HELPER_PART)
     print(_READY, flush=True)
     if sys.stdin.readline().strip() == _GO:
         compile_part(HELPER_LATE_PART)
+        print(_READY_LATE, flush=True)
+        name = sys.stdin.readline().strip()
+        if name in ENTRIES:
+            compile_part(((getattr(driver, name), ENTRIES[name]),))
     # the first process waits for this one to end: skip the interpreter's teardown, which walks the
     # compile's millions of objects (about half a second); everything was written and flushed
     sys.stdout.flush()
@@ -167,22 +180,43 @@ def _start_helper():
     return helper, errors
 
 
-def _phase_two(helper: subprocess.Popen) -> bool:
-    """Wait for the helper's phase 1 and start both processes' phase 2; False if the helper failed
-    or is late (this process then compiles the mid-level kernels with the entry)."""
+def _next_phase(helper: subprocess.Popen, ready: str, answer: str) -> bool:
+    """Wait for the helper's line ``ready`` and answer; False if the helper failed or is late (this
+    process then compiles what is left with the entry). The helper's input is closed on False: it
+    ends there."""
     try:
-        ready, _, _ = select.select([helper.stdout], [], [], HELPER_TIMEOUT)
-        if not ready or helper.stdout.readline().strip() != _READY:
-            return False
-        helper.stdin.write(_GO + "\n")
-        return True
+        readable, _, _ = select.select([helper.stdout], [], [], HELPER_TIMEOUT)
+        if readable and helper.stdout.readline().strip() == ready:
+            helper.stdin.write(answer + "\n")
+            helper.stdin.flush()
+            return True
     except OSError:  # the helper is gone
+        pass
+    _close_input(helper)
+    return False
+
+
+def _close_input(helper: subprocess.Popen) -> None:
+    try:
+        helper.stdin.close()
+    except OSError:
+        pass
+
+
+def _next_phase_after_loop(helper: subprocess.Popen, entry) -> bool:
+    """Phase 3: once the helper's phase 2 is done, the run loop here, then the helper is told to
+    make the entry other than ``entry``. False if the helper failed or is late."""
+    readable, _, _ = select.select([helper.stdout], [], [], HELPER_TIMEOUT)
+    if not readable or helper.stdout.readline().strip() != _READY_LATE:
         return False
-    finally:
-        try:
-            helper.stdin.close()  # without "go" the helper ends after its phase 1
-        except OSError:
-            pass
+    compile_part(LOOP_PART)  # with the kernels of both phases, as the helper's entry needs it
+    other = next(name for name in ENTRIES if getattr(driver, name) is not entry)
+    try:
+        helper.stdin.write(other + "\n")
+        helper.stdin.close()
+    except OSError:
+        return False
+    return True
 
 
 def _join(helper: subprocess.Popen, errors) -> None:
@@ -238,6 +272,7 @@ class _FirstCompile(event.Listener):
         self.announced = bool(os.environ.get(_HELPER_VARIABLE))
         self.entries_compiling = 0
         self.paused_gc = False
+        self.helper = None  # (entry, helper, its error file) while the helper makes the other entry
 
     def on_start(self, ev):
         dispatcher = ev.data["dispatcher"]
@@ -257,12 +292,20 @@ class _FirstCompile(event.Listener):
             return  # the helper's work reaches this process through the cache: without one, it is wasted
         helper = _start_helper()
         compile_part(LOCAL_PART)
-        if helper is not None and _phase_two(helper[0]):
+        if helper is None:
+            return
+        if _next_phase(helper[0], _READY, _GO):
             compile_part(LOCAL_LATE_PART)
-        if helper is not None:
-            _join(*helper)
+            if _next_phase_after_loop(helper[0], dispatcher):
+                self.helper = (dispatcher, *helper)  # joined when this entry is compiled (on_end)
+                return
+        _close_input(helper[0])
+        _join(*helper)
 
     def on_end(self, ev):
+        if self.helper is not None and ev.data["dispatcher"] is self.helper[0]:
+            _join(*self.helper[1:])
+            self.helper = None
         if _is_entry(ev.data["dispatcher"]):
             self.entries_compiling -= 1
             if self.entries_compiling == 0 and self.paused_gc:
