@@ -141,7 +141,7 @@ def main(argv=None) -> int:
             + f"\n\nTwo processes against one: {cold_total:.3g} / {single_total:.3g} s = "
             f"{cold_total / single_total:.2f} (runs: {seconds(colds)} s against {seconds(singles)} s)."
             + "\n\nA user's first command on an empty cache, `phaseimpact simulate --law hunt-crossley --kappa 3e9` "
-            f"(two processes; it compiles `run` only): median {first_time:.3g} s (runs: "
+            f"(two processes: `run` here, `run_block` in the helper): median {first_time:.3g} s (runs: "
             + ", ".join(f"{t:.1f}" for t in commands_cold) + " s)."
             + "\n\nWhole commands on the project's cache (warm), median of 5:\n\n"
             + table(("command", "wall, median [s]", "runs [s]"), cmd_rows))

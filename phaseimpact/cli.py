@@ -1474,7 +1474,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser("warmup", help="compile the engine ahead, and say where its cache is",
                        description="Compile every entry of the engine into its cache now (the first command that "
-                                   "integrates would otherwise do it, about 25 s on 2 cores), and say where the "
+                                   "integrates would otherwise do it, about 20 s on 2 cores), and say where the "
                                    "cache is: for shared installs (run it as the install's owner: other users read "
                                    "that cache), containers and cluster workers. On a warm cache it only loads.")
     json_option(p)

@@ -241,11 +241,11 @@ def announce() -> str:
     """The line a first compile writes on stderr (it depends on where the cache is)."""
     info = cache_info()
     if info.path is None:
-        return (f"phaseimpact: compiling the engine for this process, about 35 s (one process: nothing is "
+        return (f"phaseimpact: compiling the engine for this process, about 30 s (one process: nothing is "
                 f"cached: {info.reason}; set NUMBA_CACHE_DIR to a writable directory to compile once)")
     if not info.writable:
         return f"phaseimpact: compiling part of the engine for this process (the cache {info.path} is read-only)"
-    return f"phaseimpact: compiling the engine once for this machine, about 25 s on 2 cores (cache: {info.path})"
+    return f"phaseimpact: compiling the engine once for this machine, about 20 s on 2 cores (cache: {info.path})"
 
 
 def _is_entry(dispatcher) -> bool:
