@@ -329,7 +329,7 @@ def test_engine_kernels_are_compiled_without_reference_counting():
                 assert "_nrt" in obj.targetoptions, f"{module.__name__}.{name} is not declared through _jit"
                 if obj.targetoptions["_nrt"]:
                     counted.add(name)
-    assert counted == {"run", "run_block", "run_rk4", "_open_logs", "_grow", "_push_event", "_push_sample",
+    assert counted == {"run", "_run", "run_block", "run_rk4", "_open_logs", "_grow", "_push_event", "_push_sample",
                        "_summarize", "workspace"}
 
 
