@@ -271,9 +271,10 @@ def _cache_class():
 # and 29.9 s after (``benchmarks/startup.py``).
 #
 # numba has no public switch for this: the library class below overrides three of its library's
-# internal steps, and :func:`_linked_only_installed` hooks two more (where a function's library is
-# made, and where a cached one is read back). Each is checked first: with a numba that lacks
-# them nothing is changed, and the compile takes its old time (``tests/test_jit.py`` says so).
+# internal steps, and :func:`_linked_only_installed` hooks three more (where a function's library
+# is made, where a cached one is read back, and where a function's environment is set). Each is
+# checked first: with a numba that lacks them nothing is changed, and the compile takes its old
+# time (``tests/test_cache.py`` says so).
 
 #: The Python functions compiled as kernels without a Python wrapper (see above).
 _LINKED_ONLY: set = set()
