@@ -117,11 +117,11 @@ LOCAL_LATE_PART = (
     (driver._advance, "I V I I F F V V V V F F F V F F F F F I V V BV M V V V V V STIFF"),
     (driver._record, "I V I I B I I F F F BV V V V M M V V STIFF V V M I IV V"),
 )
-# Phase 3: the run loop here, then the two entries, one in each process.
-LOOP_PART = ((driver._run, "I V V F F V F B I I I V I I I"),)
 #: The entries of :mod:`.driver` a first compile makes, by name: the helper compiles the one this
 #: process does not.
 ENTRIES = {"run": "I V V F F V F B I I I V I I I", "run_block": "I M M V F M V B I I I I I I I I M M M M IV"}
+# Phase 3: the run loop here (it takes run's arguments), then the two entries, one in each process.
+LOOP_PART = ((driver._run, ENTRIES["run"]),)
 #: The helper's lines on stdout and this process's answer on its stdin (phase 3: the entry's name).
 _READY, _READY_LATE, _GO = "phase 1 done", "phase 2 done", "go"
 
@@ -184,16 +184,24 @@ def _next_phase(helper: subprocess.Popen, ready: str, answer: str) -> bool:
     """Wait for the helper's line ``ready`` and answer; False if the helper failed or is late (this
     process then compiles what is left with the entry). The helper's input is closed on False: it
     ends there."""
-    try:
-        readable, _, _ = select.select([helper.stdout], [], [], HELPER_TIMEOUT)
-        if readable and helper.stdout.readline().strip() == ready:
+    if _heard(helper, ready):
+        try:
             helper.stdin.write(answer + "\n")
             helper.stdin.flush()
             return True
-    except OSError:  # the helper is gone
-        pass
+        except OSError:  # the helper is gone
+            pass
     _close_input(helper)
     return False
+
+
+def _heard(helper: subprocess.Popen, line: str) -> bool:
+    """Whether the helper's next line on its stdout, within :data:`HELPER_TIMEOUT`, is ``line``."""
+    try:
+        readable, _, _ = select.select([helper.stdout], [], [], HELPER_TIMEOUT)
+        return bool(readable) and helper.stdout.readline().strip() == line
+    except OSError:  # the helper is gone
+        return False
 
 
 def _close_input(helper: subprocess.Popen) -> None:
@@ -206,8 +214,7 @@ def _close_input(helper: subprocess.Popen) -> None:
 def _next_phase_after_loop(helper: subprocess.Popen, entry) -> bool:
     """Phase 3: once the helper's phase 2 is done, the run loop here, then the helper is told to
     make the entry other than ``entry``. False if the helper failed or is late."""
-    readable, _, _ = select.select([helper.stdout], [], [], HELPER_TIMEOUT)
-    if not readable or helper.stdout.readline().strip() != _READY_LATE:
+    if not _heard(helper, _READY_LATE):
         return False
     compile_part(LOOP_PART)  # with the kernels of both phases, as the helper's entry needs it
     other = next(name for name in ENTRIES if getattr(driver, name) is not entry)
