@@ -1395,14 +1395,13 @@ def build_parser() -> argparse.ArgumentParser:
                             f"NAME=V1,V2,...; names: {names}; at most {limit} values in all"
                             + ("" if repeat else "; once"))
 
-    def kappa_range(p, required, default_text=""):
+    def kappa_range(p, required, default_min="", default_max=""):
         kmin = _real("kappa-min", 0.0, KAPPA_MAX, low_open=True, unit=KAPPA_UNIT)
         kmax = _real("kappa-max", 0.0, KAPPA_MAX, low_open=True, unit=KAPPA_UNIT)
         p.add_argument("--kappa-min", type=kmin, default=None, required=required,
-                       help=f"lower end of kappa ({KAPPA_UNIT}), 0 < KAPPA_MIN <= {KAPPA_MAX:g}{default_text}")
+                       help=f"lower end of kappa ({KAPPA_UNIT}), 0 < KAPPA_MIN <= {KAPPA_MAX:g}{default_min}")
         p.add_argument("--kappa-max", type=kmax, default=None, required=required,
-                       help=f"upper end of kappa ({KAPPA_UNIT}), KAPPA_MIN < KAPPA_MAX <= {KAPPA_MAX:g}"
-                            + default_text.replace("1e-8", "1e8"))
+                       help=f"upper end of kappa ({KAPPA_UNIT}), KAPPA_MIN < KAPPA_MAX <= {KAPPA_MAX:g}{default_max}")
 
     def samples(p, default):
         lo, hi = SAMPLES_RANGE
@@ -1533,7 +1532,8 @@ def build_parser() -> argparse.ArgumentParser:
     target(p)
     kappa_tolerance(p)
     tolerance(p)
-    kappa_range(p, False, " (default: 1e-8 K/v)")
+    kappa_range(p, False, " (default: 1e-8 K/v, the damping number below which the approach is undamped)",
+                f" (default: {KAPPA_MAX:g}; the search widens from the closed form until the margin changes sign)")
     p.add_argument("--exponents", action="store_true",
                    help="also measure the adding-sliding exponents (slip speed ~ eps^1.5, stick offset ~ eps^2; "
                         "about 1 s)")
@@ -1601,7 +1601,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--what", choices=CURVE_WHATS, default="kappa_c",
                    help="what is continued: kappa_c or kappa_2 (law paper), or grazing (a unilateral law: the first "
                         "grazing value in [KAPPA_MIN, KAPPA_MAX] at the first value) (default: %(default)s)")
-    kappa_range(p, False, " (--what grazing only; default: none)")
+    kappa_range(p, False, " (--what grazing only; default: none)", " (--what grazing only; default: none)")
     samples(p, None)
     kappa_tolerance(p, "width of kappa_c's (kappa_2's, the grazing value's) final bracket at each point")
     tolerance(p)

@@ -78,10 +78,42 @@ def test_printed_and_unilateral_readings_share_kappa_c():
     assert unilateral == pytest.approx(printed, rel=1e-12)
 
 
+#: Known answers of the issue's independent scipy code (issue 42, item 2), quoted to 5 digits:
+#: compared at 2e-5, half a unit of their last digit.
+KAPPA_C_R1_2MM_V1, KAPPA_C_R1_1MM_V100 = 9.2946e17, 3.0957e18
+
+
+def test_kappa_c_beyond_the_old_range_of_damping_numbers():
+    """R1 = 2 mm at 1 m/s: the root lies at 1.35 times the old range's end (damping number 1e8),
+    inside the inputs' kappa <= 1e18; the search reaches it, and single runs either side agree
+    (a permanent stick just below, an escape above)."""
+    p = load_case("seed").parameters(R1=0.002)
+    assert KAPPA_C_R1_2MM_V1 > 1e8 * p.K / p.v
+    found = critical_damping(p, "paper")
+    assert found.status == "success", found.message
+    assert found.kappa_c == pytest.approx(KAPPA_C_R1_2MM_V1, rel=2e-5)
+    assert simulate(p.replace(kappa=0.99 * KAPPA_C_R1_2MM_V1), "paper").outcome == "permanent-stick"
+    assert simulate(p.replace(kappa=9.6e17), "paper").outcome == "ratchet-escape"
+
+
+def test_a_root_beyond_the_inputs_limit_is_reported_as_a_search_not_a_claim():
+    """R1 = 1 mm at 100 m/s: the root (3.0957e18) lies beyond kappa <= 1e18; the search says how far
+    it looked, and the closed form, which is not bound by the inputs, finds the root."""
+    p = load_case("seed").parameters(R1=0.001, v=100.0)
+    found = critical_damping(p, "paper")
+    assert found.status == "not-found" and found.kappa_c is None
+    assert "no root of the first stick's margin up to kappa = 1e+18" in found.message
+    assert found.search_range[1] == 1e18 and found.margins[1] > 0
+    assert "never breaks" not in found.message
+    assert closed_form_kappa_c(p) == pytest.approx(KAPPA_C_R1_1MM_V100, rel=2e-5)
+    assert "3.0957e+18" in found.message
+
+
 def test_not_found_gives_null_and_both_margins():
     rigid = critical_damping(SEED.replace(target="rigid"), "paper")
     assert rigid.status == "not-found" and rigid.kappa_c is None
-    assert "never breaks" in rigid.message
+    assert "no root of the first stick's margin up to kappa = 1e+18" in rigid.message
+    assert "without springs" in rigid.message and rigid.margins == (1.0, 1.0)
     narrow = critical_damping(SEED, "paper", kappa_min=1e9, kappa_max=1e10)
     assert narrow.status == "not-found" and narrow.kappa_c is None
     assert all(m > 0 for m in narrow.margins)

@@ -37,8 +37,10 @@ _REVERSAL = EVENT_KINDS.index("reversal")
 #: Horizon of an extremum search, in plate periods: every contact of an impact happens within a
 #: few periods; an extremum beyond that is not a grazing candidate.
 EXTREMA_PERIODS = 50
-#: Default search range of the damping number ``a = kappa v / K``.
-A_RANGE = (1e-8, 1e8)
+#: Lower end of the default search range, as a damping number ``a = kappa v / K``: below it the
+#: approach phase is undamped to 1e-8 (``delta*`` moves by ``O(a)``), so the margin cannot change
+#: sign there. The upper end is the inputs' own limit :data:`~phaseimpact.parameters.KAPPA_MAX`.
+A_MIN = 1e-8
 #: kappa samples of a grazing search (each is one run).
 SAMPLES_RANGE = (8, 10_000)
 #: A grazing search samples the extrema of delta on a log grid of kappa: a window between two grazing
@@ -170,9 +172,8 @@ def check_samples(num, kappa_min: float, kappa_max: float, names=("kappa_min", "
 
 
 def _default_range(params: Parameters) -> tuple[float, float]:
-    """The search range of damping numbers :data:`A_RANGE`, within the allowed kappa."""
-    scale = params.K / params.v
-    return min(A_RANGE[0] * scale, KAPPA_MAX / 10), min(A_RANGE[1] * scale, KAPPA_MAX)
+    """The default search range: from the damping number :data:`A_MIN` up to ``KAPPA_MAX``."""
+    return min(A_MIN * params.K / params.v, KAPPA_MAX / 10), KAPPA_MAX
 
 
 def closed_form_kappa_c(params: Parameters) -> float | None:
@@ -190,8 +191,9 @@ def closed_form_kappa_c(params: Parameters) -> float | None:
     Returns
     -------
     float or None
-        N s/m^(1+alpha); None for a rigid or free target, a plate without bending stiffness, or
-        no root for damping numbers ``kappa v / K`` in ``A_RANGE`` (1e-8 to 1e8).
+        N s/m^(1+alpha), possibly beyond ``KAPPA_MAX`` (an estimate, not an input); None for a
+        rigid or free target, a plate without bending stiffness, or a stick that breaks already
+        at the damping number ``kappa v / K`` = :data:`A_MIN` (no root above it).
 
     Examples
     --------
@@ -224,9 +226,16 @@ def closed_form_kappa_c(params: Parameters) -> float | None:
         delta = ((alpha + 1) * m * v * v * core / (K * a * a)) ** (1 / (alpha + 1))
         return math.log(K * delta**alpha / required)
 
-    lo, hi = math.log(A_RANGE[0]), math.log(A_RANGE[1])
-    if gap(lo) * gap(hi) > 0:
+    # delta* falls monotonically with a (like a^(-1/(alpha+1)) for large a), so the gap has at most
+    # one root, and one exactly when it is positive at A_MIN: widen the upper end until it is negative
+    lo = math.log(A_MIN)
+    if gap(lo) <= 0:
         return None
+    hi = lo + math.log(1e8)
+    while gap(hi) > 0:
+        hi += math.log(1e8)
+        if hi > math.log(1e100):  # a * a would overflow: no estimate
+            return None
     return math.exp(brentq(gap, lo, hi, xtol=1e-14, rtol=1e-14)) * K / v
 
 
@@ -312,6 +321,8 @@ class CriticalDamping:
         docs/physics.md §5's closed-form estimate.
     bracket : tuple of float
         The final bracket of the root (or the search range when none was found), N s/m^(1+alpha).
+    search_range : tuple of float
+        The range searched, N s/m^(1+alpha) (no root found: none lies in it).
     margins : tuple
         Margin at the search range's ends (or at the final bracket).
     message : str
@@ -367,6 +378,7 @@ class CriticalDamping:
     n_staircase: list = field(default_factory=list)
     classification: str | None = None
     exponents: dict | None = None
+    search_range: tuple = ()
 
     def as_dict(self) -> dict:
         """The fields as a plain dict (for JSON).
@@ -392,10 +404,13 @@ def critical_damping(params: Parameters, law: ContactLaw | str = "paper", *, kap
     """Locate ``kappa_c``, the root of the first stick's margin, for any case.
 
     The bracket is seeded by the closed form (docs/physics.md §5) and widened geometrically within
-    ``[kappa_min, kappa_max]`` (default: damping numbers ``kappa v / K`` in 1e-8..1e8); Brent's
-    method narrows it to ``rtol`` (relative). Counts either side confirm it: one permanent
-    stick just below, two or more stick phases just above. No root in the range gives status
-    ``not-found``, ``kappa_c`` None and the margins at both ends in the message.
+    ``[kappa_min, kappa_max]`` (default: from the damping number ``kappa v / K`` = 1e-8, below
+    which the approach is undamped, up to the inputs' limit ``KAPPA_MAX`` = 1e18) until the margin
+    changes sign; Brent's method narrows it to ``rtol`` (relative). Counts either side confirm it:
+    one permanent stick just below, two or more stick phases just above. No root in the range
+    gives status ``not-found``, ``kappa_c`` None and a message saying what was searched ("no
+    root ... up to kappa = ...", the margins at both ends), never that the stick cannot break
+    unless the equations say so (a target without springs).
 
     Parameters
     ----------
@@ -405,7 +420,7 @@ def critical_damping(params: Parameters, law: ContactLaw | str = "paper", *, kap
         ``paper`` or another Filippov law.
     kappa_min, kappa_max : float, optional
         Search range, N s/m^(1+alpha), ``0 < kappa_min < kappa_max <= 1e18``; an end not given
-        comes from the damping numbers above.
+        is the default above.
     rtol : float, default 1e-10
         Relative tolerance of ``kappa_c``, ``1e-14 <= rtol <= 1e-2``.
     integrator_rtol : float, default 1e-10
@@ -449,11 +464,12 @@ def critical_damping(params: Parameters, law: ContactLaw | str = "paper", *, kap
     kappa_min, kappa_max = default_kappa_range(params, kappa_min, kappa_max)
     closed = closed_form_kappa_c(params)
     try:
-        return _critical_damping(params, law, kappa_min, kappa_max, rtol, integrator_rtol, with_kappa_2,
-                                 with_exponents, closed)
+        result = _critical_damping(params, law, kappa_min, kappa_max, rtol, integrator_rtol, with_kappa_2,
+                                   with_exponents, closed)
     except RunFailed as error:
-        return CriticalDamping(law.name, law.contact, params.v, None, rtol, closed, (kappa_min, kappa_max),
-                               (math.nan, math.nan), "failed", f"a run of the search failed: {error}", 0)
+        result = CriticalDamping(law.name, law.contact, params.v, None, rtol, closed, (kappa_min, kappa_max),
+                                 (math.nan, math.nan), "failed", f"a run of the search failed: {error}", 0)
+    return _replace(result, search_range=(kappa_min, kappa_max))
 
 
 def check_rtol_of_kappa(rtol) -> float:
@@ -464,8 +480,9 @@ def check_rtol_of_kappa(rtol) -> float:
 
 def default_kappa_range(params: Parameters, kappa_min=None, kappa_max=None,
                         names=("kappa_min", "kappa_max")) -> tuple[float, float]:
-    """The search range of :func:`critical_damping`: the ends given, the others from the damping
-    numbers :data:`A_RANGE` (a default end on the wrong side of a given one is named as a default)."""
+    """The search range of :func:`critical_damping`: the ends given, the others the defaults (the
+    damping number :data:`A_MIN` and ``KAPPA_MAX``; a default end on the wrong side of a given one
+    is named as a default)."""
     lo_default, hi_default = _default_range(params)
     lo = lo_default if kappa_min is None else kappa_min
     hi = hi_default if kappa_max is None else kappa_max
@@ -473,8 +490,9 @@ def default_kappa_range(params: Parameters, kappa_min=None, kappa_max=None,
                                         (kappa_min, hi_default, names[1], names[0])):
         if (kappa_min is None) != (kappa_max is None) and given is not None and is_number(given) and (
                 (name == names[0] and not default < given) or (name == names[1] and not given < default)):
+            origin = f"damping number kappa v/K = {A_MIN:g}" if name == names[0] else "the largest kappa"
             raise ValueError(f"{other} = {given!r} is out of range with the default {name} = {default:.4g} "
-                             f"(damping number kappa v/K = {A_RANGE[0 if name == names[0] else 1]:g}); allowed: "
+                             f"({origin}); allowed: "
                              f"{other} {'>' if name == names[0] else '<'} {default:.4g}, or {name} given too")
     return check_kappa_range(lo, hi, names)
 
@@ -507,9 +525,7 @@ def _critical_damping(params, law, kappa_min, kappa_max, rtol, integrator_rtol, 
         m_min, m_max = (margin(lo), margin(hi))
         return CriticalDamping(law.name, law.contact, params.v, None, rtol, closed, (kappa_min, kappa_max),
                                (m_min, m_max), "not-found",
-                               f"no root of the first stick's margin for kappa in [{kappa_min:.4g}, {kappa_max:.4g}]"
-                               f" N s/m^(1+alpha): margin {m_min:.4g} at the low end, {m_max:.4g} at the high end"
-                               + (" (the stick never breaks)" if m_max >= 0 else ""), evaluations)
+                               _not_found_message(params, kappa_min, kappa_max, m_min, m_max, closed), evaluations)
     root = brentq(margin, min(a, b), max(a, b), xtol=rtol / 4, rtol=4 * np.finfo(float).eps, maxiter=200)
     kappa_c = math.exp(root)
     accuracy, spent = _kappa_c_accuracy(params, law, root, rtol, integrator_rtol)
@@ -536,6 +552,20 @@ def _critical_damping(params, law, kappa_min, kappa_max, rtol, integrator_rtol, 
     elif ok:
         result = _replace(result, classification="adding-sliding")
     return result
+
+
+def _not_found_message(params, kappa_min, kappa_max, m_min, m_max, closed) -> str:
+    """What a search without a root did: its range and the margins at its ends; a physical reading
+    only where the equations prove it (no target springs: the margin is 1 at every kappa)."""
+    limit = " (the largest kappa of the inputs)" if kappa_max == KAPPA_MAX else ""
+    text = (f"no root of the first stick's margin up to kappa = {kappa_max:.4g} N s/m^(1+alpha){limit}, searched "
+            f"from {kappa_min:.4g}: margin {m_min:.4g} at the low end, {m_max:.4g} at the high end")
+    if params.target != "plate" or (params.Kb == 0 and params.Km == 0):
+        return text + (f" (target {params.target} without springs: nothing pulls the stuck pair apart, the margin "
+                       "is 1 at every kappa)")
+    if closed is not None and closed > kappa_max:
+        return text + f"; the closed form (docs/physics.md §5) puts kappa_c at {closed:.5g}, beyond the range"
+    return text
 
 
 #: Doublings of kappa_2's bracket, at most, until the tighter tolerance confirms both its ends.
