@@ -254,8 +254,8 @@ NASTY = ["0", "-0", "-1", "1", "2", "0.5", "1e-300", "1e-15", "1e-3", "1e308", "
          "inf", "-inf", "", " ", "abc", "1,5", "0x10", "1e", "--", "3e9", "1e12", "2.5", "1e8", "1e7"]
 #: Values that could start long work are overridden at the end of the list (the random value is still
 #: parsed and checked by the parser, which is what is under test). Ranges of kappa are narrowed to a
-#: decade, so that a transition search or a grazing curve stays cheap; critical runs on a case where the
-#: stick never breaks (no kappa_2 search).
+#: decade, so that a transition search or a grazing curve stays cheap; critical runs on a case whose root
+#: lies beyond the inputs' kappa <= 1e18 (no root found, no kappa_2 search).
 FAST = {"simulate": ["--t-end", "1e-4"], "critical": ["--case", "sand-gelcoat"],
         "sweep": ["--t-end", "1e-4", "--no-progress"],
         "critical-curve": ["--samples", "8", "--no-progress"],
