@@ -573,13 +573,11 @@ PARAM_UNITS = {"M1": "kg", "M2": "kg", "K": "N/m^1.5", "Kb": "N/m", "Km": "N/m^3
 def cmd_params(args) -> int:
     from .case import hertz_scales, validity
 
-    setup = _setup(args, law=False)
-    p, case = setup.params, setup.case
-    out = {k: getattr(p, k) for k in ("M1", "M2", "K", "Kb", "Km", "alpha", "kappa", "v", "target", "R")}
-    from .model import REGISTRY  # kappa's unit is the case's law's (no law: none named)
-
-    entry = REGISTRY.get(case.impact.get("law"))
-    out["kappa_unit"] = entry.damping_unit(p.alpha) if entry is not None else None
+    setup = _setup(args)
+    p, case, law = setup.params, setup.case, setup.law
+    out = {**_law_fields(setup),
+           **{k: getattr(p, k) for k in ("M1", "M2", "K", "Kb", "Km", "alpha", "kappa", "v", "target", "R")}}
+    out["kappa_unit"] = law.damping_unit(p.alpha)
     # The Hertz scales are those of the relative motion: the reduced mass M1 M2/(M1+M2) unless the
     # target is rigid (docs/physics.md §4); say which, since a plate's figures differ from a rigid one's.
     out["hertz_mass"] = p.reduced_mass
@@ -596,8 +594,9 @@ def cmd_params(args) -> int:
         _print_json(args, out)
     else:
         print(f"case {case.name}: {case.description}" if case.description else f"case {case.name}")
+        print(f"  {'law':>23} = {law.label()}")
         for k, value in out.items():
-            if k in ("case", "validity", "target", "hertz_mass_is", "kappa_unit"):
+            if k in ("case", "validity", "target", "hertz_mass_is", "kappa_unit", *_law_fields(setup)):
                 continue
             unit = out["kappa_unit"] or KAPPA_UNIT if k == "kappa" else PARAM_UNITS.get(k, "")
             print(f"  {k:>23} = {_fmt(value, unit)}".rstrip())
@@ -721,8 +720,11 @@ def cmd_critical(args) -> int:
     out = {**_law_fields(setup), "v": result.v, "kappa_c": result.kappa_c,
            "kappa_c_accuracy": result.kappa_c_accuracy, "kappa_2": result.kappa_2,
            "kappa_2_accuracy": result.kappa_2_accuracy, "n_below": result.n_below, "n_above": result.n_above,
+           "n_below_kappa_2": result.n_below_kappa_2, "n_above_kappa_2": result.n_above_kappa_2,
            "closed_form": result.closed_form, "classification": result.classification,
-           "status": result.status, "message": result.message, "bracket": list(result.bracket),
+           "status": result.status, "kappa_c_status": result.kappa_c_status,
+           "kappa_2_status": result.kappa_2_status, "staircase_status": result.staircase_status,
+           "message": result.message, "bracket": list(result.bracket), "search_range": list(result.search_range),
            "margins": list(result.margins), "kappa_rtol": result.rtol, "rtol": args.rtol,
            "n_staircase": result.n_staircase, "evaluations": result.evaluations, "case": setup.case.as_dict()}
     if args.exponents:
@@ -731,8 +733,14 @@ def cmd_critical(args) -> int:
         _print_json(args, out)
     else:
         unit = law.damping_unit(params.alpha)
-        kc = "not found" if result.kappa_c is None else f"{result.kappa_c:.10g} {unit}"
+        kc = (f"not found up to kappa = {result.search_range[1]:g} {unit}" if result.kappa_c is None
+              else f"{result.kappa_c:.10g} {unit}")
         print(f"critical damping of {law.label()} ({setup.case.name}) at v = {params.v:g} m/s: {kc}")
+        statuses = {"kappa_c": result.kappa_c_status, "kappa_2": result.kappa_2_status,
+                    "staircase": result.staircase_status}
+        print("  " + ", ".join(f"{name} {status}" for name, status in statuses.items() if status is not None)
+              + (f"; counts just below / above kappa_c: {_fmt(result.n_below, '', 'd')} / "
+                 f"{_fmt(result.n_above, '', 'd')}" if result.kappa_c is not None else ""))
         print(f"  closed form {_fmt(result.closed_form, unit)}; kappa_2 (N = 2 from here on) "
               f"{_fmt(result.kappa_2, unit, '.10g')}; classification {result.classification or 'none'}")
         if result.n_staircase:
@@ -1492,6 +1500,7 @@ def build_parser() -> argparse.ArgumentParser:
             "The derived parameters (seed eq. 3-5) of a case, its Hertz scales (contact time, plate period, "
             "indentation, peak force, contact radius, peak pressure) and whether elastic Hertz contact holds.")
     case_options(p)
+    law_options(p)
     speed(p)
     damping(p, "not read by the scales")
     target(p)

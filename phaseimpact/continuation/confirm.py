@@ -18,7 +18,7 @@ import numpy as np
 from ..integrate import simulate
 from ..integrate.events import EVENT_KINDS
 
-__all__ = ["CONFIRM_FACTOR", "ConfirmedCount", "confirmed_count", "stick_sequence_violation", "tighter"]
+__all__ = ["CONFIRM_FACTOR", "ConfirmedCount", "confirmed_count", "resolution", "stick_sequence_violation", "tighter"]
 
 _STICK, _SLIP, _REVERSAL = (EVENT_KINDS.index(k) for k in ("stick", "slip", "reversal"))
 _ESCAPES = ("ratchet-escape", "runaway", "rebound")
@@ -48,22 +48,61 @@ def tighter(rtol: float) -> float:
     return max(rtol / CONFIRM_FACTOR, _RTOL_FLOOR)
 
 
-def stick_sequence_violation(trajectory) -> str | None:
+def resolution(rtol: float, x1, x2, scale: float):
+    """The smallest difference of ``x1 - x2`` a run at ``rtol`` resolves: ``rtol (|x1| + |x2| + 2 scale)``
+    plus the rounding of the difference.
+
+    The integrator keeps the error of each step within ``rtol |x| + atol`` for each component,
+    with ``atol = rtol scale`` (positions: ``scale`` the Hertz indentation; velocities: the impact
+    speed; :func:`~phaseimpact.integrate.api.state_tolerances`); a difference of two components
+    below the sum of their allowances is not resolved by the run, so it cannot break an invariant.
+
+    Parameters
+    ----------
+    rtol : float
+        The run's integrator tolerance.
+    x1, x2 : float or ndarray
+        The two components (m, or m/s).
+    scale : float
+        The scale of their absolute tolerance (m, or m/s).
+
+    Returns
+    -------
+    float or ndarray
+
+    Examples
+    --------
+    >>> from phaseimpact.continuation.confirm import resolution
+    >>> print(f"{resolution(1e-12, 1.4546e-3, 1.4318e-3, 1.382e-4):.3g} m")
+    3.17e-15 m
+    """
+    rounding = 16 * np.finfo(float).eps * (np.abs(x1) + np.abs(x2))
+    return rtol * (np.abs(x1) + np.abs(x2) + 2 * scale) + rounding
+
+
+def stick_sequence_violation(trajectory, rtol: float = 1e-10) -> str | None:
     """Why the stick phases of a ``paper`` run cannot be the motion of eq. 8, or None.
 
     Three invariants hold whatever the tolerance:
 
     * a slip from one stick to the next (no reversal between) moves ``delta`` in the direction of
-      its mode: an outward slip (``deltadot > 0``) re-sticks deeper, an inward one shallower
-      (to the rounding of ``delta``);
+      its mode: an outward slip (``deltadot > 0``) re-sticks deeper, an inward one shallower;
     * the break of the first stick is followed by a second stick: the first slip above
       ``kappa_c`` goes deeper and is damped, so an escape right after it is a missed re-stick;
     * a run that ends slipping has ``deltadot`` of its mode's sign (else its zero was stepped over).
+
+    Each is tested within what the run resolves (:func:`resolution`): a re-stick against its slip's
+    direction by less than ``rtol (|x1| + |x2| + 2 delta_H)`` at each of the two sticks (``delta_H``
+    the Hertz indentation, the positions' absolute tolerance over ``rtol``), or a final
+    ``deltadot`` of the wrong sign by less than ``rtol (|x1dot| + |x2dot| + 2 v)``, is within the
+    integrator's error and no violation; anything larger is.
 
     Parameters
     ----------
     trajectory : Trajectory
         A run of ``paper`` (or another Filippov law); a summary run is enough (the event log).
+    rtol : float, default 1e-10
+        The integrator tolerance the run was made with.
 
     Returns
     -------
@@ -80,16 +119,18 @@ def stick_sequence_violation(trajectory) -> str | None:
     kinds = trajectory.event_kind
     y = trajectory.event_y
     delta = y[:, 0] - y[:, 1]
-    rounding = 16 * np.finfo(float).eps * (np.abs(y[:, 0]) + np.abs(y[:, 1]))
+    params = trajectory.params
+    resolved = resolution(rtol, y[:, 0], y[:, 1], params.hertz_indentation)
     stuck_at, slip_mode = None, 0
     for i, kind in enumerate(kinds):
         if kind == _STICK:
-            if stuck_at is not None and slip_mode != 0 and \
-                    (delta[i] - delta[stuck_at]) * slip_mode < -(rounding[i] + rounding[stuck_at]):
+            tolerance = resolved[i] + resolved[stuck_at] if stuck_at is not None else 0.0
+            if stuck_at is not None and slip_mode != 0 and (delta[i] - delta[stuck_at]) * slip_mode < -tolerance:
                 direction = "shallower" if slip_mode > 0 else "deeper"
                 return (f"the slip of mode {slip_mode:+d} that began at t = {trajectory.event_t[stuck_at]:.9g} s "
-                        f"re-stuck {direction} than it stuck (delta {delta[stuck_at]:.12g} -> {delta[i]:.12g} m), "
-                        "against its direction")
+                        f"re-stuck {direction} than it stuck (delta {delta[stuck_at]:.12g} -> {delta[i]:.12g} m, "
+                        f"{abs(delta[i] - delta[stuck_at]):.3g} m against its direction, more than the "
+                        f"{tolerance:.3g} m the run resolves at rtol {rtol:g})")
             stuck_at, slip_mode = i, 0
         elif kind == _SLIP:
             slip_mode = int(trajectory.event_mode[i])
@@ -99,7 +140,7 @@ def stick_sequence_violation(trajectory) -> str | None:
         return "the first stick broke and the run escaped without a second stick (a missed re-stick)"
     mode, final = trajectory.final_mode, trajectory.final_state
     deltadot = final[2] - final[3]
-    if mode in (1, -1) and deltadot * mode < -16 * np.finfo(float).eps * (abs(final[2]) + abs(final[3])):
+    if mode in (1, -1) and deltadot * mode < -resolution(rtol, final[2], final[3], params.v):
         return f"the run ended slipping in mode {mode:+d} with deltadot = {deltadot:.3g} m/s of the other sign"
     return None
 
@@ -149,7 +190,7 @@ def _count(params, law, rtol):
     run = simulate(params, law, None, rtol=rtol)
     if run.status != "success":
         return run, f"the run at rtol {rtol:g} failed: {run.message}"
-    return run, stick_sequence_violation(run)
+    return run, stick_sequence_violation(run, rtol)
 
 
 def confirmed_count(params, law, rtol: float) -> ConfirmedCount:

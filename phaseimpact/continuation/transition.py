@@ -231,7 +231,7 @@ def closed_form_kappa_c(params: Parameters) -> float | None:
     lo = math.log(A_MIN)
     if gap(lo) <= 0:
         return None
-    hi = lo + math.log(1e8)
+    hi = math.log(1e8)
     while gap(hi) > 0:
         hi += math.log(1e8)
         if hi > math.log(1e100):  # a * a would overflow: no estimate
@@ -338,6 +338,9 @@ class CriticalDamping:
         Relative width of ``kappa_2``'s final bracket, whose ends are confirmed (N = 2 above, N != 2
         below) at the tighter tolerance; None when they are not.
     n_below, n_above : int or None
+        Stick phases just below ``kappa_c`` (1: the permanent stick) and just above it, at
+        ``kappa_c (1 -+ SIDE_OFFSET)``; None where the count is not confirmed.
+    n_below_kappa_2, n_above_kappa_2 : int or None
         Stick phases just below ``kappa_2`` (at its bracket's lower end, confirmed) and above it (2).
     n_staircase : list of dict
         ``{"kappa", "relative", "n_stick", "t_run", "cut", "confirmed", "reason"}`` sampled from
@@ -348,7 +351,18 @@ class CriticalDamping:
     exponents : dict or None
         :func:`adding_sliding_exponents`, when asked for.
     status : {"success", "not-found", "unconfirmed", "failed"}
-        ``failed``: a run of the search failed numerically (the message says which).
+        The whole result: ``success`` only when every quantity below is confirmed; ``failed``: a
+        run of the search failed numerically (the message says which).
+    kappa_c_status : {"confirmed", "unconfirmed", "not-found", "failed"}
+        ``kappa_c`` alone: confirmed by the counts either side (1 permanent stick below, a break
+        above), each confirmed (:func:`.confirm.confirmed_count`).
+    kappa_2_status : {"confirmed", "unconfirmed", "not-found"} or None
+        ``kappa_2`` alone: both ends of its bracket confirmed; None when not located (not asked
+        for, or ``kappa_c`` unconfirmed).
+    staircase_status : {"confirmed", "unconfirmed"} or None
+        Every count of :attr:`n_staircase` confirmed, or some not (their ``reason`` says why);
+        None without a staircase. An unconfirmed count leaves ``kappa_c`` and ``kappa_2``
+        confirmed where they are.
 
     Examples
     --------
@@ -375,10 +389,15 @@ class CriticalDamping:
     kappa_2_accuracy: float | None = None
     n_below: int | None = None
     n_above: int | None = None
+    n_below_kappa_2: int | None = None
+    n_above_kappa_2: int | None = None
     n_staircase: list = field(default_factory=list)
     classification: str | None = None
     exponents: dict | None = None
     search_range: tuple = ()
+    kappa_c_status: str | None = None
+    kappa_2_status: str | None = None
+    staircase_status: str | None = None
 
     def as_dict(self) -> dict:
         """The fields as a plain dict (for JSON).
@@ -468,7 +487,8 @@ def critical_damping(params: Parameters, law: ContactLaw | str = "paper", *, kap
                                    with_exponents, closed)
     except RunFailed as error:
         result = CriticalDamping(law.name, law.contact, params.v, None, rtol, closed, (kappa_min, kappa_max),
-                                 (math.nan, math.nan), "failed", f"a run of the search failed: {error}", 0)
+                                 (math.nan, math.nan), "failed", f"a run of the search failed: {error}", 0,
+                                 kappa_c_status="failed")
     return _replace(result, search_range=(kappa_min, kappa_max))
 
 
@@ -525,7 +545,8 @@ def _critical_damping(params, law, kappa_min, kappa_max, rtol, integrator_rtol, 
         m_min, m_max = (margin(lo), margin(hi))
         return CriticalDamping(law.name, law.contact, params.v, None, rtol, closed, (kappa_min, kappa_max),
                                (m_min, m_max), "not-found",
-                               _not_found_message(params, kappa_min, kappa_max, m_min, m_max, closed), evaluations)
+                               _not_found_message(params, kappa_min, kappa_max, m_min, m_max, closed), evaluations,
+                               kappa_c_status="not-found")
     root = brentq(margin, min(a, b), max(a, b), xtol=rtol / 4, rtol=4 * np.finfo(float).eps, maxiter=200)
     kappa_c = math.exp(root)
     accuracy, spent = _kappa_c_accuracy(params, law, root, rtol, integrator_rtol)
@@ -543,7 +564,9 @@ def _critical_damping(params, law, kappa_min, kappa_max, rtol, integrator_rtol, 
             else "; the counts either side do not show a permanent stick below and a break above"
     result = CriticalDamping(law.name, law.contact, params.v, kappa_c, rtol, closed, (kappa_lo, kappa_hi),
                              (float(m_a), float(m_b)), "success" if ok else "unconfirmed", message, evaluations,
-                             kappa_c_accuracy=accuracy)
+                             kappa_c_accuracy=accuracy, n_below=below.n_stick if below.confirmed else None,
+                             n_above=above.n_stick if above.confirmed else None,
+                             kappa_c_status="confirmed" if ok else "unconfirmed")
     if with_kappa_2 and ok:
         result = _with_kappa_2(result, params, law, integrator_rtol)
     if with_exponents and ok:
@@ -606,16 +629,18 @@ def _with_kappa_2(result: CriticalDamping, params, law, integrator_rtol) -> Crit
     message = result.message + (f"; kappa_2 = {kappa_2:.10g}, estimated relative error {_fmt_accuracy(accuracy)}"
                                 if kappa_2 is not None else "")
     unconfirmed = [s for s in staircase if not s["confirmed"]]
-    status = result.status
+    kappa_2_status = "not-found" if kappa_2 is None else ("unconfirmed" if reason else "confirmed")
+    staircase_status = None if not staircase else ("unconfirmed" if unconfirmed else "confirmed")
     if reason:
-        status, message = "unconfirmed", f"{message}; kappa_2 unconfirmed: {reason}"
+        message = f"{message}; kappa_2 {kappa_2_status}: {reason}"
     if unconfirmed:
-        status = "unconfirmed"
         message += (f"; {len(unconfirmed)} of {len(staircase)} staircase counts unconfirmed (first: "
                     f"{unconfirmed[0]['reason']})")
-    return _replace(result, kappa_2=kappa_2, kappa_2_accuracy=accuracy, n_below=found.n_below,
-                    n_above=2 if kappa_2 is not None else None, n_staircase=staircase,
-                    evaluations=result.evaluations + found.evaluations, status=status, message=message)
+    status = result.status if kappa_2_status == "confirmed" and staircase_status != "unconfirmed" else "unconfirmed"
+    return _replace(result, kappa_2=kappa_2, kappa_2_accuracy=accuracy, n_below_kappa_2=found.n_below,
+                    n_above_kappa_2=2 if kappa_2 is not None else None, n_staircase=staircase,
+                    evaluations=result.evaluations + found.evaluations, status=status, message=message,
+                    kappa_2_status=kappa_2_status, staircase_status=staircase_status)
 
 
 def _replace(result: CriticalDamping, **changes) -> CriticalDamping:
@@ -714,7 +739,7 @@ def locate_kappa_2(params: Parameters, law: ContactLaw | str, kappa_c: float, *,
         nonlocal evaluations
         evaluations += 1
         run = simulate(params.replace(kappa=kappa_c * (1 + eps)), law, None, rtol=integrator_rtol)
-        violation = stick_sequence_violation(run) if run.status == "success" else run.message
+        violation = stick_sequence_violation(run, integrator_rtol) if run.status == "success" else run.message
         return run.n_stick, violation
 
     def confirmed(eps):
@@ -1246,5 +1271,5 @@ def transitions(params: Parameters, law: ContactLaw | str, kappa_min: float, kap
     if critical.kappa_c is not None:
         out.append(Transition("adding-sliding", critical.kappa_c, 1, None))
     if critical.kappa_2 is not None and critical.kappa_2 <= kappa_max:
-        out.append(Transition("staircase-end", critical.kappa_2, critical.n_below, 2))
+        out.append(Transition("staircase-end", critical.kappa_2, critical.n_below_kappa_2, 2))
     return out
