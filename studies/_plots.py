@@ -128,10 +128,11 @@ def outcome_of(trajectory) -> str:
     return trajectory.outcome
 
 
-def missed_restick(trajectory) -> bool:
-    """Whether the engine visibly missed a re-stick of ``paper`` (a library defect): the run
-    breaks an invariant of eq. 8 (:func:`phaseimpact.continuation.stick_sequence_violation`)."""
-    return stick_sequence_violation(trajectory) is not None
+def missed_restick(trajectory, rtol: float = COUNT_RTOL) -> bool:
+    """Whether the engine visibly missed a re-stick of ``paper`` (a library defect): the run, made at
+    ``rtol``, breaks an invariant of eq. 8 beyond what it resolves
+    (:func:`phaseimpact.continuation.stick_sequence_violation`)."""
+    return stick_sequence_violation(trajectory, rtol) is not None
 
 
 def log_ticks(axis, ticks) -> None:
