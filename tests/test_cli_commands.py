@@ -12,6 +12,7 @@ from __future__ import annotations
 import importlib
 import json
 import math
+import re
 import shlex
 from pathlib import Path
 
@@ -103,6 +104,19 @@ def test_params_json_has_hertz_scales_and_validity():
                                                  rel=1e-12)
     plate = run_json(["params"])
     assert plate["plate_period"] == pytest.approx(2 * math.pi * math.sqrt(plate["M2"] / plate["Kb"]), rel=1e-12)
+
+
+def test_params_takes_law_like_every_other_command():
+    """Issue 42 item 5: params --law (it needed --set law=...); the law is named, checked and used."""
+    by_option = run_json(["params", "--case", "sand-gelcoat", "--law", "thornton"])
+    by_setting = run_json(["params", "--case", "sand-gelcoat", "--set", "law=thornton"])
+    assert by_option["law"] == by_setting["law"] == "thornton"
+    assert by_option["yield_velocity"] == by_setting["yield_velocity"] > 0
+    assert by_option["kappa_unit"] == by_setting["kappa_unit"]
+    code, text, _ = run(["params", "--case", "sand-gelcoat", "--law", "thornton"])
+    assert code == 0 and re.search(r"law = thornton\n", text) and "yield_velocity" in text
+    code, _, err = run(["params", "--law", "abrate", "--kappa", "3"])
+    assert code == 2 and "kappa = 3.0 is not read by law 'abrate'" in err
 
 
 def test_set_changes_the_derived_parameters_and_is_recorded_in_the_case():
