@@ -10,7 +10,7 @@ no stop when settled (the state at ``t_end`` is then defined for everyone). Erro
 Contenders:
 
 - ours: ``simulate(params, law, 2e-3, rtol=r, stop_when_settled=False)``, rtol 1e-4..1e-13;
-- scipy with the same events: the oracle (``tests/oracle.py``: ``solve_ivp`` on the same law
+- scipy with the same events: the oracle (``phaseimpact/_oracle.py``: ``solve_ivp`` on the same law
   entries, the same event table, phase by phase) with ``method`` DOP853, RK45, Radau, BDF, LSODA;
   its max force is located on the force-peak event;
 - plain scipy: ``solve_ivp`` on the same right-hand side without events (``paper``: eq. 8 read
@@ -38,11 +38,9 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from _common import FIGURES, RESULTS, ROOT, emit, load, machine, save_section, save_targets, table, target  # noqa: E402
+from _common import FIGURES, RESULTS, emit, load, machine, save_section, save_targets, table, target  # noqa: E402
 
-sys.path.insert(0, str(ROOT / "tests"))
-import oracle as oracle_module  # noqa: E402
-
+from phaseimpact import _oracle as oracle_module  # noqa: E402
 from phaseimpact import seed_parameters, simulate  # noqa: E402
 from phaseimpact.integrate import api  # noqa: E402
 from phaseimpact.model import as_law, pack  # noqa: E402
