@@ -565,7 +565,7 @@ def cmd_check_law(args) -> int:
 
     if args.law in REGISTRY:
         names = [args.law]
-    elif args.law.endswith(".py") or os.path.lexists(args.law):
+    elif args.law.endswith(".py"):
         names = _checked_law_file(args.law)
     else:
         raise ValueError(f"law = {args.law!r} is neither a registered law nor a .py file; allowed: "

@@ -26,35 +26,39 @@ ROOT = Path(__file__).resolve().parents[1]
 
 HEAD = "import math\nimport phaseimpact\n\n\n"
 #: The audit's laws (../shared/audits/inputs-2026-11b.md), written from their descriptions, and the
-#: check each must fail. define_law samples delta up to 2e-5; "deep" means beyond, where check-law looks.
+#: checks each must fail (together: every check). define_law samples delta up to 2e-5; "deep" is
+#: beyond, where check-law looks.
 LAWS = {
     "nan-deep": ("def force(delta, deltadot, K, kappa, alpha):\n"
-                 "    return math.nan if delta > 3e-5 else K * delta**alpha\n", "force"),
+                 "    return math.nan if delta > 3e-5 else K * delta**alpha\n",
+                 ("force", "repulsive", "partials", "energy ledger", "momentum", "scipy", "oracle")),
     "inf-deep": ("def force(delta, deltadot, K, kappa, alpha):\n"
-                 "    return math.inf if delta > 3e-5 else K * delta**alpha\n", "force"),
+                 "    return math.inf if delta > 3e-5 else K * delta**alpha\n", ("force", "partials", "momentum")),
     "huge": ("def force(delta, deltadot, K, kappa, alpha):\n"
-             "    return 1e300 * delta if delta > 0 else 0.0\n", "energy ledger"),
+             "    return 1e300 * delta if delta > 0 else 0.0\n", ("energy ledger", "momentum", "scipy", "oracle")),
     "intret": ("def force(delta, deltadot, K, kappa, alpha):\n"
-               "    return float(int(K * delta**alpha)) if delta > 0 else 0.0\n", "scipy"),
+               "    return float(int(K * delta**alpha)) if delta > 0 else 0.0\n",
+               ("energy ledger", "momentum", "scipy", "oracle")),
     "negative": ("def force(delta, deltadot, K, kappa, alpha):\n"
-                 "    return -K * delta**alpha if delta > 0 else 0.0\n", "repulsive"),
+                 "    return -K * delta**alpha if delta > 0 else 0.0\n", ("repulsive", "scipy", "oracle")),
     # eq. 8's sign factor on the elastic term, not declared Filippov: the bodies stick at deltadot = 0
     "sticky": ("def force(delta, deltadot, K, kappa, alpha):\n"
                "    s = 1.0 if deltadot >= 0 else -1.0\n"
-               "    return (K * s + kappa * deltadot) * delta**alpha if delta > 0 else 0.0\n", "force"),
+               "    return (K * s + kappa * deltadot) * delta**alpha if delta > 0 else 0.0\n",
+               ("force", "energy ledger", "momentum", "scipy", "oracle")),
     "wrong-partials": ("def force(delta, deltadot, K, kappa, alpha):\n"
                        "    return (K + kappa * deltadot) * delta**alpha if delta > 0 else 0.0\n"
                        "def partials(delta, deltadot, K, kappa, alpha):\n"
-                       "    return 1.4 * K * delta**0.5, kappa * delta**alpha\n", "partials"),
+                       "    return 1.4 * K * delta**0.5, kappa * delta**alpha\n", ("partials",)),
     "wrong-potential": ("def force(delta, deltadot, K, kappa, alpha):\n"
                         "    return (K + kappa * deltadot) * delta**alpha if delta > 0 else 0.0\n"
                         "def potential(delta, K, alpha):\n"
-                        "    return K * delta**(alpha + 1)\n", "energy ledger"),
+                        "    return K * delta**(alpha + 1)\n", ("energy ledger",)),
 }
 
 
 def _law_file(tmp_path, name):
-    source, _ = LAWS[name]
+    source = LAWS[name][0]
     options = ", ".join(f"{o}={o}" for o in ("partials", "potential") if f"def {o}(" in source)
     path = tmp_path / f"{name}.py"
     path.write_text(HEAD + source + f"\n\nphaseimpact.define_law({name!r}, force{', ' + options if options else ''})\n")
@@ -88,18 +92,24 @@ def test_a_verdict_is_a_python_bool_or_none():
     assert LawReport("x", [Verdict("force", True, ""), Verdict("scipy", None, "")]).passed is True
 
 
+def test_the_failing_laws_cover_every_check():
+    names = {v.check for v in check_law("hunt-crossley").verdicts}
+    assert names == {"force", "repulsive", "partials", "energy ledger", "momentum", "scipy", "oracle"}
+    assert set().union(*(failing for _, failing in LAWS.values())) == names
+
+
 @pytest.mark.slow
 @pytest.mark.parametrize("name", list(LAWS))
 def test_a_law_failing_a_check_makes_check_law_fail(tmp_path, capsys, name):
-    """Each audit law and each wrong law fails its check, with exit 1 and passed = false (the
+    """Each audit law and each wrong law fails its checks, with exit 1 and passed = false (the
     negative law printed FAIL oracle and exited 0); every line a verdict, no warning or traceback."""
-    failing = LAWS[name][1]
     code, out, err = _check_law_cli(capsys, _law_file(tmp_path, name), "--json")
     assert code == 1, out + err
     report = json.loads(out)
     assert report["passed"] is False and report["laws"][0]["passed"] is False
     verdicts = {c["check"]: c for c in report["laws"][0]["checks"]}
-    assert verdicts[failing]["passed"] is False, verdicts[failing]
+    for check in LAWS[name][1]:
+        assert verdicts[check]["passed"] is False, verdicts[check]
     assert "Traceback" not in err and "Warning" not in err
 
 
