@@ -71,7 +71,7 @@ from scipy.integrate import solve_ivp
 
 from phaseimpact.model.laws import ContactLaw, contact_force
 
-__all__ = ["OracleRun", "oracle", "compare", "Agreement", "BudgetExceeded"]
+__all__ = ["OracleRun", "oracle", "compare", "Agreement", "Budget", "BudgetExceeded"]
 
 # Relative state z = (delta, x2, deltadot, x2dot, W).
 D, X2, DD, V2, W = range(5)
