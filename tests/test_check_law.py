@@ -140,6 +140,18 @@ def test_the_oracle_run_has_a_budget():
     assert full.nfev > 100
 
 
+@pytest.mark.slow
+def test_the_oracle_ends_a_run_that_scipy_cannot_integrate():
+    """A force that is NaN beyond 3e-5 m: scipy's step fails there, and the oracle stops with the
+    reason "failed" (before, it restarted the failed phase up to 100 000 times)."""
+    import math
+
+    phaseimpact.define_law("nan-deep-oracle", lambda d, dd, K, k, a: math.nan if d > 3e-5 else K * d**a)
+    run = oracle(seed_parameters(v=1.0, kappa=3e9), "nan-deep-oracle", 4e-3, rtol=1e-12, max_nfev=100_000)
+    assert run.reason == "failed"
+    assert run.t_stop < 4e-3
+
+
 def test_every_run_of_the_checks_has_a_budget(monkeypatch):
     """Runs past their budget are failed verdicts that say so (before, the scipy runs had none:
     a grinding law ran 480 s without a verdict)."""
