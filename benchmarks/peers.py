@@ -7,7 +7,7 @@ The work-precision problem of ``work_precision.py`` for Hunt-Crossley: seed case
 (``seed_parameters(v=1, kappa=3e9)``), ``t_end = 2e-3`` s, no stop when settled (two contacts
 and the flights after them), errors (a) of the max force (relative) and (b) of the state at
 ``t_end`` (positions over the Hertz indentation ``L``, velocities over ``v``), both against the
-scipy oracle (``tests/oracle.py``) at rtol 1e-13, the same reference as ``work_precision.py``.
+scipy oracle (``phaseimpact/_oracle.py``) at rtol 1e-13, the same reference as ``work_precision.py``.
 
 - ours: ``simulate(params, "hunt-crossley", 2e-3, rtol=r, stop_when_settled=False)``, rtol
   1e-4..1e-13.
@@ -233,11 +233,10 @@ def main(argv=None) -> int:
     import numpy as np
 
     sys.path.insert(0, str(HERE))
-    sys.path.insert(0, str(ROOT / "tests"))
     from _common import emit, load, machine, save_section, table
-    from oracle import oracle
 
     from phaseimpact import seed_parameters, simulate
+    from phaseimpact._oracle import oracle
 
     rtols, tols, repeats = OURS_RTOLS, HEYOKA_TOLS, 5
     if args.quick:

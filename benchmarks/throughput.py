@@ -3,7 +3,7 @@ the scipy oracle; and the 20,000-``kappa`` sweep through the command line, start
 
 Seed case, v = 1 m/s, ``N`` kappa log-spaced in [1e8, 1e13], each run until its outcome settles
 (rtol 1e-10), for ``paper`` (the command line's example) and ``hunt-crossley``. The in-process
-contenders take turns within each repeat (medians); the oracle loop (``tests/oracle.py``:
+contenders take turns within each repeat (medians); the oracle loop (``phaseimpact/_oracle.py``:
 ``solve_ivp`` DOP853 with the same events) is timed on a random subset and extrapolated. The
 command line is timed as a whole process (``phaseimpact sweep ... --out X.h5 --no-progress``,
 median of 3), with ``--jobs 1`` (its default) and ``--jobs 2``.
@@ -24,12 +24,10 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from _common import ROOT, VENV_BIN, emit, load, machine, save_section, save_targets, table, target  # noqa: E402
-
-sys.path.insert(0, str(ROOT / "tests"))
-from oracle import oracle  # noqa: E402
+from _common import VENV_BIN, emit, load, machine, save_section, save_targets, table, target  # noqa: E402
 
 from phaseimpact import seed_parameters, simulate, simulate_many  # noqa: E402
+from phaseimpact._oracle import oracle  # noqa: E402
 from phaseimpact.continuation import sweep  # noqa: E402
 
 LAWS = ("paper", "hunt-crossley")

@@ -3,7 +3,7 @@
 The seed plate, Hunt-Crossley contact (kappa = 3e9, 1 m/s), one projectile every 3 ms (three plate
 periods): the median time of one map evaluation (a 200-impact train divided by 200: the engine's
 run over the period plus its Python layer) next to the same map integrated by the scipy oracle
-(``tests/oracle.py``, ``solve_ivp`` DOP853 with the same events), with the two maps' difference
+(``phaseimpact/_oracle.py``, ``solve_ivp`` DOP853 with the same events), with the two maps' difference
 after one impact; then an orbit diagram over T (values x impacts, threads), timed at a size this
 machine runs in seconds and extrapolated linearly in values x impacts to issue 26's 1000 x 500;
 with ``--full``, the 1000 x 500 diagram itself on 2 threads (about a minute).
@@ -22,12 +22,10 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from _common import ROOT, emit, load, machine, save_section, save_targets, table, target  # noqa: E402
-
-sys.path.insert(0, str(ROOT / "tests"))
-from oracle import oracle  # noqa: E402
+from _common import emit, load, machine, save_section, save_targets, table, target  # noqa: E402
 
 from phaseimpact import seed_parameters  # noqa: E402
+from phaseimpact._oracle import oracle  # noqa: E402
 from phaseimpact.train import impact_map, impact_train, orbit_diagram  # noqa: E402
 
 PERIOD = 3e-3

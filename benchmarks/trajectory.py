@@ -11,7 +11,7 @@ Seed case ``seed_parameters(v=1.0, kappa=3e9)``, rtol 1e-10, summary, stop when 
 Columns: the median time of one ``simulate`` call; of one ``driver.run`` inside a compiled
 (numba) loop, i.e. the engine without any Python; the difference (the Python layer: argument
 checks, packing, the Trajectory); and ``driver.run`` called from Python. Alternatives: the
-scipy oracle (``tests/oracle.py``: ``solve_ivp`` DOP853 on the same law entries with the same
+scipy oracle (``phaseimpact/_oracle.py``: ``solve_ivp`` DOP853 on the same law entries with the same
 events, phase by phase) and a plain ``solve_ivp`` DOP853 run on the same right-hand side
 without events (what a user would write; its max force is only the largest over its steps).
 Errors: max force, restitution (Hunt-Crossley) or the slip time and stick depth (paper),
@@ -33,12 +33,10 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from _common import ROOT, emit, load, machine, per_call, save_section, save_targets, table, target, us  # noqa: E402
-
-sys.path.insert(0, str(ROOT / "tests"))
-from oracle import oracle  # noqa: E402
+from _common import emit, load, machine, per_call, save_section, save_targets, table, target, us  # noqa: E402
 
 from phaseimpact import seed_parameters, simulate  # noqa: E402
+from phaseimpact._oracle import oracle  # noqa: E402
 from phaseimpact.integrate import api  # noqa: E402
 from phaseimpact.integrate import driver as d  # noqa: E402
 from phaseimpact.model import as_law, pack  # noqa: E402

@@ -10,7 +10,7 @@ no stop when settled (the state at ``t_end`` is then defined for everyone). Erro
 Contenders:
 
 - ours: ``simulate(params, law, 2e-3, rtol=r, stop_when_settled=False)``, rtol 1e-4..1e-13;
-- scipy with the same events: the oracle (``tests/oracle.py``: ``solve_ivp`` on the same law
+- scipy with the same events: the oracle (``phaseimpact/_oracle.py``: ``solve_ivp`` on the same law
   entries, the same event table, phase by phase) with ``method`` DOP853, RK45, Radau, BDF, LSODA;
   its max force is located on the force-peak event;
 - plain scipy: ``solve_ivp`` on the same right-hand side without events (``paper``: eq. 8 read
@@ -38,11 +38,9 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from _common import FIGURES, RESULTS, ROOT, emit, load, machine, save_section, save_targets, table, target  # noqa: E402
+from _common import FIGURES, RESULTS, emit, load, machine, save_section, save_targets, table, target  # noqa: E402
 
-sys.path.insert(0, str(ROOT / "tests"))
-import oracle as oracle_module  # noqa: E402
-
+from phaseimpact import _oracle as oracle_module  # noqa: E402
 from phaseimpact import seed_parameters, simulate  # noqa: E402
 from phaseimpact.integrate import api  # noqa: E402
 from phaseimpact.model import as_law, pack  # noqa: E402
@@ -58,58 +56,32 @@ ERRORS = ("max force", "state at t_end")
 OURS = "ours (compiled driver)"
 
 
-class _Timeout(Exception):
-    pass
-
-
-class Budget:
-    """A deadline for the scipy runs: the right-hand side they call raises after it."""
-
-    def __init__(self):
-        self.deadline = math.inf
-
-    def _check(self):
-        if time.perf_counter() > self.deadline:
-            raise _Timeout
-
-    def rhs(self, *args):
-        self._check()
-        return rhs(*args)
-
-    def force(self, *args):
-        self._check()
-        return oracle_force(*args)
-
-
-BUDGET = Budget()
-oracle_force = oracle_module.contact_force
-oracle_module.contact_force = BUDGET.force  # the oracle's one engine function (the law), with the deadline
-
-
 def scale_of(params):
     s = params.hertz_indentation
     return np.array([s, s, params.v, params.v])
 
 
-def run_ours(params, law, rtol):
+def run_ours(params, law, rtol, seconds=None):  # the compiled run has no deadline (it is the fast one)
     tr = simulate(params, law, T_END, rtol=rtol, stop_when_settled=False)
     return tr.max_force, tr.final_state[:4], tr.nfev, tr.status
 
 
-def run_oracle(params, law, rtol, method):
-    run = oracle_module.oracle(params, law, T_END, rtol=rtol, method=method, settle=False)
+def run_oracle(params, law, rtol, method, seconds=None):
+    run = oracle_module.oracle(params, law, T_END, rtol=rtol, method=method, settle=False, seconds=seconds)
     status = "success" if run.t_stop >= T_END * (1 - 1e-12) else f"stopped at {run.t_stop:.3g} s ({run.reason})"
     return run.max_force, run.final_state[:4], run.nfev, status
 
 
-def run_plain(params, law, rtol, method):
+def run_plain(params, law, rtol, method, seconds=None):
     law = as_law(law)
     c = pack(params, law)
     mode = PLAIN if law.is_filippov else 1
+    budget = oracle_module.Budget(seconds=seconds)
 
     def fun(_t, y):
+        budget.spend()
         out = np.empty(5)
-        BUDGET.rhs(law.code, c, y, mode, out)
+        rhs(law.code, c, y, mode, out)
         return out
 
     with warnings.catch_warnings(), np.errstate(all="ignore"):  # the chattering runs overflow their Jacobians
@@ -122,17 +94,15 @@ def run_plain(params, law, rtol, method):
 
 
 def measure(fn, repeats, budget):
-    """(median time, result) of ``fn``; one run only if it is slow; None if over ``budget``."""
+    """(median time, result) of ``fn(seconds)``; one run only if it is slow; None if over ``budget``
+    seconds (the scipy runs raise :class:`~phaseimpact._oracle.BudgetExceeded` past it)."""
     times, result = [], None
     for _ in range(repeats):
-        BUDGET.deadline = time.perf_counter() + budget
         start = time.perf_counter()
         try:
-            result = fn()
-        except _Timeout:
+            result = fn(budget)
+        except oracle_module.BudgetExceeded:
             return None
-        finally:
-            BUDGET.deadline = math.inf
         times.append(time.perf_counter() - start)
         if times[-1] > 0.5:
             break
@@ -142,7 +112,7 @@ def measure(fn, repeats, budget):
         for _ in range(repeats):
             start = time.perf_counter()
             for _ in range(number):
-                fn()
+                fn(None)
             times.append((time.perf_counter() - start) / number)
     return statistics.median(times), result
 
@@ -172,12 +142,14 @@ def main(argv=None) -> int:
         floors[law] = (abs(f13 / ref_force - 1), float(np.max(np.abs(s13 - ref_state) / scale)))
         emit(f"{law}: reference max force {ref_force!r} N; ours at 1e-13 differs by {floors[law][0]:.1e} (force), "
              f"{floors[law][1]:.1e} (state)")
-        contenders = [(OURS, lambda r, law=law: run_ours(params, law, r))]
-        contenders += [(f"scipy {m} + events", lambda r, m=m, law=law: run_oracle(params, law, r, m)) for m in METHODS]
-        contenders += [(f"scipy {m}, no events", lambda r, m=m, law=law: run_plain(params, law, r, m)) for m in METHODS]
+        contenders = [(OURS, lambda r, s, law=law: run_ours(params, law, r, s))]
+        contenders += [(f"scipy {m} + events", lambda r, s, m=m, law=law: run_oracle(params, law, r, m, s))
+                       for m in METHODS]
+        contenders += [(f"scipy {m}, no events", lambda r, s, m=m, law=law: run_plain(params, law, r, m, s))
+                       for m in METHODS]
         for label, fn in contenders:
             for r in rtols:
-                got = measure(lambda fn=fn, r=r: fn(r), repeats, budget)
+                got = measure(lambda s, fn=fn, r=r: fn(r, s), repeats, budget)
                 if got is None:
                     rows.append((law, label, f"{r:.0e}", f"> {budget:g} s", "", "", "", "abandoned (budget)"))
                     emit(f"{law:14s} {label:26s} rtol={r:.0e} abandoned after {budget:g} s")

@@ -524,16 +524,49 @@ def cmd_completion(args) -> int:
     return EXIT_OK
 
 
+def _checked_law_file(path: str) -> list:
+    """Load the law file ``check-law`` was given; whatever the file does that is not defining laws
+    (a folder or FIFO in its place, ``sys.exit`` or ``os._exit`` while it runs) is one ValueError
+    naming it: a check that ran nothing must not exit 0."""
+    import stat
+
+    from .model.userlaw import UserLawError, load_law_file
+
+    try:
+        mode = os.stat(path).st_mode
+    except OSError:
+        mode = None
+    if mode is not None and stat.S_ISDIR(mode):
+        raise ValueError(f"law file {path!r} is a folder, not a Python file")
+    if mode is not None and not stat.S_ISREG(mode):
+        kind = "a FIFO (named pipe)" if stat.S_ISFIFO(mode) else "not a regular file"
+        raise ValueError(f"law file {path!r} is {kind}, not a Python file")
+
+    def refuse_exit(status=0):  # os._exit would end the process before any verdict, with its status
+        raise SystemExit(status)
+
+    exit_now, os._exit = os._exit, refuse_exit
+    try:
+        return load_law_file(path)
+    except UserLawError as error:  # define_law's own message names the law, not the file
+        if path in str(error):
+            raise
+        raise UserLawError(f"law file {path!r}: {error}") from None
+    except SystemExit as stop:
+        raise ValueError(f"law file {path!r} exited (status {stop.code!r}) while it was loaded: a law file should "
+                         "only define laws (phaseimpact.define_law); nothing was checked") from None
+    finally:
+        os._exit = exit_now
+
+
 def cmd_check_law(args) -> int:
     from .checks import check_law
     from .model import REGISTRY, law_variants
 
-    if args.law.endswith(".py"):
-        from .model.userlaw import load_law_file
-
-        names = load_law_file(args.law)
-    elif args.law in REGISTRY:
+    if args.law in REGISTRY:
         names = [args.law]
+    elif args.law.endswith(".py"):
+        names = _checked_law_file(args.law)
     else:
         raise ValueError(f"law = {args.law!r} is neither a registered law nor a .py file; allowed: "
                          f"{', '.join(REGISTRY)} or FILE.py")
@@ -1488,10 +1521,12 @@ def build_parser() -> argparse.ArgumentParser:
     p.set_defaults(func=cmd_warmup)
 
     p = sub.add_parser("check-law", help="run the law conformance suite on a law or a law file",
-                       description="The checks every shipped law passes (force, partials against finite "
-                                   "differences, energy ledger, momentum, scipy and the test oracle), on a registered "
-                                   "law with each of its options, or on the laws a Python file defines with "
-                                   "phaseimpact.define_law. Exit code 1 when a check fails.")
+                       description="The checks every shipped law passes (force, repulsive on loading, partials "
+                                   "against finite differences, energy ledger, momentum, scipy and the independent "
+                                   "oracle), on a registered law with each of its options, or on the laws a Python "
+                                   "file defines with phaseimpact.define_law. Every run has a step and time budget "
+                                   "(a law whose integration grinds fails within seconds). Exit code 1 when a check "
+                                   "fails, 2 when the law file cannot be loaded.")
     p.add_argument("law", metavar="LAW|FILE.py", help="a registered law's name, or a Python file defining laws")
     json_option(p)
     p.set_defaults(func=cmd_check_law)
@@ -2006,6 +2041,9 @@ def _load_law_files(argv) -> list:
     return rest
 
 
+_ANSI_ESCAPE = re.compile(r"\x1b\[[0-9;]*[A-Za-z]")
+
+
 def main(argv=None) -> int:
     # Ctrl-C and SIGTERM, wherever they arrive (compiled runs included): one line, exit 130 or 143
     previous_term = signal.getsignal(signal.SIGTERM)
@@ -2020,8 +2058,8 @@ def main(argv=None) -> int:
 
             _signals.install_command_line()
         return args.func(args)
-    except ValueError as error:
-        print(f"phaseimpact: error: {error}", file=sys.stderr)
+    except ValueError as error:  # one line, without the colour escapes numba puts in its messages
+        print(f"phaseimpact: error: {_ANSI_ESCAPE.sub('', str(error))}", file=sys.stderr)
         return EXIT_USAGE
     except KeyboardInterrupt as stop:
         if not getattr(stop, "reported", False):

@@ -9,10 +9,10 @@ import sys
 
 import numpy as np
 import pytest
-from oracle import oracle
 from scipy.special import gamma
 
 from phaseimpact import ContactLaw, scales, seed_parameters, simulate, simulate_many
+from phaseimpact._oracle import oracle
 from phaseimpact.model import hunt_crossley_restitution
 
 SEED = seed_parameters(v=1.0)

@@ -40,8 +40,8 @@ def test_sdist_has_every_test_input_and_its_tests_run(tmp_path):
         tar.extractall(tmp_path / "unpacked", filter="data")
     missing = sorted(_source_files() - names)
     assert not missing, f"files the tests need are not in the sdist: {missing[:10]}"
-    assert {"tests/conftest.py", "tests/oracle.py", "Makefile", "mkdocs.yml", "phaseimpact/docs/physics.md"} <= names
-    # Collecting every test imports each test module, conftest and oracle from the unpacked sdist.
+    assert {"phaseimpact/_oracle.py", "Makefile", "mkdocs.yml", "phaseimpact/docs/physics.md"} <= names
+    # Collecting every test imports each test module from the unpacked sdist.
     tree = tmp_path / "unpacked" / top
     collected = subprocess.run([sys.executable, "-m", "pytest", "--collect-only", "-q", "-p", "no:cacheprovider",
                                 "tests"], cwd=tree, capture_output=True, text=True)

@@ -6,10 +6,10 @@ import textwrap
 
 import numpy as np
 import pytest
-from oracle import oracle
 
 import phaseimpact
 from phaseimpact import ContactLaw, check_law, define_law, seed_parameters, simulate
+from phaseimpact._oracle import oracle
 from phaseimpact.cli import main
 from phaseimpact.continuation import critical_damping
 from phaseimpact.model import REGISTRY

@@ -9,7 +9,12 @@ settling rules, tolerances and horizon) is written here from the physics, so tha
 engine's event table or transitions shows up as a disagreement instead of being copied. Even the
 law's flags are read off the force function itself (:class:`_Case`), not from the registry.
 
-Not a production path (DESIGN principle 3): tests and benchmarks use it to check the engine.
+Not a production path (DESIGN principle 3): ``check-law`` (:mod:`phaseimpact.checks`), the tests
+and the benchmarks use it to check the engine, and :func:`compare` is the one comparison of an
+engine run with an oracle run. A run can be given a budget (``max_nfev`` right-hand side calls,
+``seconds`` of wall time): past it the run raises :class:`BudgetExceeded`, so that a law whose
+integration grinds (a force that jumps, or overflows beyond the points anyone sampled) gets a
+verdict instead of a wait.
 
 The state
 ---------
@@ -58,6 +63,7 @@ settled at once (nothing brings the bodies together again).
 from __future__ import annotations
 
 import math
+import time
 from dataclasses import dataclass
 
 import numpy as np
@@ -65,7 +71,7 @@ from scipy.integrate import solve_ivp
 
 from phaseimpact.model.laws import ContactLaw, contact_force
 
-__all__ = ["OracleRun", "oracle"]
+__all__ = ["OracleRun", "oracle", "compare", "Agreement", "Budget", "BudgetExceeded"]
 
 # Relative state z = (delta, x2, deltadot, x2dot, W).
 D, X2, DD, V2, W = range(5)
@@ -261,11 +267,38 @@ def _break_point(case, sol, t_end, delta):
     return b
 
 
+class BudgetExceeded(RuntimeError):
+    """A run went past its budget of right-hand side calls or wall time (its message says which)."""
+
+
+class Budget:
+    """A budget of right-hand side calls and wall time for scipy runs: :meth:`spend` is called
+    once per evaluation and raises :class:`BudgetExceeded` past either limit (None: no limit).
+    ``solve_ivp`` has no step limit of its own."""
+
+    def __init__(self, max_nfev=None, seconds=None):
+        self.max_nfev = max_nfev
+        self.seconds = seconds
+        self.nfev = 0
+        self._deadline = math.inf if seconds is None else time.monotonic() + seconds
+
+    def spend(self):
+        self.nfev += 1
+        if self.max_nfev is not None and self.nfev > self.max_nfev:
+            raise BudgetExceeded(f"no result within {self.max_nfev} right-hand side calls")
+        if time.monotonic() > self._deadline:
+            raise BudgetExceeded(f"no result within {self.seconds:g} s ({self.nfev} right-hand side calls)")
+
+
 def oracle(params, law, t_end=None, *, rtol=1e-12, method="DOP853", settle=True, stop_on=None,
-           initial=None, max_phases=100_000) -> OracleRun:
+           initial=None, max_phases=100_000, max_nfev=None, seconds=None) -> OracleRun:
     """Integrate one impact of ``params`` under ``law`` from seed eq. 6 (or ``initial``, 4 numbers)
     to ``t_end`` (default: ``HORIZON_PERIODS`` slow times) or until the outcome settles
-    (``settle``) or ``stop_on`` (a kind, or ``(kind, count)``) is logged."""
+    (``settle``) or ``stop_on`` (a kind, or ``(kind, count)``) is logged. A step that scipy
+    cannot take (a force that is not finite) ends the run with the reason ``"failed"``; past
+    ``max_nfev`` right-hand side calls or ``seconds`` of wall time it raises
+    :class:`BudgetExceeded`."""
+    budget = Budget(max_nfev, seconds)
     case = _Case(params, law)
     horizon = HORIZON_PERIODS * case.slow if t_end is None else float(t_end)
     atol = rtol * case.scale
@@ -308,6 +341,7 @@ def oracle(params, law, t_end=None, *, rtol=1e-12, method="DOP853", settle=True,
         events = []  # (event, kind or action tag)
         if mode == "stuck":
             def fun(_t, zz):
+                budget.spend()
                 return case.stuck_rates(zz)
             # the pair's next turning point; from a turning point, the next one on the other side
             # (without springs the pair moves on uniformly and nothing pulls it apart)
@@ -319,6 +353,7 @@ def oracle(params, law, t_end=None, *, rtol=1e-12, method="DOP853", settle=True,
             m = mode
 
             def fun(_t, zz, m=m):
+                budget.spend()
                 return case.rates(zz, m)[0]
 
             side = _side(z)
@@ -343,6 +378,9 @@ def oracle(params, law, t_end=None, *, rtol=1e-12, method="DOP853", settle=True,
             sol = solve_ivp(fun, (t, horizon), z, method=method, rtol=rtol, atol=atol,
                             events=[e for e, _ in events], dense_output=mode == "stuck")
         nfev += sol.nfev
+        if sol.status == -1:  # scipy could not take a step: nothing later would be the law's motion
+            t, z, reason = float(sol.t[-1]), sol.y[:, -1].copy(), "failed"
+            break
         found = []  # (t, kind, z, terminal)
         for (ev, tag), ts, zs in zip(events, sol.t_events, sol.y_events, strict=True):
             for t_ev, z_ev in zip(ts, zs, strict=True):
@@ -420,3 +458,54 @@ def oracle(params, law, t_end=None, *, rtol=1e-12, method="DOP853", settle=True,
     log.sort(key=lambda e: e[0])
     return OracleRun([e[1] for e in log], [float(e[0]) for e in log], [case.physical(e[2]) for e in log],
                      [float(e[3]) for e in log], case.physical(z), float(t), float(max_force), reason, nfev)
+
+
+@dataclass
+class Agreement:
+    """How an engine run and an oracle run of the same case compare (:func:`compare`):
+    ``differences`` lists what disagrees beyond the tolerances (empty: they agree)."""
+
+    differences: list
+    n_events: int
+    worst_time: float
+    worst_force: float
+
+    @property
+    def agrees(self) -> bool:
+        return not self.differences
+
+    def detail(self) -> str:
+        if self.differences:
+            return "; ".join(self.differences)
+        return (f"{self.n_events} events, times within {self.worst_time:.2g} s, max force relative "
+                f"{self.worst_force:.2g}, same stop and final state")
+
+
+def compare(run, ref: OracleRun, t_end: float) -> Agreement:
+    """Compare an engine run (a :class:`~phaseimpact.Trajectory` to ``t_end``) with the oracle's
+    run ``ref`` of the same case: the same event kinds in time order (events within 1e-12 s may
+    swap), times within ``1e-9 t_end``, the largest force within 1e-9 relative, the same stop
+    reason (the engine's ``end`` is the oracle's ``horizon``) and final state (positions within
+    1e-12 m, speeds within 1e-9 m/s). Reads only the run's public fields."""
+    ours = sorted(zip(np.round(run.event_t, 12), [e.kind for e in run.events], strict=True))
+    theirs = sorted(zip(np.round(ref.times, 12), ref.kinds, strict=True))
+    differences = []
+    kinds_ours, kinds_theirs = [k for _, k in ours], [k for _, k in theirs]
+    worst_time = math.inf
+    if kinds_ours != kinds_theirs:
+        differences.append(f"event kinds differ: engine {kinds_ours[:6]}..., oracle {kinds_theirs[:6]}...")
+    else:
+        worst_time = max((abs(a - b) for (a, _), (b, _) in zip(ours, theirs, strict=True)), default=0.0)
+        if not worst_time <= 1e-9 * t_end:
+            differences.append(f"event times differ by {worst_time:.2g} s (allowed {1e-9 * t_end:.2g})")
+    worst_force = abs(run.max_force - ref.max_force) / abs(ref.max_force) if ref.max_force else abs(run.max_force)
+    if not worst_force <= 1e-9:
+        differences.append(f"max force {run.max_force:.10g} N, oracle {ref.max_force:.10g} (relative "
+                           f"{worst_force:.2g}, allowed 1e-9)")
+    if run.stop_reason != ref.reason and (run.stop_reason, ref.reason) != ("end", "horizon"):
+        differences.append(f"stop reason: engine {run.stop_reason}, oracle {ref.reason}")
+    positions = np.max(np.abs(np.asarray(run.final_state[:2]) - ref.final_state[:2]))
+    speeds = np.max(np.abs(np.asarray(run.final_state[2:4]) - ref.final_state[2:4]))
+    if not (positions <= 1e-12 and speeds <= 1e-9):
+        differences.append(f"final state differs by {positions:.2g} m, {speeds:.2g} m/s (allowed 1e-12 m, 1e-9 m/s)")
+    return Agreement(differences, len(ours), float(worst_time), float(worst_force))
