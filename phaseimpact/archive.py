@@ -905,8 +905,10 @@ def _texts_digest(f) -> str:
     h = hashlib.sha256()
 
     def add(name, node):
-        for key in sorted(node.attrs):
-            value = node.attrs[key] if key != _TEXT_DIGEST else None
+        for key in sorted(node.attrs):  # not netCDF's reserved attributes (_NCProperties): the library's
+            value = node.attrs[key] if key != _TEXT_DIGEST and not key.startswith("_") else None
+            if isinstance(value, bytes):  # netCDF4 (xarray's re-save) writes texts as fixed-length bytes
+                value = value.decode("utf-8", "replace")
             if isinstance(value, str):
                 h.update(json.dumps([name, key, value]).encode())
 
@@ -2003,15 +2005,32 @@ def _reading(path: str):
     """The archive at ``path`` open for reading. Whatever goes wrong while it is read (an HDF5 error, a
     checksum, a malformed attribute, content out of range) becomes a :class:`DamagedArchiveError`."""
     f = _open(path)
+    writer = _netcdf_writer(f)
     try:
         with f:
             yield f
     except (_Refusal, MemoryError):
         raise
-    except _Damaged as error:
-        raise DamagedArchiveError(path, str(error), checksum=error.checksum) from None
     except Exception as error:  # a damaged file reaches h5py, json and numpy in many ways: all are damage
-        raise DamagedArchiveError(path, _why(error)) from None
+        reason = str(error) if isinstance(error, _Damaged) else _why(error)
+        if writer is not None:  # not damage: a netCDF writer's copy, whose content was changed or left out
+            raise _Refusal(f"{path!r} was written by xarray (or another netCDF writer: {writer}) without what "
+                           f"phaseimpact reads back: {reason}. A subset (.sel, .isel) or an edited Dataset is "
+                           "not an archive: open it with xarray, or load the archive it came from") from None
+        raise DamagedArchiveError(path, reason, checksum=isinstance(error, _Damaged) and error.checksum) from None
+
+
+def _netcdf_writer(f) -> str | None:
+    """The library that wrote the file when it is not phaseimpact: netCDF-C and h5netcdf (xarray's
+    ``to_netcdf``) leave ``_NCProperties``, h5py (:func:`save`) does not."""
+    try:
+        value = f.attrs.get("_NCProperties")
+    except Exception:  # unreadable attributes: the damage is reported by the read itself
+        return None
+    if value is None:
+        return None
+    text = value.decode("utf-8", "replace") if isinstance(value, bytes) else str(value)
+    return next((part for part in text.split(",") if part.startswith(("netcdf=", "h5netcdf="))), text)
 
 
 def _retrying(read, path: str):
@@ -2033,8 +2052,17 @@ def _short(value) -> str:
     return text if len(text) <= 60 else text[:57] + "..."
 
 
-def _attr_str(node, key) -> str:
+def _attr(node, key):
+    """Attribute ``key`` as written: netCDF (so xarray's re-save) stores a number as a length-1 array,
+    h5py and :func:`save` as a scalar; both are the same value."""
     value = node.attrs[key]
+    if isinstance(value, np.ndarray) and value.shape == (1,):
+        return value[0]
+    return value
+
+
+def _attr_str(node, key) -> str:
+    value = _attr(node, key)
     if isinstance(value, bytes):
         value = value.decode("utf-8")
     if not isinstance(value, str):
@@ -2047,14 +2075,14 @@ def _strings(dataset) -> np.ndarray:
 
 
 def _int_attr(node, key) -> int:
-    value = node.attrs[key]
+    value = _attr(node, key)
     if isinstance(value, (int, np.integer)) and not isinstance(value, (bool, np.bool_)):
         return int(value)
     raise _Damaged(f"attribute {key} = {_short(value)} is out of range; allowed: an integer")
 
 
 def _real_attr(node, key) -> float:
-    value = node.attrs[key]
+    value = _attr(node, key)
     if isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(value, (bool, np.bool_)):
         return float(value)
     raise _Damaged(f"attribute {key} = {_short(value)} is out of range; allowed: a number")
@@ -2335,6 +2363,10 @@ def _read_sweep(f) -> SweepResult:
                          stick_t=stick["stick_t"][rows], stick_delta=stick["stick_delta"][rows],
                          stick_dwell=stick["stick_dwell"][rows],
                          extras=_read_tree(f["extras"]) if "extras" in f else {})
+    if "extras_digest" in f.attrs and _attr_str(f, "extras_digest") != _digest(result.extras):
+        raise _Damaged("/extras (atlas --refine's boundaries, ...) is missing or changed: it does not match "
+                       "the digest extras_digest" + (" (xarray writes the root group only)" if "extras" not in f
+                                                     else ""))
     result.values.update(values)
     return result
 
