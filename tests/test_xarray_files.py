@@ -6,8 +6,8 @@ otherwise refused as xarray's copy (never as "damaged"); attributes read as netC
 import h5py
 import numpy as np
 import pytest
-
 from _cli import run
+
 from phaseimpact import archive, seed_parameters
 from phaseimpact.continuation import atlas, critical_curve, refine_boundaries, sweep
 from phaseimpact.train import impact_train
