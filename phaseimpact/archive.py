@@ -782,6 +782,11 @@ def _write_result(f, result, created: str, layout, spare_rows: int, context=None
     f.attrs[_TEXT_DIGEST] = _texts_digest(f)
 
 
+#: How to install what to_xarray and stick_phases need (the package is installed from a checkout or a wheel).
+_XARRAY_EXTRA = ("install the extra phaseimpact[xarray] (in a checkout: pip install -e '.[xarray]'; with a wheel: "
+                 "pip install 'phaseimpact-VERSION-py3-none-any.whl[xarray]'), or pip install xarray h5netcdf")
+
+
 def to_xarray(result, *, params=None, law=None, settings: dict | None = None):
     """``result`` as an in-memory :class:`xarray.Dataset`, no file written.
 
@@ -790,7 +795,7 @@ def to_xarray(result, *, params=None, law=None, settings: dict | None = None):
     alike, so code written for one reads the other. A trajectory and a list of transitions, which
     have no archive kind, get a Dataset in the same conventions (CF-1.11 attributes, units as
     :func:`unit_attributes` gives them, codes as integer flags, the header's attributes); the module
-    docstring gives every layout. Needs xarray and h5netcdf (``pip install xarray h5netcdf``).
+    docstring gives every layout. Needs xarray and h5netcdf (the extra ``phaseimpact[xarray]``).
 
     Parameters
     ----------
@@ -820,8 +825,8 @@ MapBranch or Basins
     TypeError
         For a result of another type (the message lists the allowed ones), or ``params``, ``law``
         or ``settings`` given for a result that carries its own.
-    ValueError
-        When xarray or h5netcdf is not installed.
+    ImportError
+        When xarray or h5netcdf is not installed (the message names the extra).
 
     Examples
     --------
@@ -854,8 +859,7 @@ MapBranch or Basins
         import h5netcdf  # noqa: F401  (xarray's engine for the in-memory file)
         import xarray
     except ImportError as error:
-        raise ImportError(f"to_xarray needs xarray and h5netcdf ({error}): install the extra, "
-                          "pip install 'phaseimpact[xarray]' (or pip install xarray h5netcdf)") from None
+        raise ImportError(f"to_xarray needs xarray and h5netcdf ({error}): {_XARRAY_EXTRA}") from None
     buffer = io.BytesIO()
     with h5py.File(buffer, "w", libver=_LIBVER) as f:
         _write_result(f, result, created_timestamp(),
@@ -892,7 +896,9 @@ def stick_phases(ds_or_path):
     Raises
     ------
     ValueError
-        For a critical curve (it has no stick phases), or without xarray and h5netcdf.
+        For a critical curve (it has no stick phases).
+    ImportError
+        Without xarray and h5netcdf (the message names the extra).
 
     Examples
     --------
@@ -906,7 +912,7 @@ def stick_phases(ds_or_path):
     try:
         import xarray
     except ImportError:
-        raise ValueError("stick_phases needs xarray and h5netcdf: pip install xarray h5netcdf") from None
+        raise ImportError(f"stick_phases needs xarray and h5netcdf: {_XARRAY_EXTRA}") from None
     if not isinstance(ds_or_path, xarray.Dataset):
         with xarray.open_dataset(os.fspath(ds_or_path), engine="h5netcdf") as ds:
             return stick_phases(ds.load())
