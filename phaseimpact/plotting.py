@@ -1263,7 +1263,13 @@ def plot_variable(da, *, ax=None, **kwargs):
 
     Returns
     -------
-    The artist ``da.plot`` returns.
+    object
+        The artist ``da.plot`` returns (a QuadMesh for 2-d, a list of lines for 1-d).
+
+    Raises
+    ------
+    ValueError
+        For a variable of other than 1 or 2 dimensions.
 
     Examples
     --------
