@@ -71,17 +71,26 @@ Layout (``schema_version`` 5). Every variable of the result is in the root group
                   (orbit_point) float64: the attractors' points, attractor_period rows each, in order
 
     :func:`to_xarray` also gives, in the same conventions but with no archive kind:
-    trajectory    (a Trajectory; kind "trajectory", the header from its case and law, message) time (n,)
-                  coordinate (s; empty for a summary run); x1, x2, x1dot, x2dot, contact_work, delta,
-                  deltadot, force (time) float64 m, m, m s-1, m s-1, J, m, m s-1, N; mode (time) int64;
+    trajectory    (a Trajectory; kind "trajectory", the header from its case and law, message) t (n,)
+                  coordinate (s since the start of the run, cartesian_axis T; empty for a summary run);
+                  x1, x2, x1dot, x2dot, contact_work, delta, deltadot, force (t) float64 m, m, m s-1,
+                  m s-1, J, m, m s-1, N; mode (t) int64;
                   along event: event_time, event_kind (int8 flags: the event kinds), event_x1 ...
                   event_contact_work, event_force, event_mode; 0-d: status, outcome, stop_reason (int8
                   flags), every summary column (max_force, n_stick, t_run, ...), final_mode;
                   initial_state, final_state (component,) float64 (attrs components, component_units)
     transitions   (a list of Transition; kind "transitions", attrs kappa_min, kappa_max from settings)
-                  along transition: kind (int8 flags adding-sliding staircase-end grazing), kappa
-                  (float64, fractional_units), count_below, count_above, extremum (int64, _FillValue -1:
-                  not known)
+                  kappa (n,) float64 coordinate (fractional_units; the transitions in increasing kappa,
+                  so ``ds.sel(kappa=..., method="nearest")``); along kappa: kind (int8 flags
+                  adding-sliding staircase-end grazing), count_below, count_above, extremum (int64,
+                  _FillValue -1: not known)
+
+    Coordinates of a grid (a sweep's or atlas's axes, a curve's or orbit diagram's parameter, basins'
+    x2 and x2dot, the transitions' kappa) carry ``cartesian_axis``: X for the last, Y for the one
+    before (as xarray plots them), so ``ds.cf.axes`` names them (CF's ``axis`` X and Y would make
+    them a longitude and latitude; CF has no standard_name for these parameters). :func:`to_xarray`
+    leaves ``_FillValue`` out of the coordinates' encoding, so that ``to_netcdf`` writes a file that
+    passes the CF checks too.
 
     /extras       SweepResult.extras: arrays as datasets, dicts as groups, the rest as JSON in the
                   group's attribute "json" (a group: the xarray root view leaves it out; open it with
@@ -161,6 +170,7 @@ from . import __version__
 from ._atomic import atomic_path, exclusive, fsync_file, release_reserve, reserve
 from .continuation import CriticalCurve, SweepResult, Transition
 from .continuation.grid import Axis, Grid
+from .continuation.sweep import ENGINE as _ENGINE
 from .integrate import OUTCOMES, STATUSES
 from .integrate import driver as _driver
 from .integrate.events import EVENT_KINDS
@@ -521,6 +531,18 @@ def _fixed(group, name, data, dtype, chunks, *, fill=None, fill_attr=True, units
     return d
 
 
+#: The axis of the last grid dimensions, last first (xarray plots the last along x), as the attribute
+#: ``cartesian_axis`` (COARDS, which cf_xarray reads: ``ds.cf.axes`` names them). Not CF's ``axis``: CF
+#: readers take a coordinate with axis X or Y for a longitude or latitude (compliance-checker then
+#: demands degrees), and the grid's parameters have no CF standard_name; the long_name says what they are.
+_GRID_AXES = ("X", "Y")
+
+
+def _grid_axes(coordinates) -> None:
+    for d, axis in zip(reversed(coordinates), _GRID_AXES, strict=False):
+        d.attrs["cartesian_axis"] = axis
+
+
 def _dimension(group, name: str, size: int):
     """A netCDF dimension without a variable (as netCDF-C writes it: an empty dimension scale)."""
     d = group.create_dataset(name, shape=(size,), dtype="f4")
@@ -760,6 +782,11 @@ def _write_result(f, result, created: str, layout, spare_rows: int, context=None
     f.attrs[_TEXT_DIGEST] = _texts_digest(f)
 
 
+#: How to install what to_xarray and stick_phases need (the package is installed from a checkout or a wheel).
+_XARRAY_EXTRA = ("install the extra phaseimpact[xarray] (in a checkout: pip install -e '.[xarray]'; with a wheel: "
+                 "pip install 'phaseimpact-VERSION-py3-none-any.whl[xarray]'), or pip install xarray h5netcdf")
+
+
 def to_xarray(result, *, params=None, law=None, settings: dict | None = None):
     """``result`` as an in-memory :class:`xarray.Dataset`, no file written.
 
@@ -768,7 +795,7 @@ def to_xarray(result, *, params=None, law=None, settings: dict | None = None):
     alike, so code written for one reads the other. A trajectory and a list of transitions, which
     have no archive kind, get a Dataset in the same conventions (CF-1.11 attributes, units as
     :func:`unit_attributes` gives them, codes as integer flags, the header's attributes); the module
-    docstring gives every layout. Needs xarray and h5netcdf (``pip install xarray h5netcdf``).
+    docstring gives every layout. Needs xarray and h5netcdf (the extra ``phaseimpact[xarray]``).
 
     Parameters
     ----------
@@ -798,8 +825,8 @@ MapBranch or Basins
     TypeError
         For a result of another type (the message lists the allowed ones), or ``params``, ``law``
         or ``settings`` given for a result that carries its own.
-    ValueError
-        When xarray or h5netcdf is not installed.
+    ImportError
+        When xarray or h5netcdf is not installed (the message names the extra).
 
     Examples
     --------
@@ -829,16 +856,20 @@ MapBranch or Basins
                         "Trajectory, a list of Transition, or an ImpactTrain, OrbitDiagram, MapBranch or Basins")
     context = _context(result, params, law, settings, required=False)
     try:
+        import h5netcdf  # noqa: F401  (xarray's engine for the in-memory file)
         import xarray
-    except ImportError:
-        raise ValueError("to_xarray needs xarray and h5netcdf: pip install xarray h5netcdf") from None
+    except ImportError as error:
+        raise ImportError(f"to_xarray needs xarray and h5netcdf ({error}): {_XARRAY_EXTRA}") from None
     buffer = io.BytesIO()
     with h5py.File(buffer, "w", libver=_LIBVER) as f:
         _write_result(f, result, created_timestamp(),
                       _sweep_layout(result) if isinstance(result, SweepResult) else None, 0, context)
     buffer.seek(0)
     with xarray.open_dataset(buffer, engine="h5netcdf") as ds:
-        return ds.load()
+        ds = ds.load()
+    for name in ds.coords:  # else to_netcdf gives a float coordinate _FillValue NaN, which CF forbids
+        ds[name].encoding["_FillValue"] = None
+    return ds
 
 
 def stick_phases(ds_or_path):
@@ -865,7 +896,9 @@ def stick_phases(ds_or_path):
     Raises
     ------
     ValueError
-        For a critical curve (it has no stick phases), or without xarray and h5netcdf.
+        For a critical curve (it has no stick phases).
+    ImportError
+        Without xarray and h5netcdf (the message names the extra).
 
     Examples
     --------
@@ -879,7 +912,7 @@ def stick_phases(ds_or_path):
     try:
         import xarray
     except ImportError:
-        raise ValueError("stick_phases needs xarray and h5netcdf: pip install xarray h5netcdf") from None
+        raise ImportError(f"stick_phases needs xarray and h5netcdf: {_XARRAY_EXTRA}") from None
     if not isinstance(ds_or_path, xarray.Dataset):
         with xarray.open_dataset(os.fspath(ds_or_path), engine="h5netcdf") as ds:
             return stick_phases(ds.load())
@@ -905,8 +938,10 @@ def _texts_digest(f) -> str:
     h = hashlib.sha256()
 
     def add(name, node):
-        for key in sorted(node.attrs):
-            value = node.attrs[key] if key != _TEXT_DIGEST else None
+        for key in sorted(node.attrs):  # not netCDF's reserved attributes (_NCProperties): the library's
+            value = node.attrs[key] if key != _TEXT_DIGEST and not key.startswith("_") else None
+            if isinstance(value, bytes):  # netCDF4 (xarray's re-save) writes texts as fixed-length bytes
+                value = value.decode("utf-8", "replace")
             if isinstance(value, str):
                 h.update(json.dumps([name, key, value]).encode())
 
@@ -926,7 +961,7 @@ def _header(f, kind: str, law: ContactLaw | None, base, t_end, rtol, engine: str
     f.attrs["history"] = f"{created} phaseimpact {__version__}: written by phaseimpact.archive"
     f.attrs["source"] = (f"phaseimpact {__version__}: impact simulations "
                          f"({law.name if law is not None else 'unnamed'} contact law, engine "
-                         f"{engine or 'default'}, rtol {_float(rtol):g})")
+                         f"{engine or _ENGINE}, rtol {_float(rtol):g})")
     f.attrs["references"] = REFERENCES
     f.attrs["schema_version"] = np.int64(SCHEMA_VERSION)
     f.attrs["package_version"] = __version__
@@ -936,7 +971,7 @@ def _header(f, kind: str, law: ContactLaw | None, base, t_end, rtol, engine: str
         f.attrs["contact"] = str(law.contact)
     for key, value in (_base_attrs(base) if base is not None else {}).items():
         f.attrs[key] = value
-    f.attrs["engine"] = str(engine)
+    f.attrs["engine"] = str(engine) or _ENGINE  # curves, transitions and trains run on the sweeps' engine
     f.attrs["rtol"] = _float(rtol)
     f.attrs["t_end"] = _float(t_end)
     f.attrs["created"] = created
@@ -1014,6 +1049,7 @@ def _write_sweep(f, r: SweepResult, created: str, layout: _Layout, spare_rows: i
         d.attrs["parameter"] = axis.name
         d.attrs["log"] = np.int8(bool(axis.log))
         scales.append(d)
+    _grid_axes(scales)
     chunks = _slab_chunks(shape, CHUNK_POINTS)
 
     def gridded(name, data, dtype, units=None):
@@ -1111,6 +1147,7 @@ def _write_curve(f, c: CriticalCurve, created: str) -> None:
     values.attrs.update(unit_attributes(units))
     values.attrs["long_name"] = _long_name(c.param, units)
     values.attrs["parameter"] = c.param
+    _grid_axes([values])
     units = kappa_units(alpha, c.law)
     for name in ("kappa", "closed_form", "predicted"):
         d = f.create_dataset(name, data=np.asarray(getattr(c, name), dtype=float), **_CHECKED)
@@ -1257,13 +1294,15 @@ def _write_trajectory(f, tr: Trajectory, created: str, context: _Context) -> Non
     _header(f, "trajectory", tr.law, tr.params, tr.t_end, float(found.group(1)) if found else None, tr.integrator,
             created, f"phaseimpact trajectory: {tr.law.name} law, {tr.outcome} ({tr.status})")
     f.attrs["message"] = tr.message
-    _coordinate(f, "time", tr.t, "s", "time")
+    # t, not time: CF's time coordinate (the name time, standard_name time or axis T) needs units "s since
+    # <a date>", which xarray decodes to datetime64 (whole nanoseconds; the run's clock starts at 0)
+    _coordinate(f, "t", tr.t, "s", "time since the start of the run").attrs["cartesian_axis"] = "T"
     for i, (name, units, long_name) in enumerate(_STATE):
-        _variable(f, name, tr.y[:, i], ("time",), long_name=long_name, units=units)
-    _variable(f, "delta", tr.delta, ("time",), long_name="indentation x1 - x2", units="m")
-    _variable(f, "deltadot", tr.deltadot, ("time",), long_name="relative velocity x1dot - x2dot", units="m s-1")
-    _variable(f, "force", tr.force, ("time",), long_name="contact force", units="N")
-    _variable(f, "mode", tr.mode, ("time",), long_name="mode (paper: +-1 slipping, 0 stuck)")
+        _variable(f, name, tr.y[:, i], ("t",), long_name=long_name, units=units)
+    _variable(f, "delta", tr.delta, ("t",), long_name="indentation x1 - x2", units="m")
+    _variable(f, "deltadot", tr.deltadot, ("t",), long_name="relative velocity x1dot - x2dot", units="m s-1")
+    _variable(f, "force", tr.force, ("t",), long_name="contact force", units="N")
+    _variable(f, "mode", tr.mode, ("t",), long_name="mode (paper: +-1 slipping, 0 stuck)")
 
     _variable(f, "event_time", tr.event_t, ("event",), long_name="time of the event", units="s")
     _variable(f, "event_kind", tr.event_kind, ("event",), long_name="kind of the event", flags=EVENT_KINDS,
@@ -1296,18 +1335,19 @@ def _write_transitions(f, items, created: str, context: _Context) -> None:
         if key in settings:
             f.attrs[key] = float(settings[key])
     units = _parameter_units("kappa", context)
+    items = sorted(items, key=lambda t: t.kappa)  # the coordinate kappa increases (CF; .sel(kappa=...))
 
     def count(name):  # None (not confirmed, unbounded) is -1, read by xarray as NaN
         return np.array([-1 if getattr(t, name) is None else getattr(t, name) for t in items], dtype=np.int64)
 
-    _variable(f, "kind", _codes_of([t.kind for t in items], TRANSITION_KINDS, "kind"), ("transition",),
+    _grid_axes([_coordinate(f, "kappa", np.array([t.kappa for t in items], dtype=float), units,
+                            "kappa at the transition")])
+    _variable(f, "kind", _codes_of([t.kind for t in items], TRANSITION_KINDS, "kind"), ("kappa",),
               long_name="kind of the transition", flags=TRANSITION_KINDS)
-    _variable(f, "kappa", [t.kappa for t in items], ("transition",), long_name="kappa at the transition",
-              units=units, dtype=float, fill=True)
     for name, long_name in (("count_below", "long-time count just below"),
                             ("count_above", "long-time count just above"),
                             ("extremum", "grazing: the extremum of delta that touches zero")):
-        _variable(f, name, count(name), ("transition",), long_name=long_name, units="1", fill=True)
+        _variable(f, name, count(name), ("kappa",), long_name=long_name, units="1", fill=True)
 
 
 def _write_impact_train(f, r: ImpactTrain, created: str, context: _Context) -> None:
@@ -1343,7 +1383,7 @@ def _write_orbit_diagram(f, r: OrbitDiagram, created: str, context: _Context) ->
                   f"phaseimpact orbit diagram: {r.plate.shape[1]} samples at {len(values)} values of {r.param}"
                   f"{_by(context)}")
     f.attrs["param"] = r.param
-    _coordinate(f, dim, values, _parameter_units(r.param, context), r.param)
+    _grid_axes([_coordinate(f, dim, values, _parameter_units(r.param, context), r.param)])
     dims = (dim, "sample")
     _variable(f, "x2", r.plate[..., 0], dims, long_name="plate displacement just before the sampled impact",
               units="m", dtype=float)
@@ -1417,8 +1457,8 @@ def _write_basins(f, r: Basins, created: str, context: _Context) -> None:
                   f"{len(r.attractors)} attractors{_by(context)}")
     f.attrs["not_converged"] = np.int64(r.not_converged)
     f.attrs["no_map"] = np.int64(r.no_map)
-    _coordinate(f, "x2dot", np.asarray(r.x2dot_values, dtype=float), "m s-1", "initial plate velocity")
-    _coordinate(f, "x2", np.asarray(r.x2_values, dtype=float), "m", "initial plate displacement")
+    _grid_axes([_coordinate(f, "x2dot", np.asarray(r.x2dot_values, dtype=float), "m s-1", "initial plate velocity"),
+                _coordinate(f, "x2", np.asarray(r.x2_values, dtype=float), "m", "initial plate displacement")])
     _variable(f, "labels", r.labels, ("x2dot", "x2"), long_name="attractor reached from the initial state",
               dtype=np.int64, comment=f"the attractor's index; {NOT_CONVERGED}: no period repeated, {NO_MAP}: a run "
                                       "failed")
@@ -2003,15 +2043,32 @@ def _reading(path: str):
     """The archive at ``path`` open for reading. Whatever goes wrong while it is read (an HDF5 error, a
     checksum, a malformed attribute, content out of range) becomes a :class:`DamagedArchiveError`."""
     f = _open(path)
+    writer = _netcdf_writer(f)
     try:
         with f:
             yield f
     except (_Refusal, MemoryError):
         raise
-    except _Damaged as error:
-        raise DamagedArchiveError(path, str(error), checksum=error.checksum) from None
     except Exception as error:  # a damaged file reaches h5py, json and numpy in many ways: all are damage
-        raise DamagedArchiveError(path, _why(error)) from None
+        reason = str(error) if isinstance(error, _Damaged) else _why(error)
+        if writer is not None:  # not damage: a netCDF writer's copy, whose content was changed or left out
+            raise _Refusal(f"{path!r} was written by xarray (or another netCDF writer: {writer}) without what "
+                           f"phaseimpact reads back: {reason}. A subset (.sel, .isel) or an edited Dataset is "
+                           "not an archive: open it with xarray, or load the archive it came from") from None
+        raise DamagedArchiveError(path, reason, checksum=isinstance(error, _Damaged) and error.checksum) from None
+
+
+def _netcdf_writer(f) -> str | None:
+    """The library that wrote the file when it is not phaseimpact: netCDF-C and h5netcdf (xarray's
+    ``to_netcdf``) leave ``_NCProperties``, h5py (:func:`save`) does not."""
+    try:
+        value = f.attrs.get("_NCProperties")
+    except Exception:  # unreadable attributes: the damage is reported by the read itself
+        return None
+    if value is None:
+        return None
+    text = value.decode("utf-8", "replace") if isinstance(value, bytes) else str(value)
+    return next((part for part in text.split(",") if part.startswith(("netcdf=", "h5netcdf="))), text)
 
 
 def _retrying(read, path: str):
@@ -2033,8 +2090,17 @@ def _short(value) -> str:
     return text if len(text) <= 60 else text[:57] + "..."
 
 
-def _attr_str(node, key) -> str:
+def _attr(node, key):
+    """Attribute ``key`` as written: netCDF (so xarray's re-save) stores a number as a length-1 array,
+    h5py and :func:`save` as a scalar; both are the same value."""
     value = node.attrs[key]
+    if isinstance(value, np.ndarray) and value.shape == (1,):
+        return value[0]
+    return value
+
+
+def _attr_str(node, key) -> str:
+    value = _attr(node, key)
     if isinstance(value, bytes):
         value = value.decode("utf-8")
     if not isinstance(value, str):
@@ -2047,14 +2113,14 @@ def _strings(dataset) -> np.ndarray:
 
 
 def _int_attr(node, key) -> int:
-    value = node.attrs[key]
+    value = _attr(node, key)
     if isinstance(value, (int, np.integer)) and not isinstance(value, (bool, np.bool_)):
         return int(value)
     raise _Damaged(f"attribute {key} = {_short(value)} is out of range; allowed: an integer")
 
 
 def _real_attr(node, key) -> float:
-    value = node.attrs[key]
+    value = _attr(node, key)
     if isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(value, (bool, np.bool_)):
         return float(value)
     raise _Damaged(f"attribute {key} = {_short(value)} is out of range; allowed: a number")
@@ -2335,6 +2401,10 @@ def _read_sweep(f) -> SweepResult:
                          stick_t=stick["stick_t"][rows], stick_delta=stick["stick_delta"][rows],
                          stick_dwell=stick["stick_dwell"][rows],
                          extras=_read_tree(f["extras"]) if "extras" in f else {})
+    if "extras_digest" in f.attrs and _attr_str(f, "extras_digest") != _digest(result.extras):
+        raise _Damaged("/extras (atlas --refine's boundaries, ...) is missing or changed: it does not match "
+                       "the digest extras_digest" + (" (xarray writes the root group only)" if "extras" not in f
+                                                     else ""))
     result.values.update(values)
     return result
 

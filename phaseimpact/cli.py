@@ -1816,7 +1816,7 @@ def _save_train_archive(args, setup: Setup, result, **settings) -> None:
     from . import archive
 
     with exclusive(args.archive, "archive"):
-        archive.save(result, args.archive, force=getattr(args, "force", False), params=setup.params, law=setup.law,
+        archive.save(result, args.archive, force=getattr(args, "force", False), params=setup.case, law=setup.law,
                      settings={"rtol": args.rtol, **settings})
 
 

@@ -1243,3 +1243,75 @@ def plot_basins(result, *, ax=None, title: str = ""):
 
 
 __all__ += ["plot_map_branch", "mark_bifurcations", "plot_bifurcation_curves", "plot_basins", "BIFURCATION_MARKERS"]
+
+
+def plot_variable(da, *, ax=None, **kwargs):
+    """Plot a variable of a phaseimpact Dataset (:func:`~phaseimpact.archive.to_xarray`, or an archive
+    opened with xarray) as ``da.plot`` does, with what its attributes say and xarray does not read:
+    a coordinate marked ``log`` (1: a log-spaced grid axis) goes on a log axis, and a flag variable
+    (``flag_values``, ``flag_meanings``: status, outcome, ...) gets one colour per value named in the
+    colour bar (2-d), or its values named on the y axis (1-d); -1 (not computed) is left blank.
+
+    Parameters
+    ----------
+    da : xarray.DataArray
+        One variable, 1-d or 2-d.
+    ax : matplotlib.axes.Axes, optional
+        Where to draw (default: a new :func:`figure`).
+    **kwargs
+        Passed on to ``da.plot`` (``x=``, ``y=``, ``xscale=`` ... given here win).
+
+    Returns
+    -------
+    object
+        The artist ``da.plot`` returns (a QuadMesh for 2-d, a list of lines for 1-d).
+
+    Raises
+    ------
+    ValueError
+        For a variable of other than 1 or 2 dimensions.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from phaseimpact import seed_parameters
+    >>> from phaseimpact.archive import to_xarray
+    >>> from phaseimpact.continuation import atlas
+    >>> ds = to_xarray(atlas(seed_parameters(), "paper", {"kappa": np.geomspace(1e11, 1e13, 3), "v": [1.0, 2.0]}))
+    >>> mesh = plot_variable(ds.outcome, x="kappa")
+    >>> mesh.axes.get_xscale(), mesh.axes.get_yscale(), [t.get_text() for t in mesh.colorbar.ax.get_yticklabels()][:2]
+    ('log', 'linear', ['failed', 'permanent-stick'])
+    """
+    from matplotlib.colors import BoundaryNorm, ListedColormap
+
+    if ax is None:
+        ax = figure()[1][0, 0]
+    if da.ndim not in (1, 2):
+        raise ValueError(f"da has {da.ndim} dimensions {da.dims}; allowed: 1 or 2")
+    x, y = kwargs.get("x"), kwargs.get("y")
+    if da.ndim == 1:
+        x = x or da.dims[0]
+    else:  # as xarray: the last dimension along x, unless one of them is named
+        x = x or next(d for d in reversed(da.dims) if d != y)
+        y = y or next(d for d in da.dims if d != x)
+    for scale, name in (("xscale", x), ("yscale", y)):
+        if name is not None and name in da.coords and int(np.ravel(da[name].attrs.get("log", 0))[0]) == 1:
+            kwargs.setdefault(scale, "log")
+    if "flag_meanings" not in da.attrs:
+        return da.plot(ax=ax, **kwargs)
+    names = str(da.attrs["flag_meanings"]).split()
+    values = np.ravel(da.attrs["flag_values"]).astype(float)
+    shown = da.where(da >= values.min())
+    if da.ndim == 1:
+        artist = shown.plot(ax=ax, marker="o", linestyle="none", **kwargs)
+        ax.set_yticks(values, names)
+        return artist
+    edges = np.concatenate([[values[0] - 0.5], (values[:-1] + values[1:]) / 2, [values[-1] + 0.5]])
+    colours = ListedColormap(plt.get_cmap("tab10")(np.arange(len(names)) % 10))
+    artist = shown.plot(ax=ax, cmap=colours, norm=BoundaryNorm(edges, len(names)),
+                        cbar_kwargs={"ticks": values, "label": da.attrs.get("long_name", da.name)}, **kwargs)
+    artist.colorbar.set_ticklabels(names)
+    return artist
+
+
+__all__ += ["plot_variable"]

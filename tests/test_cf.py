@@ -211,8 +211,10 @@ def test_cf_xarray_reads_the_flags(kind, archives, results):
     assert cf_xarray
     with xr.open_dataset(archives[kind], engine="h5netcdf") as ds:
         assert "CF Axes" in repr(ds.cf) and isinstance(ds.cf.keys(), set)
-        # no CF axis (X, Y, Z, T) or coordinate type: a grid of parameters is not space-time
-        assert ds.cf.axes == {} and ds.cf.coordinates == {}
+        # the grid's axes, as xarray plots them (the last along x); no CF coordinate type: a grid of
+        # parameters is not space-time (no longitude, latitude, vertical or time)
+        assert ds.cf.axes == ({"X": ["kappa"]} if kind == "sweep" else {"X": ["v"], "Y": ["kappa"]})
+        assert ds.cf.coordinates == {}
         outcome = results[kind].outcome.reshape(ds.outcome.shape)
         for code, name in enumerate(OUTCOMES):
             np.testing.assert_array_equal((ds.outcome.cf == name).values, outcome == code, err_msg=name)
@@ -238,3 +240,95 @@ def test_stick_phases_of_an_atlas_file(archives, results):
     np.testing.assert_array_equal(rows.stick_delta.values, grid.stick_delta)
     with pytest.raises(ValueError, match="no stick phases"):
         archive.stick_phases(archives["critical-curve"])
+
+
+# ------------------------------------------------------------------------------------------------
+# Exports written by xarray (issue 41, item 3): every to_xarray passes the CF checks as to_netcdf
+# writes it; grid axes named for cf_xarray, log axes and flags read by plot_variable
+# ------------------------------------------------------------------------------------------------
+
+def _compliance(path, tmp_path) -> dict:
+    runner = pytest.importorskip("compliance_checker.runner")
+    runner.CheckSuite.load_all_available_checkers()
+    report = tmp_path / "report.json"
+    runner.ComplianceChecker.run_checker(str(path), ["cf:1.11"], 0, "normal", output_filename=str(report),
+                                         output_format="json")
+    scores = json.loads(report.read_text())["cf:1.11"]
+    return {item["name"]: item["msgs"] for level in ("high_priorities", "medium_priorities", "low_priorities")
+            for item in scores[level] if item["msgs"]}
+
+
+@pytest.fixture(scope="module")
+def exports():
+    """A Dataset of each kind to_xarray converts that has no archive test above (the archives' kinds
+    are checked as files above), with the case and law where the result does not carry them."""
+    from phaseimpact import simulate
+    from phaseimpact.continuation import Transition
+    from phaseimpact.train import basins, impact_train, orbit_diagram
+
+    p = seed_parameters(kappa=3e9)
+    given = {"params": p, "law": "hunt-crossley", "settings": {"rtol": 1e-10, "period": 3e-3}}
+    return {"trajectory": archive.to_xarray(simulate(seed_parameters(v=1.0, kappa=3e9), "paper", save="steps")),
+            "transitions": archive.to_xarray([Transition("staircase-end", 2e12, 2, 1),
+                                              Transition("adding-sliding", 1.5e12, 1, None)],
+                                             params=p, law="paper", settings={"kappa_min": 1e8, "kappa_max": 1e13}),
+            "impact-train": archive.to_xarray(impact_train(p, "hunt-crossley", 3e-3, 3), **given),
+            "orbit-diagram": archive.to_xarray(orbit_diagram(p, "hunt-crossley", "kappa", [2e9, 3e9], period=3e-3,
+                                                             transients=2, samples=3), **given),
+            "basins": archive.to_xarray(basins(p, "hunt-crossley", 0.4e-3, [-1e-4, 1e-4], [0.0]), **given)}
+
+
+@pytest.mark.parametrize("kind", ("trajectory", "transitions", "impact-train", "orbit-diagram", "basins"))
+def test_to_xarray_written_by_xarray_passes_the_cf_checks(kind, exports, tmp_path):
+    path = tmp_path / f"{kind}.nc"
+    exports[kind].to_netcdf(path)
+    assert _compliance(path, tmp_path) == {}
+    with h5py.File(path, "r") as f:  # xarray's default, a NaN _FillValue, is refused on a coordinate
+        assert not [name for name in exports[kind].coords if "_FillValue" in f[name].attrs]
+
+
+def test_the_trajectory_time_and_the_transitions_kappa_are_coordinates(exports):
+    run = exports["trajectory"]
+    assert run.cf.axes == {"T": ["t"]} and run.t.attrs["units"] == "s" and run.force.dims == ("t",)
+    found = exports["transitions"]
+    assert found.kappa.values.tolist() == [1.5e12, 2e12]  # sorted: a coordinate increases
+    assert found.sel(kappa=2e12).count_below.item() == 2 and found.cf.axes == {"X": ["kappa"]}
+    assert found.sel(kappa=1.6e12, method="nearest").kind.item() == archive.TRANSITION_KINDS.index("adding-sliding")
+
+
+def test_basins_and_orbit_diagrams_name_their_axes(exports):
+    assert exports["basins"].cf.axes == {"X": ["x2"], "Y": ["x2dot"]}
+    assert exports["orbit-diagram"].cf.axes == {"X": ["kappa"]}
+
+
+def test_every_kind_names_its_engine(results, exports):
+    from phaseimpact.continuation.sweep import ENGINE
+
+    engines = {kind: archive.to_xarray(r).attrs["engine"] for kind, r in results.items()}
+    engines.update({kind: ds.attrs["engine"] for kind, ds in exports.items()})
+    assert all(engines.values()), engines
+    assert engines["critical-curve"] == engines["transitions"] == engines["basins"] == ENGINE
+    assert "DOP853" in engines["trajectory"]  # the run's own integrator line
+
+
+def test_plot_variable_puts_log_axes_on_log_scales_and_names_flags(results):
+    from phaseimpact.plotting import plot_variable
+
+    ds = archive.to_xarray(results["atlas"])
+    assert int(ds.kappa.attrs["log"]) == 1 and int(ds.v.attrs["log"]) == 0
+    mesh = plot_variable(ds.outcome)  # kappa along y (xarray's order), v along x
+    assert (mesh.axes.get_xscale(), mesh.axes.get_yscale()) == ("linear", "log")
+    assert [t.get_text() for t in mesh.colorbar.ax.get_yticklabels()] == list(OUTCOMES)
+    np.testing.assert_array_equal(mesh.colorbar.get_ticks(), np.arange(len(OUTCOMES)))
+    line = plot_variable(ds.max_force.sel(v=1.0))[0]
+    assert line.axes.get_xscale() == "log"
+    dots = plot_variable(ds.status.sel(v=1.0))[0]
+    assert [t.get_text() for t in dots.axes.get_yticklabels()][:2] == ["success", "step-size-collapse"]
+
+
+def test_to_xarray_without_xarray_names_the_extra(results, monkeypatch):
+    import sys
+
+    monkeypatch.setitem(sys.modules, "xarray", None)
+    with pytest.raises(ImportError, match=r"phaseimpact\[xarray\]"):
+        archive.to_xarray(results["sweep"])

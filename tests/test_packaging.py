@@ -1,6 +1,8 @@
 """What the distributions carry: the sdist is enough to run the tests, the wheel carries the physics
 notes that archives cite."""
 
+import os
+import re
 import subprocess
 import sys
 import tarfile
@@ -10,8 +12,17 @@ from pathlib import Path
 import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
-#: Everything a test imports or reads from the source tree.
-NEEDED = ("tests", "studies", "docs", "benchmarks")
+#: Everything a test imports or reads from the source tree (figures: the committed figures, their
+#: archives and captions, which the gallery, test_figures, test_studies and test_statements read).
+NEEDED = ("tests", "studies", "docs", "benchmarks", "figures")
+#: The quick tests run from the unpacked sdist: those that read what the sdist must carry besides the
+#: package (the figures and their data, the studies, the docs pages), not marked slow; the whole
+#: suite there would take as long as ``make test``.
+FROM_SDIST = ("tests/test_figures.py", "tests/test_studies.py", "tests/test_statements.py", "tests/test_docs.py",
+              "tests/test_parameters.py")
+#: An sdist larger than this is carrying something by mistake (it is about 9.9 MB: the figures' PNGs,
+#: PDFs and HDF5 archives are most of it).
+MAX_SDIST_BYTES = 15_000_000
 
 pytestmark = pytest.mark.slow
 
@@ -40,6 +51,7 @@ def test_sdist_has_every_test_input_and_its_tests_run(tmp_path):
         tar.extractall(tmp_path / "unpacked", filter="data")
     missing = sorted(_source_files() - names)
     assert not missing, f"files the tests need are not in the sdist: {missing[:10]}"
+    assert sdist.stat().st_size < MAX_SDIST_BYTES and not any(n.startswith("figures/preview") for n in names)
     assert {"phaseimpact/_oracle.py", "Makefile", "mkdocs.yml", "phaseimpact/docs/physics.md"} <= names
     # Collecting every test imports each test module from the unpacked sdist.
     tree = tmp_path / "unpacked" / top
@@ -47,9 +59,16 @@ def test_sdist_has_every_test_input_and_its_tests_run(tmp_path):
                                 "tests"], cwd=tree, capture_output=True, text=True)
     assert collected.returncode == 0, collected.stdout[-2000:] + collected.stderr[-2000:]
     assert " tests collected" in collected.stdout
-    ran = subprocess.run([sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", "tests/test_parameters.py"],
-                         cwd=tree, capture_output=True, text=True)
-    assert ran.returncode == 0, ran.stdout[-2000:]
+    env = {**os.environ, "PYTHONPATH": str(tree)}  # the sdist's own package, not this checkout's
+    ran = subprocess.run([sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", "-m", "not slow",
+                          *FROM_SDIST], cwd=tree, env=env, capture_output=True, text=True)
+    assert ran.returncode == 0, ran.stdout[-3000:]
+    assert re.search(r"\b\d{3,} passed", ran.stdout) and " skipped" not in ran.stdout, ran.stdout[-500:]
+    site = tmp_path / "site"
+    built = subprocess.run([sys.executable, "-m", "mkdocs", "build", "--strict", "--site-dir", str(site)], cwd=tree,
+                           env=env, capture_output=True, text=True)
+    assert built.returncode == 0, built.stderr[-3000:]
+    assert (site / "gallery" / "index.html").is_file() and (site / "changelog" / "index.html").is_file()
 
 
 def test_wheel_carries_the_physics_notes_archives_cite(tmp_path):

@@ -22,6 +22,7 @@ pytest.importorskip("h5netcdf")
 cf_units = pytest.importorskip("cf_units")
 
 LAW = "hunt-crossley"
+TRANSITION_CODES = {name: code for code, name in enumerate(archive.TRANSITION_KINDS)}
 PARAMS = seed_parameters(kappa=3e9)
 PERIOD = 3e-3
 #: A fixed creation time, so that to_xarray and save write the same attributes (created, history).
@@ -79,17 +80,17 @@ def _flag(ds, name) -> list:
 def test_a_trajectory_with_samples():
     tr = simulate(PARAMS, LAW, save="steps")
     ds = archive.to_xarray(tr)
-    assert ds.sizes["time"] == len(tr.t) > 10 and ds.sizes["event"] == len(tr.events)
+    assert ds.sizes["t"] == len(tr.t) > 10 and ds.sizes["event"] == len(tr.events)
     assert ds.attrs["kind"] == "trajectory" and json.loads(ds.attrs["law"]) == tr.law.as_dict()
     assert json.loads(ds.attrs["parameters"]) == json.loads(json.dumps(tr.params.as_dict()))
     assert ds.attrs["message"] == tr.message and ds.attrs["rtol"] == 1e-10 and ds.attrs["t_end"] == tr.t_end
-    np.testing.assert_array_equal(ds.time.values, tr.t)
+    np.testing.assert_array_equal(ds.t.values, tr.t)
     for name, expected, units in (("x1", tr.x1, "m"), ("x2", tr.x2, "m"), ("x1dot", tr.y[:, 2], "m s-1"),
                                   ("x2dot", tr.y[:, 3], "m s-1"), ("contact_work", tr.y[:, 4], "J"),
                                   ("delta", tr.delta, "m"), ("deltadot", tr.deltadot, "m s-1"),
                                   ("force", tr.force, "N")):
         np.testing.assert_array_equal(ds[name].values, expected, err_msg=name)
-        assert ds[name].dims == ("time",) and ds[name].attrs["units"] == units and ds[name].attrs["long_name"]
+        assert ds[name].dims == ("t",) and ds[name].attrs["units"] == units and ds[name].attrs["long_name"]
     np.testing.assert_array_equal(ds.mode.values, tr.mode)
     # the event log
     assert _flag(ds, "event_kind") == [e.kind for e in tr.events]
@@ -113,7 +114,7 @@ def test_a_trajectory_with_samples():
 def test_a_summary_run_has_its_events_and_summary_without_samples():
     tr = simulate(PARAMS, LAW, save="summary")
     ds = archive.to_xarray(tr)
-    assert ds.sizes["time"] == 0 and ds.sizes["event"] == len(tr.events) > 0
+    assert ds.sizes["t"] == 0 and ds.sizes["event"] == len(tr.events) > 0
     np.testing.assert_array_equal(ds.event_time.values, tr.event_t)
     assert ds.dissipated_energy.item() == tr.dissipated_energy and _flag(ds, "outcome") == [tr.outcome]
     assert set(_flag(ds, "outcome")) <= set(OUTCOMES) and set(_flag(ds, "status")) <= set(STATUSES)
@@ -131,7 +132,9 @@ def test_a_trajectory_carries_its_own_case():
 def test_transitions():
     found = transitions(PARAMS, LAW, 1e8, 1e13, num=80)
     ds = archive.to_xarray(found, params=PARAMS, law=LAW, settings={"kappa_min": 1e8, "kappa_max": 1e13})
-    assert ds.sizes["transition"] == len(found) >= 2 and ds.attrs["kind"] == "transitions"
+    assert ds.sizes["kappa"] == len(found) >= 2 and ds.attrs["kind"] == "transitions"
+    assert [t.kappa for t in found] == sorted(t.kappa for t in found)  # as the coordinate orders them
+    assert ds.sel(kappa=found[1].kappa).kind.item() == TRANSITION_CODES[found[1].kind]
     assert _flag(ds, "kind") == [t.kind for t in found]
     np.testing.assert_array_equal(ds.kappa.values, [t.kappa for t in found])
     assert ds.kappa.attrs["fractional_units"] == "N s m-2.5" and "units" not in ds.kappa.attrs
@@ -147,7 +150,7 @@ def test_a_count_that_is_not_known_is_missing_not_minus_one():
     assert ds.count_below.item() == 1 and np.isnan(ds.count_above.item()) and np.isnan(ds.extremum.item())
     assert "law" not in ds.attrs  # not given: left out
     assert ds.kappa.attrs["fractional_units"] == "N s m-(1+alpha)"
-    assert archive.to_xarray([]).sizes["transition"] == 0  # none in the range
+    assert archive.to_xarray([]).sizes["kappa"] == 0  # none in the range
 
 
 # ------------------------------------------------------------------------------------------------
@@ -296,3 +299,21 @@ def test_compliance_checker_reports_no_errors_on_a_train_archive(kind, train_arc
     scores = json.loads(report.read_text())[f"cf:{version}"]
     assert not failed and passed, (scores["high_priorities"], scores["medium_priorities"])
     assert scores["high_count"] == scores["medium_count"] == scores["low_count"] == 0, scores["low_priorities"]
+
+
+def test_train_archives_of_the_command_line_keep_the_case_name_and_description(tmp_path):
+    """The command line archives the case it ran (name, description, source), not only its numbers."""
+    from _cli import run
+
+    from phaseimpact.case import load_case
+
+    path = tmp_path / "train.nc"
+    code, _, err = run(["train", "--law", LAW, "--kappa", "3e9", "--period", "3e-3", "--impacts", "2",
+                        "--archive", path])
+    assert code == 0, err
+    with h5py.File(path, "r") as f:
+        assert f.attrs["base"] == "case"
+        case = json.loads(f.attrs["case"])
+    seed = load_case("seed")
+    assert (case["name"], case["description"]) == (seed.name, seed.description) and seed.description
+    assert json.loads(xr.open_dataset(path).attrs["case"])["name"] == "seed"
