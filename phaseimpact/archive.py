@@ -708,8 +708,9 @@ def _reserve(f, nbytes: int) -> None:
 
     HDF5 must never meet a full disk: a failed write leaves objects it can no longer close (their
     finalizers print a traceback each) and the interpreter's exit then crashes inside HDF5 (a
-    segfault). Reserved first, a full disk is an ``OSError`` here, before HDF5 writes. An archive
-    built in memory (:func:`to_xarray`) has no disk to reserve."""
+    segfault). Reserved first, a full disk is an ``OSError`` here, before HDF5 writes (and the file is
+    discarded: :func:`_write_file`). An archive built in memory (:func:`to_xarray`) has no disk to
+    reserve."""
     if f.driver == "fileobj":
         return
     fd = f.id.get_vfd_handle()
@@ -736,9 +737,20 @@ def _write_file(result, path: str, *, force: bool, spare_rows: int, context=None
                              "(force=True replaces it)")
         try:
             with h5py.File(tmp, "w", libver=_LIBVER) as f:
-                _reserve(f, 0)  # the header, attributes and small datasets
-                _write_result(f, result, created, layout, spare_rows, context)
-                _reserve(f, 0)  # what the close writes
+                fd = f.id.get_vfd_handle()
+                try:
+                    _reserve(f, 0)  # the header, attributes and small datasets
+                    _write_result(f, result, created, layout, spare_rows, context)
+                    _reserve(f, 0)  # what the close writes
+                except BaseException:
+                    # The close writes what HDF5 still holds (chunks, object headers) at addresses it chose,
+                    # which a failed reservation may have given back (tmpfs returns every unwritten block of
+                    # the range asked for): that write fails on a full disk and leaves HDF5 objects it cannot
+                    # close (a segfault at exit). The file is discarded: give its blocks back, so that the
+                    # close finds room.
+                    with contextlib.suppress(OSError):
+                        os.ftruncate(fd, 0)
+                    raise
         except (ValueError, RuntimeError) as error:
             disk = _as_disk_error(error)
             if disk is None:
@@ -2643,20 +2655,27 @@ def same_work(held: dict, kind: str, law: ContactLaw, params: Parameters, axes: 
 
 
 def check_overwrite(path, kind: str, law: ContactLaw, params: Parameters, axes: dict, t_end, rtol, *,
-                    force: bool = False, name: str = "out") -> None:
+                    force: bool = False, name: str = "out", settings: dict | None = None) -> None:
     """Refuse (``ValueError``) to replace ``path`` unless it is missing, or an archive of the same work
-    (kind, law, parameters, axis values, ``t_end`` and ``rtol``), or ``force`` is set.
+    (kind, law, parameters, axis values, ``t_end``, ``rtol`` and ``settings``), or ``force`` is set.
+
+    The one rule of every command that writes an archive (``--out`` of ``sweep``, ``atlas``,
+    ``critical-curve``; ``--archive`` of ``train``, ``orbit-diagram``, ``map-continuation``, ``basins``).
 
     Parameters
     ----------
     path : str or path-like
         The file a command would write.
     kind, law, params, axes, t_end, rtol
-        The work asked for, as for :func:`same_work`.
+        The work asked for, as for :func:`same_work`. A critical curve's ``axes`` are the values asked
+        for (the archive also holds its continuation's intermediate steps).
     force : bool, default False
         Allow any replacement (the command line's ``--force``).
     name : str, default "out"
         How the message names ``path`` (the command line's option).
+    settings : dict, optional
+        Compared too where given: a train result's settings as :func:`save` stores them (``period``,
+        ``impacts``, ...), or a critical curve's ``{"what": ...}``.
 
     Raises
     ------
@@ -2683,6 +2702,11 @@ def check_overwrite(path, kind: str, law: ContactLaw, params: Parameters, axes: 
         return
     try:
         held = describe(path)
+        if held["kind"] == kind and settings is not None:
+            held_settings = _retrying(_stored_settings, path)
+            if kind == "critical-curve":
+                curve = load(path)
+                held["axes"] = {curve.param: np.asarray(curve.values)[np.asarray(curve.requested, dtype=bool)]}
     except DamagedArchiveError as error:
         raise ValueError(f"{name} = {path!r} exists and is a damaged phaseimpact archive ({error.reason}); refusing "
                          "to overwrite it (choose another path, or add --force to replace it)") from None
@@ -2690,6 +2714,18 @@ def check_overwrite(path, kind: str, law: ContactLaw, params: Parameters, axes: 
         raise ValueError(f"{name} = {path!r} exists and is not a phaseimpact archive; refusing to overwrite it "
                          "(choose another path, or add --force to replace it)") from None
     differences = same_work(held, kind, law, params, axes, t_end, rtol)
+    if held["kind"] == kind and settings is not None:
+        asked = json.loads(_json(settings))
+        differences += [f"{key} {held_settings.get(key)!r} (asked {asked.get(key)!r})"
+                        for key in sorted(set(asked) | set(held_settings)) if held_settings.get(key) != asked.get(key)]
     if differences:
         raise ValueError(f"{name} = {path!r} holds other work ({'; '.join(differences)}); refusing to overwrite it "
                          "(choose another path, or add --force to replace it)")
+
+
+def _stored_settings(path: str) -> dict:
+    """What identifies an archive's work beyond :func:`describe`: a train result's settings, a curve's ``what``."""
+    with _reading(path) as f:
+        if _attr_str(f, "kind") == "critical-curve":
+            return {"what": _attr_str(f, "what")} if "what" in f.attrs else {}
+        return _json_attr(f, "settings", dict) if "settings" in f.attrs else {}
