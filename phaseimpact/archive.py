@@ -244,6 +244,16 @@ _LIBVER = ("v108", "v108")
 #: Root attribute: SHA-256 of the file's text attributes, which HDF5 keeps in its global heap (no
 #: checksum there: a changed digit of the case JSON would load silently).
 _TEXT_DIGEST = "text_sha256"
+#: Root attribute: the SHA-256 of each dataset's contents (:func:`_dataset_digest`), JSON ``{path: hex}`` in a
+#: fixed-length text, so that a checkpoint rewrites it in place. Fletcher-32 passes a chunk whose data and
+#: checksum were both zeroed or filled with 0xFF; this digest does not.
+_DATA_DIGEST = "data_sha256"
+#: What :data:`_DATA_DIGEST` holds while a checkpoint writes in place: a file killed then has nothing to be
+#: verified against (:func:`load` takes it unverified, as an archive written before data digests); the next
+#: checkpoint rewrites it whole.
+_IN_PROGRESS = '{"checkpoint": "in progress"}'
+#: Elements (C order) per piece of a dataset's digest: a checkpoint hashes again only the pieces it wrote.
+_DIGEST_PIECE = 8192
 
 
 # ------------------------------------------------------------------------------------------------
@@ -728,7 +738,7 @@ def _as_disk_error(error: Exception) -> OSError | None:
 
 def _write_file(result, path: str, *, force: bool, spare_rows: int, context=None):
     """Write a whole archive atomically; a sweep's stick variables get ``spare_rows`` free rows.
-    Returns the sweep's per-point ``(stick_first, stick_count)`` (None for a curve)."""
+    Returns the sweep's per-point ``(stick_first, stick_count, piece digests)`` (None for another kind)."""
     created = created_timestamp()  # a bad SOURCE_DATE_EPOCH is refused before anything is written
     layout = _sweep_layout(result) if isinstance(result, SweepResult) else None
     with atomic_path(path, "path") as tmp:
@@ -740,7 +750,7 @@ def _write_file(result, path: str, *, force: bool, spare_rows: int, context=None
                 fd = f.id.get_vfd_handle()
                 try:
                     _reserve(f, 0)  # the header, attributes and small datasets
-                    _write_result(f, result, created, layout, spare_rows, context)
+                    pieces = _write_result(f, result, created, layout, spare_rows, context)
                     _reserve(f, 0)  # what the close writes
                 except BaseException:
                     # The close writes what HDF5 still holds (chunks, object headers) at addresses it chose,
@@ -757,10 +767,11 @@ def _write_file(result, path: str, *, force: bool, spare_rows: int, context=None
                 raise
             raise disk from None  # atomic_path names the path
         release_reserve(tmp)
-    return None if layout is None else (layout.first, layout.count)
+    return None if layout is None else (layout.first, layout.count, pieces)
 
 
-def _write_result(f, result, created: str, layout, spare_rows: int, context=None) -> None:
+def _write_result(f, result, created: str, layout, spare_rows: int, context=None) -> dict:
+    """Write ``result`` into the open file ``f``; return its datasets' piece digests (:func:`_file_pieces`)."""
     if isinstance(result, SweepResult):
         _write_sweep(f, result, created, layout, spare_rows)
     elif isinstance(result, CriticalCurve):
@@ -769,7 +780,10 @@ def _write_result(f, result, created: str, layout, spare_rows: int, context=None
         _write_transitions(f, result, created, context)
     else:
         _WRITERS[type(result)](f, result, created, context)
+    pieces = _file_pieces(f)  # read back: the digests are of what the file holds
+    f.attrs[_DATA_DIGEST] = np.bytes_(_digests_text(pieces).encode("ascii"))
     f.attrs[_TEXT_DIGEST] = _texts_digest(f)
+    return pieces
 
 
 def to_xarray(result, *, params=None, law=None, settings: dict | None = None):
@@ -927,6 +941,76 @@ def _texts_digest(f) -> str:
         add("extras", f["extras"])
         f["extras"].visititems(add)
     return h.hexdigest()
+
+
+def _piece_digests(data: np.ndarray) -> list:
+    """SHA-256 of each :data:`_DIGEST_PIECE` elements of ``data`` in C order (its bytes as stored)."""
+    flat = np.ascontiguousarray(data).reshape(-1)
+    if flat.dtype.kind not in "biufc":  # text: its characters, not the addresses of Python objects
+        flat = np.array([_json(x.decode() if isinstance(x, bytes) else x) for x in flat.tolist()], dtype=str)
+    return [hashlib.sha256(flat[i:i + _DIGEST_PIECE].tobytes()).digest()
+            for i in range(0, max(flat.size, 1), _DIGEST_PIECE)]
+
+
+def _dataset_digest(dtype, shape, pieces) -> str:
+    """A dataset's digest: of its type, shape and the digests of its pieces; whatever its chunks or filters."""
+    h = hashlib.sha256(_json([np.dtype(dtype).str, list(shape)]).encode())
+    for piece in pieces:
+        h.update(piece)
+    return h.hexdigest()
+
+
+def _file_pieces(f) -> dict:
+    """``{path: (dtype, shape, piece digests)}`` of every dataset of the open file ``f`` (each is read whole)."""
+    found = {}
+
+    def visit(name, node):
+        if isinstance(node, h5py.Dataset):
+            found[name] = (node.dtype, node.shape, _piece_digests(node[()]))
+
+    f.visititems(visit)
+    return found
+
+
+def _digests_text(pieces: dict) -> str:
+    digests = {name: _dataset_digest(*entry) for name, entry in pieces.items()}
+    return json.dumps(digests, sort_keys=True, separators=(",", ":")).ljust(len(_IN_PROGRESS))
+
+
+def _stored_digests(f) -> dict | None:
+    """The digests :data:`_DATA_DIGEST` holds; None where the file has none to check against (written before
+    data digests, or killed while a checkpoint wrote in place)."""
+    if _DATA_DIGEST not in f.attrs:
+        return None
+    value = f.attrs[_DATA_DIGEST]
+    try:
+        stored = json.loads(value.decode("ascii") if isinstance(value, bytes) else value)
+    except (TypeError, ValueError, AttributeError):
+        stored = None
+    if stored == json.loads(_IN_PROGRESS):
+        return None
+    if not (isinstance(stored, dict) and all(isinstance(v, str) for v in stored.values())):
+        raise _Damaged(f"attribute {_DATA_DIGEST} = {_short(value)} is out of range; allowed: the SHA-256 digests "
+                       "of the datasets")
+    return stored
+
+
+def _check_data_digests(f) -> None:
+    """Every dataset's contents against :data:`_DATA_DIGEST`, where the file has it."""
+    stored = _stored_digests(f)
+    if stored is None:
+        return
+    pieces = _file_pieces(f)
+    for name in sorted(set(stored) | set(pieces)):
+        if name not in pieces:
+            raise _Damaged(f"variable {name} is missing")
+        if name not in stored:
+            raise _Damaged(f"variable {name} has no SHA-256 digest in {_DATA_DIGEST} (it was added after the file "
+                           "was written)")
+        if stored[name] != _dataset_digest(*pieces[name]):
+            # checksum: a reader may catch a checkpoint writing in place; read again, as for Fletcher-32
+            raise _Damaged(f"variable {name}: its contents do not match their SHA-256 digest {_DATA_DIGEST} (the "
+                           "file's bytes were changed after it was written)", checksum=True)
 
 
 def _header(f, kind: str, law: ContactLaw | None, base, t_end, rtol, engine: str, created: str, title: str,
@@ -1568,6 +1652,7 @@ class _OnDisk:
     failed: np.ndarray      # committed failed points (recomputed on resume)
     failed_snapshot: dict   # their codes and columns, to see whether a recomputation changed them
     columns: list
+    pieces: dict            # every dataset's piece digests (_file_pieces), to update its digest
 
 
 class Checkpoint:
@@ -1664,10 +1749,10 @@ class Checkpoint:
         per_point = max(1.0, len(r.stick_point) / computed) if computed else 2.0
         remaining = n - int(np.count_nonzero(status == _driver.SUCCESS))
         spare = int(math.ceil(1.25 * per_point * remaining)) + 1024
-        first, count = _write_file(r, self.path, force=self.force, spare_rows=spare)
+        first, count, pieces = _write_file(r, self.path, force=self.force, spare_rows=spare)
         rows = len(r.stick_point)
         self._disk = _OnDisk(_stamp(self.path), r.grid.shape, status.astype(np.int8, copy=True), first, count,
-                             rows + spare, rows, rows, np.empty(0, dtype=np.int64), {}, list(r.values))
+                             rows + spare, rows, rows, np.empty(0, dtype=np.int64), {}, list(r.values), pieces)
         self._remember_failed(r, np.flatnonzero(status > _driver.SUCCESS))
 
     def _remember_failed(self, r: SweepResult, failed: np.ndarray) -> None:
@@ -1680,15 +1765,24 @@ class Checkpoint:
     # -- reading the file's state ---------------------------------------------------------------
 
     def _read_disk(self, r: SweepResult) -> _OnDisk | None:
-        """The file's state if it is an archive of this schema of ``r``'s grid that can be written in place."""
+        """The file's state if it is an archive of this schema of ``r``'s grid that can be written in place:
+        its data match their digests (a file killed while a checkpoint wrote, or written before data
+        digests, is rewritten whole; so no stick row a killed checkpoint wrote stays behind)."""
         path = self.path
         if not os.path.isfile(path) or not _is_archive(path):
             return None
         stamp = _stamp(path)
-        with h5py.File(path, "r+", locking=False) as f:
+        with h5py.File(path, "r", locking=False) as f:
             if int(f.attrs["schema_version"]) != SCHEMA_VERSION or not _same_grid(f, r):
                 return None
             if any(name not in f for name in ("status", "stick_first", "stick_count", "stick_point")):
+                return None
+            try:
+                stored = _stored_digests(f)
+            except _Damaged:
+                return None
+            pieces = _file_pieces(f)
+            if stored != {name: _dataset_digest(*entry) for name, entry in pieces.items()}:
                 return None
             status = f["status"][()].reshape(-1)
             first = f["stick_first"][()].reshape(-1).astype(np.int64)
@@ -1698,7 +1792,7 @@ class Checkpoint:
             free = int((first[committed] + count[committed]).max()) if committed.any() else 0
             rows = int(count[committed].sum())
             disk = _OnDisk(stamp, r.grid.shape, status.astype(np.int8), first, count, capacity, free, rows,
-                           np.empty(0, dtype=np.int64), {}, json.loads(_attr_str(f, "columns")))
+                           np.empty(0, dtype=np.int64), {}, json.loads(_attr_str(f, "columns")), pieces)
             failed = np.flatnonzero(status > _driver.SUCCESS)
             disk.failed = failed
             if failed.size:
@@ -1706,17 +1800,6 @@ class Checkpoint:
                 for name in ("outcome", "stop_reason", *disk.columns):
                     snapshot[name] = f[name][()].reshape(-1)[failed]
                 disk.failed_snapshot = snapshot
-            # rows no committed point owns (a killed checkpoint, a recomputed point) are marked unused,
-            # so that readers of stick_point alone do not see them
-            if capacity:
-                point = f["stick_point"][()]
-                owned = np.zeros(capacity, dtype=bool)
-                owned[_owned_rows(first, count, status >= 0)] = True
-                stale = (point != -1) & ~owned
-                if stale.any():
-                    point[stale] = -1
-                    f["stick_point"][...] = point
-        disk.stamp = _stamp(path)
         return disk
 
     # -- in place ---------------------------------------------------------------------------------
@@ -1768,8 +1851,13 @@ class Checkpoint:
             raw = _Raw(self.path)
         except OSError:  # e.g. open elsewhere in this process with HDF5 file locking: rewrite it
             return False
+        free, old_rows = disk.free, _owned_rows(disk.first, disk.count, np.isin(np.arange(r.grid.size), recomputed))
         with raw:
+            # a kill from here on leaves a file whose data match no digest: say so first
+            raw.set_text(_DATA_DIGEST, _IN_PROGRESS)
+            raw.flush_to_disk(self.fsync)
             self._commit(raw, r, new, recomputed, rows, counts)
+            self._update_digests(raw, new, np.union1d(np.arange(free, free + rows.size), old_rows))
         self._disk.stamp = _stamp(self.path)  # after the close: what the next call must find
         return True
 
@@ -1786,9 +1874,21 @@ class Checkpoint:
         return changed
 
     def _flush(self, raw) -> None:
-        raw.flush()
-        if self.fsync:
-            fsync_file(raw.fid)
+        raw.flush_to_disk(self.fsync)
+
+    def _update_digests(self, raw, points: np.ndarray, rows: np.ndarray) -> None:
+        """After a commit: hash again the pieces holding the ``points`` and stick ``rows`` written, then
+        store the digests (the end of the checkpoint)."""
+        disk = self._disk
+        gridded = ("status", "outcome", "stop_reason", *disk.columns, "stick_first", "stick_count")
+        for names, indices in ((gridded, points), (_STICK_VARIABLES, rows)):
+            for k in np.unique(np.asarray(indices, dtype=np.int64) // _DIGEST_PIECE).tolist():
+                for name in names:
+                    dtype, shape, pieces = disk.pieces[name]
+                    lo = k * _DIGEST_PIECE
+                    pieces[k] = _piece_digests(raw.read_flat(name, lo, min(lo + _DIGEST_PIECE, int(np.prod(shape)))))[0]
+        raw.set_text(_DATA_DIGEST, _digests_text(disk.pieces))
+        raw.flush_to_disk(self.fsync)
 
     def _commit(self, raw, r: SweepResult, new, recomputed, rows, counts) -> None:
         disk = self._disk
@@ -1874,8 +1974,31 @@ class _Raw:
         """Write ``values`` into rows ``lo, lo + 1, ...`` of the 1-d dataset ``name``."""
         self._put(name, (lo,), values)
 
-    def flush(self) -> None:
+    def read_flat(self, name: str, lo: int, hi: int) -> np.ndarray:
+        """Elements ``lo .. hi - 1`` (C order) of dataset ``name``, as the file holds them."""
+        d = self._dataset(name)
+        parts = []
+        for box in _boxes(lo, hi, d.shape):
+            start, count = tuple(s.start for s in box), tuple(s.stop - s.start for s in box)
+            block = np.empty(count, dtype=d.dtype)
+            space = d.get_space()
+            space.select_hyperslab(start, count)
+            d.read(h5py.h5s.create_simple(count), space, block)
+            parts.append(block.reshape(-1))
+        return np.concatenate(parts) if parts else np.empty(0, dtype=d.dtype)
+
+    def set_text(self, name: str, text: str) -> None:
+        """Overwrite the root's fixed-length text attribute ``name`` in place (padded with spaces)."""
+        attr = h5py.h5a.open(h5py.h5g.open(self.fid, b"/"), name.encode())
+        try:
+            attr.write(np.array(text.encode("ascii").ljust(attr.dtype.itemsize), dtype=attr.dtype))
+        finally:
+            attr.close()
+
+    def flush_to_disk(self, fsync: bool) -> None:
         h5py.h5f.flush(self.fid)
+        if fsync:
+            fsync_file(self.fid)
 
 
 def _owned_rows(first, count, committed) -> np.ndarray:
@@ -2238,14 +2361,16 @@ def _load(path: str):
     return result
 
 
-def _check_metadata(f, *, chunks: bool = True) -> None:
+def _check_metadata(f, *, data: bool = True) -> None:
     """The parts of the metadata that HDF5's own checksums leave out: the text attributes (against
-    :data:`_TEXT_DIGEST`, where the file has one) and the chunk index of every checksummed dataset."""
+    :data:`_TEXT_DIGEST`, where the file has one); with ``data``, the chunk index of every checksummed
+    dataset and every dataset's contents (against :data:`_DATA_DIGEST`, where the file has it)."""
     if _TEXT_DIGEST in f.attrs and _attr_str(f, _TEXT_DIGEST) != _texts_digest(f):
         raise _Damaged("its text attributes (case, law, settings, ...) do not match their SHA-256 digest "
                        f"{_TEXT_DIGEST} (the file's bytes were changed)")
-    if chunks:
+    if data:
         _check_storage(f)
+        _check_data_digests(f)
 
 
 def _check_storage(f) -> None:
@@ -2383,8 +2508,10 @@ def _out_of_range(name: str, values: np.ndarray, bad: np.ndarray, allowed: str) 
 
 
 def _check_sweep(r: SweepResult) -> None:
-    """Codes within their tables (the figures and summaries index tables with them). The columns are
-    not judged: NaN and -1 are legitimate values (not measured, or not stored by schema 1)."""
+    """Codes within their tables (the figures and summaries index tables with them), a finite
+    ``max_force`` where a run succeeded and counts >= 0 (or -1: not kept, as in archives of schema 1) at
+    computed points: what a chunk overwritten with its checksum breaks (0xFF makes NaN and -1; the data
+    digests catch the rest). Other NaN are legitimate: not measured."""
     status = np.asarray(r.status)
     computed = status >= 0
     _out_of_range("status", status, (status < -1) | (status >= len(STATUSES)),
@@ -2393,6 +2520,15 @@ def _check_sweep(r: SweepResult) -> None:
         codes = np.asarray(getattr(r, name))
         _out_of_range(name, codes, computed & ((codes < 0) | (codes >= len(names))),
                       f"0 to {len(names) - 1} ({', '.join(names)}) at a computed point")
+    if "max_force" in r.values:
+        force = np.asarray(r.values["max_force"])
+        _out_of_range("max_force", force, (status == _driver.SUCCESS) & ~np.isfinite(force),
+                      "a finite force (N) where the run succeeded")
+    for name, column in r.values.items():
+        column = np.asarray(column)
+        if column.dtype.kind == "i":
+            _out_of_range(name, column, computed & (column < -1), "a count >= 0 (or -1: not kept) at a computed "
+                          "point")
 
 
 def _check_curve(c: CriticalCurve) -> None:
@@ -2569,7 +2705,7 @@ def _describe(path: str) -> dict:
             param = "v" if version == 1 else _attr_str(g, "param")
             axes = {param: axis(g, param, param)}
         if version >= 3:
-            _check_metadata(f, chunks=False)
+            _check_metadata(f, data=False)
         return {"kind": kind, "law": law, "parameters": params, "axes": axes, "t_end": _real_attr(f, "t_end"),
                 "rtol": _real_attr(f, "rtol"), "schema_version": version}
 
