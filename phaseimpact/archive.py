@@ -2149,6 +2149,14 @@ def _reading(path: str):
         raise DamagedArchiveError(path, _why(error)) from None
 
 
+def _archive_path(path) -> str:
+    """``path`` as text, or a ``TypeError`` naming it (not os.fspath's, which names no argument)."""
+    if not isinstance(path, (str, bytes, os.PathLike)):
+        raise TypeError(f"path = {_short(path)} has the wrong type ({type(path).__name__}); allowed: the path of an "
+                        "archive (str or os.PathLike)")
+    return os.fsdecode(path)
+
+
 def _retrying(read, path: str):
     for pause in (*_RETRY_PAUSES, None):
         try:
@@ -2334,7 +2342,7 @@ def load(path):
     ...
     ValueError: ...
     """
-    return _retrying(_load, os.fspath(path))
+    return _retrying(_load, _archive_path(path))
 
 
 def _load(path: str):
@@ -2673,7 +2681,7 @@ def describe(path) -> dict:
     >>> held["kind"], held["law"]["name"], held["axes"]["kappa"].tolist(), held["t_end"], held["schema_version"]
     ('sweep', 'paper', [1000000000.0, 10000000000000.0], nan, 5)
     """
-    return _retrying(_describe, os.fspath(path))
+    return _retrying(_describe, _archive_path(path))
 
 
 def _describe(path: str) -> dict:
