@@ -2050,6 +2050,10 @@ def _open(path):
         raise ValueError(f"archive {path!r} cannot be read: {error.strerror or error}") from None
     if not stat.S_ISREG(mode):  # opening a FIFO waits for a writer forever; a device is no archive
         raise ValueError(f"archive {path!r} is not a regular file (a FIFO, device or socket); allowed: an HDF5 file")
+    try:  # first, as HDF5 would say it after "unable to open file" and a guess at damage
+        os.close(os.open(path, os.O_RDONLY))
+    except OSError as error:
+        raise ValueError(f"archive {path!r} cannot be read: {error.strerror or error}") from None
     try:
         return h5py.File(path, "r")
     except FileNotFoundError:

@@ -100,11 +100,22 @@ class _Parser(argparse.ArgumentParser):
             self.error(str(error))
         return super().parse_args(args, namespace)
 
+    def parse_known_args(self, args=None, namespace=None):
+        self._given = list(sys.argv[1:] if args is None else args)  # a subcommand's parser gets its own words
+        return super().parse_known_args(args, namespace)
+
     def error(self, message):
         choice = re.fullmatch(r"(argument (\S+)): invalid choice: (.*) \(choose from (.*)\)", message)
         if choice:  # the same wording as every other range message
             label, option, value, allowed = choice.groups()
             message = f"{label}: {option.lstrip('-')} = {value} is out of range; allowed: one of {allowed}"
+        missing = re.fullmatch(r"argument (--[\w.-]+): expected one argument", message)
+        given = getattr(self, "_given", [])
+        if missing:  # argparse takes a value starting with '-' for an option
+            for option, value in zip(given, given[1:], strict=False):
+                if option == missing.group(1) and value.startswith("-"):
+                    message += f" (a value that starts with '-' is written {option}={value})"
+                    break
         self.exit(EXIT_USAGE, f"{self.prog}: error: {message}\n")
 
 
@@ -1993,6 +2004,36 @@ def _load_law_files(argv) -> list:
     return rest
 
 
+class _StandardOutput:
+    """``sys.stdout`` for a command: a failed write names the standard output (``> /dev/full``: the disk
+    is full, but no file of ours); characters its encoding lacks are written as escapes
+    (``PYTHONIOENCODING=ascii``), not an error half way through the output."""
+
+    def __init__(self, stream):
+        self._stream = stream
+
+    def write(self, text: str) -> int:
+        try:
+            return self._stream.write(text)
+        except UnicodeEncodeError as error:
+            return self._stream.write(text.encode(error.encoding, "backslashreplace").decode(error.encoding))
+        except BrokenPipeError:
+            raise
+        except OSError as error:
+            raise OSError(error.errno, error.strerror or str(error), "standard output") from None
+
+    def flush(self) -> None:
+        try:
+            self._stream.flush()
+        except BrokenPipeError:
+            raise
+        except OSError as error:
+            raise OSError(error.errno, error.strerror or str(error), "standard output") from None
+
+    def __getattr__(self, name):
+        return getattr(self._stream, name)
+
+
 def main(argv=None) -> int:
     # Ctrl-C and SIGTERM, wherever they arrive (compiled runs included): one line, exit 130 or 143
     previous_term = signal.getsignal(signal.SIGTERM)
@@ -2006,7 +2047,13 @@ def main(argv=None) -> int:
             from . import _signals
 
             _signals.install_command_line()
-        return args.func(args)
+        stdout, sys.stdout = sys.stdout, _StandardOutput(sys.stdout)
+        try:
+            code = args.func(args)
+            sys.stdout.flush()  # a full standard output fails here, named, not at the interpreter's exit
+        finally:
+            sys.stdout = stdout
+        return code
     except ValueError as error:
         print(f"phaseimpact: error: {error}", file=sys.stderr)
         return EXIT_USAGE
