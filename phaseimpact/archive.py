@@ -111,10 +111,12 @@ is made (C-order slabs of :data:`CHUNK_POINTS` points) and room for more stick p
 checkpoint only overwrites the bytes of the new points and appends their stick phases; no HDF5
 metadata changes. It is crash-safe by ordering (each step flushed and fsynced before the next):
 
-0. points being recomputed (they failed before) get status -1 (not computed);
+0. the data digests (``data_sha256``, below) are marked in progress; points being recomputed (they
+   failed before) get status -1 (not computed);
 1. the new points' stick phases go to free rows, then their outcome, columns, ``stick_first`` and
    ``stick_count``;
-2. last, their ``status``: the commit.
+2. their ``status``: the commit;
+3. last, the digests of what the file now holds (only the pieces written are hashed again).
 
 A kill before step 2 leaves the new points at status -1: not computed, recomputed on resume (their
 other variables may hold the interrupted values until then; :func:`load` returns them as not
@@ -133,8 +135,12 @@ Integrity. Every chunk of every variable carries a Fletcher-32 checksum (HDF5's 
 netCDF-4, h5netcdf and h5py verify on every read); the file format is HDF5 1.8's, whose superblock
 and object headers (attributes included) are checksummed; root attribute ``text_sha256`` is the
 SHA-256 of the text attributes (HDF5 keeps them in its global heap, without a checksum); the chunk
-index (a v1 B-tree, without one) is checked on load. :func:`load` and :func:`describe` also check the
-content (codes within their tables, finite axes, scalar attributes) and refuse a damaged file with a
+index (a v1 B-tree, without one) is checked on load. Fletcher-32 passes a chunk whose data and checksum
+were both zeroed or filled with 0xFF: root attribute ``data_sha256`` is the SHA-256 of each dataset's
+contents (:func:`_dataset_digest`), checked by :func:`load`; a file written before it, or killed while a
+checkpoint wrote in place, loads unverified by it. :func:`load` and :func:`describe` also check the
+content (codes within their tables, finite axes, scalar attributes; :func:`load`: a finite
+``max_force`` where a run succeeded, counts >= -1 at computed points) and refuse a damaged file with a
 :class:`DamagedArchiveError` (a ``ValueError``) that names it and the damage; what a checkpoint
 in progress leaves at points not yet committed and in unused stick rows is not damage.
 """
