@@ -116,7 +116,8 @@ metadata changes. It is crash-safe by ordering (each step flushed and fsynced be
 1. the new points' stick phases go to free rows, then their outcome, columns, ``stick_first`` and
    ``stick_count``;
 2. their ``status``: the commit;
-3. last, the digests of what the file now holds (only the pieces written are hashed again).
+3. the recomputed points' old stick rows are marked unused; last, the digests of what the file now
+   holds (only the pieces written are hashed again).
 
 A kill before step 2 leaves the new points at status -1: not computed, recomputed on resume (their
 other variables may hold the interrupted values until then; :func:`load` returns them as not
