@@ -1670,8 +1670,9 @@ class Checkpoint:
     still to come); later calls write only the points computed since the previous call, in place, in
     the crash-safe order described in the module docstring. A file that is not an archive of the same
     grid (law, base, axes, ``t_end``, ``rtol``, columns, extras) is rewritten whole, as is one whose
-    spare stick rows are used up. ``path``'s write lock is taken for every call (re-entrant: a caller
-    may hold it for the whole sweep).
+    spare stick rows are used up and one whose data do not match their digests (killed while a
+    checkpoint wrote, or written before data digests). ``path``'s write lock is taken for every call
+    (re-entrant: a caller may hold it for the whole sweep).
 
     Parameters
     ----------
