@@ -61,7 +61,7 @@ def plane_coordinates(y: np.ndarray, plane) -> tuple[np.ndarray, np.ndarray]:
     Raises
     ------
     ValueError
-        For a plane not in :data:`PLANES`.
+        For a plane not in :data:`PLANES`, or ``y`` of another shape (the last axis: 4 or 5).
 
     Examples
     --------
@@ -159,6 +159,8 @@ def find_asymptotic_points(trajectory: Trajectory, plane=("delta", "deltadot"), 
 
     Raises
     ------
+    TypeError
+        If ``trajectory`` is not a Trajectory.
     ValueError
         For a plane not in :data:`PLANES`, ``tol`` out of range, an unknown ``method``,
         ``events`` on a trajectory without events (RK4) or outside the relative plane, or

@@ -594,6 +594,8 @@ def load_case(name_or_path) -> Case:
 
     Raises
     ------
+    TypeError
+        If ``name_or_path`` is neither a str nor a path.
     ValueError
         Unknown name (the message lists the shipped ones), missing file, TOML syntax error (with
         the file name and the parser's message), or any schema error (see :func:`case_from_dict`).
@@ -861,6 +863,11 @@ def hertz_scales(params: Parameters, plate_material: Material | None = None) -> 
         ``peak_pressure`` (Pa): ``p0 = 3 F / (2 pi a0^2)``. ``m`` is the reduced mass
         (``M1`` for a rigid target). The last two are ``None`` when ``params.R`` is ``None``;
         for ``alpha != 3/2`` they are Hertz estimates only.
+
+    Raises
+    ------
+    TypeError
+        If ``params`` is not a Parameters, or ``plate_material`` neither a Material nor None.
 
     Examples
     --------
