@@ -2335,6 +2335,8 @@ def load(path):
 
     Raises
     ------
+    TypeError
+        For a ``path`` that is not a str or path-like.
     ValueError
         As above; :class:`DamagedArchiveError` for a damaged file.
 
