@@ -2,10 +2,11 @@
 
 Two pieces, used together by :func:`atomic_path`:
 
-* :func:`exclusive` holds an advisory lock (``fcntl.flock`` on a sidecar ``PATH.lock``) for as
-  long as a writer owns ``PATH``. It never waits: a second writer gets :class:`PathLockedError`
-  (a ``ValueError``) naming the holder's process id. It is re-entrant within one process, so a
-  command can hold it for a whole sweep while each checkpoint's :func:`atomic_path` takes it again.
+* :func:`exclusive` holds an advisory lock (``fcntl.flock`` on a sidecar ``PATH.lock``; a name too long
+  for that is shortened with a digest) for as long as a writer owns ``PATH``. It never waits: a second
+  writer gets :class:`PathLockedError` (a ``ValueError``) naming the holder's process id. It is
+  re-entrant within one process, so a command can hold it for a whole sweep while each checkpoint's
+  :func:`atomic_path` takes it again.
 * :func:`atomic_path` writes to a temporary file beside ``PATH`` (named with the writer's process
   id), fsyncs it and renames it over ``PATH``. Temporary files of earlier writers are removed only
   when their process is dead, and only by the lock holder, so a live writer's file is never touched.
@@ -18,6 +19,7 @@ import ctypes
 import errno
 import fcntl
 import glob
+import hashlib
 import os
 import re
 import stat
@@ -36,8 +38,24 @@ _WRITABLE = "allowed: a file path in a folder this process can write"
 _HELD: dict[str, list] = {}
 
 
+#: The longest file name most file systems take (bytes): a sidecar name must fit too.
+_NAME_MAX = 255
+
+
+def _sidecar_stem(name: str, room: int) -> str:
+    """``name``, or, when a sidecar made of it would not fit in :data:`_NAME_MAX` (``room`` bytes are
+    added), its start and a digest of the whole: the same for every writer of the name, distinct for
+    distinct names."""
+    if len(os.fsencode(name)) + room <= _NAME_MAX:
+        return name
+    digest = hashlib.sha256(os.fsencode(name)).hexdigest()[:16]
+    keep = os.fsencode(name)[:_NAME_MAX - room - len(digest) - 1].decode("utf-8", "ignore")
+    return f"{keep}-{digest}"
+
+
 def _lock_path(path: str) -> str:
-    return path + ".lock"
+    folder, name = os.path.split(path)
+    return os.path.join(folder, _sidecar_stem(name, len(".lock")) + ".lock")
 
 
 def _holder(lock_file: str) -> str:
@@ -178,7 +196,8 @@ def atomic_path(path, name: str = "path"):
     """
     with exclusive(path, name) as path:
         folder = os.path.dirname(os.path.abspath(path))
-        prefix = f".{os.path.basename(path)}."
+        # with the pid, mkstemp's 8 characters and ".tmp" (see _remove_dead_writers_temps)
+        prefix = f".{_sidecar_stem(os.path.basename(path), 32)}."
         _remove_dead_writers_temps(folder, prefix)
         fd, tmp = tempfile.mkstemp(prefix=f"{prefix}{os.getpid()}-", suffix=".tmp", dir=folder)
         os.close(fd)

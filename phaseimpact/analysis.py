@@ -61,7 +61,7 @@ def plane_coordinates(y: np.ndarray, plane) -> tuple[np.ndarray, np.ndarray]:
     Raises
     ------
     ValueError
-        For a plane not in :data:`PLANES`.
+        For a plane not in :data:`PLANES`, or ``y`` of another shape (the last axis: 4 or 5).
 
     Examples
     --------
@@ -73,6 +73,10 @@ def plane_coordinates(y: np.ndarray, plane) -> tuple[np.ndarray, np.ndarray]:
     (True, '3.547e-05 m')
     """
     plane = _check_plane(plane)
+    y = np.asarray(y)
+    if y.ndim < 1 or y.shape[-1] not in (4, 5) or y.dtype.kind not in "fiu":
+        raise ValueError(f"y has shape {y.shape} and type {y.dtype}; allowed: states of shape (..., 5) or (..., 4): "
+                         "x1, x2, x1dot, x2dot[, W]")
     if plane[0] == "delta":
         return y[..., X1] - y[..., X2], y[..., V1] - y[..., V2]
     if plane[0] == "x1":
@@ -155,6 +159,8 @@ def find_asymptotic_points(trajectory: Trajectory, plane=("delta", "deltadot"), 
 
     Raises
     ------
+    TypeError
+        If ``trajectory`` is not a Trajectory.
     ValueError
         For a plane not in :data:`PLANES`, ``tol`` out of range, an unknown ``method``,
         ``events`` on a trajectory without events (RK4) or outside the relative plane, or
@@ -181,6 +187,9 @@ def find_asymptotic_points(trajectory: Trajectory, plane=("delta", "deltadot"), 
     >>> len(points), f"{points.points[0, 0]:.4g} m"
     (1, '3.547e-05 m')
     """
+    if not isinstance(trajectory, Trajectory):
+        raise TypeError(f"trajectory has the wrong type ({type(trajectory).__name__}); allowed: a Trajectory "
+                        "(phaseimpact.simulate)")
     plane = _check_plane(plane)
     if not (math.isfinite(tol) and 0 < tol < 1):
         raise ValueError(f"tol = {tol!r} is out of range; allowed: 0 < tol < 1")

@@ -120,10 +120,13 @@ is made (C-order slabs of :data:`CHUNK_POINTS` points) and room for more stick p
 checkpoint only overwrites the bytes of the new points and appends their stick phases; no HDF5
 metadata changes. It is crash-safe by ordering (each step flushed and fsynced before the next):
 
-0. points being recomputed (they failed before) get status -1 (not computed);
+0. the data digests (``data_sha256``, below) are marked in progress; points being recomputed (they
+   failed before) get status -1 (not computed);
 1. the new points' stick phases go to free rows, then their outcome, columns, ``stick_first`` and
    ``stick_count``;
-2. last, their ``status``: the commit.
+2. their ``status``: the commit;
+3. the recomputed points' old stick rows are marked unused; last, the digests of what the file now
+   holds (only the pieces written are hashed again).
 
 A kill before step 2 leaves the new points at status -1: not computed, recomputed on resume (their
 other variables may hold the interrupted values until then; :func:`load` returns them as not
@@ -142,8 +145,12 @@ Integrity. Every chunk of every variable carries a Fletcher-32 checksum (HDF5's 
 netCDF-4, h5netcdf and h5py verify on every read); the file format is HDF5 1.8's, whose superblock
 and object headers (attributes included) are checksummed; root attribute ``text_sha256`` is the
 SHA-256 of the text attributes (HDF5 keeps them in its global heap, without a checksum); the chunk
-index (a v1 B-tree, without one) is checked on load. :func:`load` and :func:`describe` also check the
-content (codes within their tables, finite axes, scalar attributes) and refuse a damaged file with a
+index (a v1 B-tree, without one) is checked on load. Fletcher-32 passes a chunk whose data and checksum
+were both zeroed or filled with 0xFF: root attribute ``data_sha256`` is the SHA-256 of each dataset's
+contents (:func:`_dataset_digest`), checked by :func:`load`; a file written before it, or killed while a
+checkpoint wrote in place, loads unverified by it. :func:`load` and :func:`describe` also check the
+content (codes within their tables, finite axes, scalar attributes; :func:`load`: a finite
+``max_force`` where a run succeeded, counts >= -1 at computed points) and refuse a damaged file with a
 :class:`DamagedArchiveError` (a ``ValueError``) that names it and the damage; what a checkpoint
 in progress leaves at points not yet committed and in unused stick rows is not damage.
 """
@@ -254,6 +261,16 @@ _LIBVER = ("v108", "v108")
 #: Root attribute: SHA-256 of the file's text attributes, which HDF5 keeps in its global heap (no
 #: checksum there: a changed digit of the case JSON would load silently).
 _TEXT_DIGEST = "text_sha256"
+#: Root attribute: the SHA-256 of each dataset's contents (:func:`_dataset_digest`), JSON ``{path: hex}`` in a
+#: fixed-length text, so that a checkpoint rewrites it in place. Fletcher-32 passes a chunk whose data and
+#: checksum were both zeroed or filled with 0xFF; this digest does not.
+_DATA_DIGEST = "data_sha256"
+#: What :data:`_DATA_DIGEST` holds while a checkpoint writes in place: a file killed then has nothing to be
+#: verified against (:func:`load` takes it unverified, as an archive written before data digests); the next
+#: checkpoint rewrites it whole.
+_IN_PROGRESS = '{"checkpoint": "in progress"}'
+#: Elements (C order) per piece of a dataset's digest: a checkpoint hashes again only the pieces it wrote.
+_DIGEST_PIECE = 8192
 
 
 # ------------------------------------------------------------------------------------------------
@@ -730,8 +747,9 @@ def _reserve(f, nbytes: int) -> None:
 
     HDF5 must never meet a full disk: a failed write leaves objects it can no longer close (their
     finalizers print a traceback each) and the interpreter's exit then crashes inside HDF5 (a
-    segfault). Reserved first, a full disk is an ``OSError`` here, before HDF5 writes. An archive
-    built in memory (:func:`to_xarray`) has no disk to reserve."""
+    segfault). Reserved first, a full disk is an ``OSError`` here, before HDF5 writes (and the file is
+    discarded: :func:`_write_file`). An archive built in memory (:func:`to_xarray`) has no disk to
+    reserve."""
     if f.driver == "fileobj":
         return
     fd = f.id.get_vfd_handle()
@@ -749,7 +767,7 @@ def _as_disk_error(error: Exception) -> OSError | None:
 
 def _write_file(result, path: str, *, force: bool, spare_rows: int, context=None):
     """Write a whole archive atomically; a sweep's stick variables get ``spare_rows`` free rows.
-    Returns the sweep's per-point ``(stick_first, stick_count)`` (None for a curve)."""
+    Returns the sweep's per-point ``(stick_first, stick_count, piece digests)`` (None for another kind)."""
     created = created_timestamp()  # a bad SOURCE_DATE_EPOCH is refused before anything is written
     layout = _sweep_layout(result) if isinstance(result, SweepResult) else None
     with atomic_path(path, "path") as tmp:
@@ -758,19 +776,31 @@ def _write_file(result, path: str, *, force: bool, spare_rows: int, context=None
                              "(force=True replaces it)")
         try:
             with h5py.File(tmp, "w", libver=_LIBVER) as f:
-                _reserve(f, 0)  # the header, attributes and small datasets
-                _write_result(f, result, created, layout, spare_rows, context)
-                _reserve(f, 0)  # what the close writes
+                fd = f.id.get_vfd_handle()
+                try:
+                    _reserve(f, 0)  # the header, attributes and small datasets
+                    pieces = _write_result(f, result, created, layout, spare_rows, context)
+                    _reserve(f, 0)  # what the close writes
+                except BaseException:
+                    # The close writes what HDF5 still holds (chunks, object headers) at addresses it chose,
+                    # which a failed reservation may have given back (tmpfs returns every unwritten block of
+                    # the range asked for): that write fails on a full disk and leaves HDF5 objects it cannot
+                    # close (a segfault at exit). The file is discarded: give its blocks back, so that the
+                    # close finds room.
+                    with contextlib.suppress(OSError):
+                        os.ftruncate(fd, 0)
+                    raise
         except (ValueError, RuntimeError) as error:
             disk = _as_disk_error(error)
             if disk is None:
                 raise
             raise disk from None  # atomic_path names the path
         release_reserve(tmp)
-    return None if layout is None else (layout.first, layout.count)
+    return None if layout is None else (layout.first, layout.count, pieces)
 
 
-def _write_result(f, result, created: str, layout, spare_rows: int, context=None) -> None:
+def _write_result(f, result, created: str, layout, spare_rows: int, context=None) -> dict:
+    """Write ``result`` into the open file ``f``; return its datasets' piece digests (:func:`_file_pieces`)."""
     if isinstance(result, SweepResult):
         _write_sweep(f, result, created, layout, spare_rows)
     elif isinstance(result, CriticalCurve):
@@ -779,7 +809,10 @@ def _write_result(f, result, created: str, layout, spare_rows: int, context=None
         _write_transitions(f, result, created, context)
     else:
         _WRITERS[type(result)](f, result, created, context)
+    pieces = _file_pieces(f)  # read back: the digests are of what the file holds
+    f.attrs[_DATA_DIGEST] = np.bytes_(_digests_text(pieces).encode("ascii"))
     f.attrs[_TEXT_DIGEST] = _texts_digest(f)
+    return pieces
 
 
 #: How to install what to_xarray and stick_phases need (the package is installed from a checkout or a wheel).
@@ -950,6 +983,76 @@ def _texts_digest(f) -> str:
         add("extras", f["extras"])
         f["extras"].visititems(add)
     return h.hexdigest()
+
+
+def _piece_digests(data: np.ndarray) -> list:
+    """SHA-256 of each :data:`_DIGEST_PIECE` elements of ``data`` in C order (its bytes as stored)."""
+    flat = np.ascontiguousarray(data).reshape(-1)
+    if flat.dtype.kind not in "biufc":  # text: its characters, not the addresses of Python objects
+        flat = np.array([_json(x.decode() if isinstance(x, bytes) else x) for x in flat.tolist()], dtype=str)
+    return [hashlib.sha256(flat[i:i + _DIGEST_PIECE].tobytes()).digest()
+            for i in range(0, max(flat.size, 1), _DIGEST_PIECE)]
+
+
+def _dataset_digest(dtype, shape, pieces) -> str:
+    """A dataset's digest: of its type, shape and the digests of its pieces; whatever its chunks or filters."""
+    h = hashlib.sha256(_json([np.dtype(dtype).str, list(shape)]).encode())
+    for piece in pieces:
+        h.update(piece)
+    return h.hexdigest()
+
+
+def _file_pieces(f) -> dict:
+    """``{path: (dtype, shape, piece digests)}`` of every dataset of the open file ``f`` (each is read whole)."""
+    found = {}
+
+    def visit(name, node):
+        if isinstance(node, h5py.Dataset):
+            found[name] = (node.dtype, node.shape, _piece_digests(node[()]))
+
+    f.visititems(visit)
+    return found
+
+
+def _digests_text(pieces: dict) -> str:
+    digests = {name: _dataset_digest(*entry) for name, entry in pieces.items()}
+    return json.dumps(digests, sort_keys=True, separators=(",", ":")).ljust(len(_IN_PROGRESS))
+
+
+def _stored_digests(f) -> dict | None:
+    """The digests :data:`_DATA_DIGEST` holds; None where the file has none to check against (written before
+    data digests, or killed while a checkpoint wrote in place)."""
+    if _DATA_DIGEST not in f.attrs:
+        return None
+    value = f.attrs[_DATA_DIGEST]
+    try:
+        stored = json.loads(value.decode("ascii") if isinstance(value, bytes) else value)
+    except (TypeError, ValueError, AttributeError):
+        stored = None
+    if stored == json.loads(_IN_PROGRESS):
+        return None
+    if not (isinstance(stored, dict) and all(isinstance(v, str) for v in stored.values())):
+        raise _Damaged(f"attribute {_DATA_DIGEST} = {_short(value)} is out of range; allowed: the SHA-256 digests "
+                       "of the datasets")
+    return stored
+
+
+def _check_data_digests(f) -> None:
+    """Every dataset's contents against :data:`_DATA_DIGEST`, where the file has it."""
+    stored = _stored_digests(f)
+    if stored is None:
+        return
+    pieces = _file_pieces(f)
+    for name in sorted(set(stored) | set(pieces)):
+        if name not in pieces:
+            raise _Damaged(f"variable {name} is missing")
+        if name not in stored:
+            raise _Damaged(f"variable {name} has no SHA-256 digest in {_DATA_DIGEST} (it was added after the file "
+                           "was written)")
+        if stored[name] != _dataset_digest(*pieces[name]):
+            # checksum: a reader may catch a checkpoint writing in place; read again, as for Fletcher-32
+            raise _Damaged(f"variable {name}: its contents do not match their SHA-256 digest {_DATA_DIGEST} (the "
+                           "file's bytes were changed after it was written)", checksum=True)
 
 
 def _header(f, kind: str, law: ContactLaw | None, base, t_end, rtol, engine: str, created: str, title: str,
@@ -1596,6 +1699,7 @@ class _OnDisk:
     failed: np.ndarray      # committed failed points (recomputed on resume)
     failed_snapshot: dict   # their codes and columns, to see whether a recomputation changed them
     columns: list
+    pieces: dict            # every dataset's piece digests (_file_pieces), to update its digest
 
 
 class Checkpoint:
@@ -1606,8 +1710,9 @@ class Checkpoint:
     still to come); later calls write only the points computed since the previous call, in place, in
     the crash-safe order described in the module docstring. A file that is not an archive of the same
     grid (law, base, axes, ``t_end``, ``rtol``, columns, extras) is rewritten whole, as is one whose
-    spare stick rows are used up. ``path``'s write lock is taken for every call (re-entrant: a caller
-    may hold it for the whole sweep).
+    spare stick rows are used up and one whose data do not match their digests (killed while a
+    checkpoint wrote, or written before data digests). ``path``'s write lock is taken for every call
+    (re-entrant: a caller may hold it for the whole sweep).
 
     Parameters
     ----------
@@ -1692,10 +1797,10 @@ class Checkpoint:
         per_point = max(1.0, len(r.stick_point) / computed) if computed else 2.0
         remaining = n - int(np.count_nonzero(status == _driver.SUCCESS))
         spare = int(math.ceil(1.25 * per_point * remaining)) + 1024
-        first, count = _write_file(r, self.path, force=self.force, spare_rows=spare)
+        first, count, pieces = _write_file(r, self.path, force=self.force, spare_rows=spare)
         rows = len(r.stick_point)
         self._disk = _OnDisk(_stamp(self.path), r.grid.shape, status.astype(np.int8, copy=True), first, count,
-                             rows + spare, rows, rows, np.empty(0, dtype=np.int64), {}, list(r.values))
+                             rows + spare, rows, rows, np.empty(0, dtype=np.int64), {}, list(r.values), pieces)
         self._remember_failed(r, np.flatnonzero(status > _driver.SUCCESS))
 
     def _remember_failed(self, r: SweepResult, failed: np.ndarray) -> None:
@@ -1708,15 +1813,24 @@ class Checkpoint:
     # -- reading the file's state ---------------------------------------------------------------
 
     def _read_disk(self, r: SweepResult) -> _OnDisk | None:
-        """The file's state if it is an archive of this schema of ``r``'s grid that can be written in place."""
+        """The file's state if it is an archive of this schema of ``r``'s grid that can be written in place:
+        its data match their digests (a file killed while a checkpoint wrote, or written before data
+        digests, is rewritten whole; so no stick row a killed checkpoint wrote stays behind)."""
         path = self.path
         if not os.path.isfile(path) or not _is_archive(path):
             return None
         stamp = _stamp(path)
-        with h5py.File(path, "r+", locking=False) as f:
+        with h5py.File(path, "r", locking=False) as f:
             if int(f.attrs["schema_version"]) != SCHEMA_VERSION or not _same_grid(f, r):
                 return None
             if any(name not in f for name in ("status", "stick_first", "stick_count", "stick_point")):
+                return None
+            try:
+                stored = _stored_digests(f)
+            except _Damaged:
+                return None
+            pieces = _file_pieces(f)
+            if stored != {name: _dataset_digest(*entry) for name, entry in pieces.items()}:
                 return None
             status = f["status"][()].reshape(-1)
             first = f["stick_first"][()].reshape(-1).astype(np.int64)
@@ -1726,7 +1840,7 @@ class Checkpoint:
             free = int((first[committed] + count[committed]).max()) if committed.any() else 0
             rows = int(count[committed].sum())
             disk = _OnDisk(stamp, r.grid.shape, status.astype(np.int8), first, count, capacity, free, rows,
-                           np.empty(0, dtype=np.int64), {}, json.loads(_attr_str(f, "columns")))
+                           np.empty(0, dtype=np.int64), {}, json.loads(_attr_str(f, "columns")), pieces)
             failed = np.flatnonzero(status > _driver.SUCCESS)
             disk.failed = failed
             if failed.size:
@@ -1734,17 +1848,6 @@ class Checkpoint:
                 for name in ("outcome", "stop_reason", *disk.columns):
                     snapshot[name] = f[name][()].reshape(-1)[failed]
                 disk.failed_snapshot = snapshot
-            # rows no committed point owns (a killed checkpoint, a recomputed point) are marked unused,
-            # so that readers of stick_point alone do not see them
-            if capacity:
-                point = f["stick_point"][()]
-                owned = np.zeros(capacity, dtype=bool)
-                owned[_owned_rows(first, count, status >= 0)] = True
-                stale = (point != -1) & ~owned
-                if stale.any():
-                    point[stale] = -1
-                    f["stick_point"][...] = point
-        disk.stamp = _stamp(path)
         return disk
 
     # -- in place ---------------------------------------------------------------------------------
@@ -1796,8 +1899,13 @@ class Checkpoint:
             raw = _Raw(self.path)
         except OSError:  # e.g. open elsewhere in this process with HDF5 file locking: rewrite it
             return False
+        free, old_rows = disk.free, _owned_rows(disk.first, disk.count, np.isin(np.arange(r.grid.size), recomputed))
         with raw:
+            # a kill from here on leaves a file whose data match no digest: say so first
+            raw.set_text(_DATA_DIGEST, _IN_PROGRESS)
+            raw.flush_to_disk(self.fsync)
             self._commit(raw, r, new, recomputed, rows, counts)
+            self._update_digests(raw, new, np.union1d(np.arange(free, free + rows.size), old_rows))
         self._disk.stamp = _stamp(self.path)  # after the close: what the next call must find
         return True
 
@@ -1814,9 +1922,21 @@ class Checkpoint:
         return changed
 
     def _flush(self, raw) -> None:
-        raw.flush()
-        if self.fsync:
-            fsync_file(raw.fid)
+        raw.flush_to_disk(self.fsync)
+
+    def _update_digests(self, raw, points: np.ndarray, rows: np.ndarray) -> None:
+        """After a commit: hash again the pieces holding the ``points`` and stick ``rows`` written, then
+        store the digests (the end of the checkpoint)."""
+        disk = self._disk
+        gridded = ("status", "outcome", "stop_reason", *disk.columns, "stick_first", "stick_count")
+        for names, indices in ((gridded, points), (_STICK_VARIABLES, rows)):
+            for k in np.unique(np.asarray(indices, dtype=np.int64) // _DIGEST_PIECE).tolist():
+                for name in names:
+                    dtype, shape, pieces = disk.pieces[name]
+                    lo = k * _DIGEST_PIECE
+                    pieces[k] = _piece_digests(raw.read_flat(name, lo, min(lo + _DIGEST_PIECE, int(np.prod(shape)))))[0]
+        raw.set_text(_DATA_DIGEST, _digests_text(disk.pieces))
+        raw.flush_to_disk(self.fsync)
 
     def _commit(self, raw, r: SweepResult, new, recomputed, rows, counts) -> None:
         disk = self._disk
@@ -1902,8 +2022,31 @@ class _Raw:
         """Write ``values`` into rows ``lo, lo + 1, ...`` of the 1-d dataset ``name``."""
         self._put(name, (lo,), values)
 
-    def flush(self) -> None:
+    def read_flat(self, name: str, lo: int, hi: int) -> np.ndarray:
+        """Elements ``lo .. hi - 1`` (C order) of dataset ``name``, as the file holds them."""
+        d = self._dataset(name)
+        parts = []
+        for box in _boxes(lo, hi, d.shape):
+            start, count = tuple(s.start for s in box), tuple(s.stop - s.start for s in box)
+            block = np.empty(count, dtype=d.dtype)
+            space = d.get_space()
+            space.select_hyperslab(start, count)
+            d.read(h5py.h5s.create_simple(count), space, block)
+            parts.append(block.reshape(-1))
+        return np.concatenate(parts) if parts else np.empty(0, dtype=d.dtype)
+
+    def set_text(self, name: str, text: str) -> None:
+        """Overwrite the root's fixed-length text attribute ``name`` in place (padded with spaces)."""
+        attr = h5py.h5a.open(h5py.h5g.open(self.fid, b"/"), name.encode())
+        try:
+            attr.write(np.array(text.encode("ascii").ljust(attr.dtype.itemsize), dtype=attr.dtype))
+        finally:
+            attr.close()
+
+    def flush_to_disk(self, fsync: bool) -> None:
         h5py.h5f.flush(self.fid)
+        if fsync:
+            fsync_file(self.fid)
 
 
 def _owned_rows(first, count, committed) -> np.ndarray:
@@ -1955,6 +2098,10 @@ def _open(path):
         raise ValueError(f"archive {path!r} cannot be read: {error.strerror or error}") from None
     if not stat.S_ISREG(mode):  # opening a FIFO waits for a writer forever; a device is no archive
         raise ValueError(f"archive {path!r} is not a regular file (a FIFO, device or socket); allowed: an HDF5 file")
+    try:  # first, as HDF5 would say it after "unable to open file" and a guess at damage
+        os.close(os.open(path, os.O_RDONLY))
+    except OSError as error:
+        raise ValueError(f"archive {path!r} cannot be read: {error.strerror or error}") from None
     try:
         return h5py.File(path, "r")
     except FileNotFoundError:
@@ -2069,6 +2216,14 @@ def _netcdf_writer(f) -> str | None:
         return None
     text = value.decode("utf-8", "replace") if isinstance(value, bytes) else str(value)
     return next((part for part in text.split(",") if part.startswith(("netcdf=", "h5netcdf="))), text)
+
+
+def _archive_path(path) -> str:
+    """``path`` as text, or a ``TypeError`` naming it (not os.fspath's, which names no argument)."""
+    if not isinstance(path, (str, bytes, os.PathLike)):
+        raise TypeError(f"path = {_short(path)} has the wrong type ({type(path).__name__}); allowed: the path of an "
+                        "archive (str or os.PathLike)")
+    return os.fsdecode(path)
 
 
 def _retrying(read, path: str):
@@ -2246,6 +2401,8 @@ def load(path):
 
     Raises
     ------
+    TypeError
+        For a ``path`` that is not a str or path-like.
     ValueError
         As above; :class:`DamagedArchiveError` for a damaged file.
 
@@ -2265,7 +2422,7 @@ def load(path):
     ...
     ValueError: ...
     """
-    return _retrying(_load, os.fspath(path))
+    return _retrying(_load, _archive_path(path))
 
 
 def _load(path: str):
@@ -2292,14 +2449,16 @@ def _load(path: str):
     return result
 
 
-def _check_metadata(f, *, chunks: bool = True) -> None:
+def _check_metadata(f, *, data: bool = True) -> None:
     """The parts of the metadata that HDF5's own checksums leave out: the text attributes (against
-    :data:`_TEXT_DIGEST`, where the file has one) and the chunk index of every checksummed dataset."""
+    :data:`_TEXT_DIGEST`, where the file has one); with ``data``, the chunk index of every checksummed
+    dataset and every dataset's contents (against :data:`_DATA_DIGEST`, where the file has it)."""
     if _TEXT_DIGEST in f.attrs and _attr_str(f, _TEXT_DIGEST) != _texts_digest(f):
         raise _Damaged("its text attributes (case, law, settings, ...) do not match their SHA-256 digest "
                        f"{_TEXT_DIGEST} (the file's bytes were changed)")
-    if chunks:
+    if data:
         _check_storage(f)
+        _check_data_digests(f)
 
 
 def _check_storage(f) -> None:
@@ -2441,8 +2600,10 @@ def _out_of_range(name: str, values: np.ndarray, bad: np.ndarray, allowed: str) 
 
 
 def _check_sweep(r: SweepResult) -> None:
-    """Codes within their tables (the figures and summaries index tables with them). The columns are
-    not judged: NaN and -1 are legitimate values (not measured, or not stored by schema 1)."""
+    """Codes within their tables (the figures and summaries index tables with them), a finite
+    ``max_force`` where a run succeeded and counts >= 0 (or -1: not kept, as in archives of schema 1) at
+    computed points: what a chunk overwritten with its checksum breaks (0xFF makes NaN and -1; the data
+    digests catch the rest). Other NaN are legitimate: not measured."""
     status = np.asarray(r.status)
     computed = status >= 0
     _out_of_range("status", status, (status < -1) | (status >= len(STATUSES)),
@@ -2451,6 +2612,15 @@ def _check_sweep(r: SweepResult) -> None:
         codes = np.asarray(getattr(r, name))
         _out_of_range(name, codes, computed & ((codes < 0) | (codes >= len(names))),
                       f"0 to {len(names) - 1} ({', '.join(names)}) at a computed point")
+    if "max_force" in r.values:
+        force = np.asarray(r.values["max_force"])
+        _out_of_range("max_force", force, (status == _driver.SUCCESS) & ~np.isfinite(force),
+                      "a finite force (N) where the run succeeded")
+    for name, column in r.values.items():
+        column = np.asarray(column)
+        if column.dtype.kind == "i":
+            _out_of_range(name, column, computed & (column < -1), "a count >= 0 (or -1: not kept) at a computed "
+                          "point")
 
 
 def _check_curve(c: CriticalCurve) -> None:
@@ -2595,7 +2765,7 @@ def describe(path) -> dict:
     >>> held["kind"], held["law"]["name"], held["axes"]["kappa"].tolist(), held["t_end"], held["schema_version"]
     ('sweep', 'paper', [1000000000.0, 10000000000000.0], nan, 5)
     """
-    return _retrying(_describe, os.fspath(path))
+    return _retrying(_describe, _archive_path(path))
 
 
 def _describe(path: str) -> dict:
@@ -2627,7 +2797,7 @@ def _describe(path: str) -> dict:
             param = "v" if version == 1 else _attr_str(g, "param")
             axes = {param: axis(g, param, param)}
         if version >= 3:
-            _check_metadata(f, chunks=False)
+            _check_metadata(f, data=False)
         return {"kind": kind, "law": law, "parameters": params, "axes": axes, "t_end": _real_attr(f, "t_end"),
                 "rtol": _real_attr(f, "rtol"), "schema_version": version}
 
@@ -2713,20 +2883,27 @@ def same_work(held: dict, kind: str, law: ContactLaw, params: Parameters, axes: 
 
 
 def check_overwrite(path, kind: str, law: ContactLaw, params: Parameters, axes: dict, t_end, rtol, *,
-                    force: bool = False, name: str = "out") -> None:
+                    force: bool = False, name: str = "out", settings: dict | None = None) -> None:
     """Refuse (``ValueError``) to replace ``path`` unless it is missing, or an archive of the same work
-    (kind, law, parameters, axis values, ``t_end`` and ``rtol``), or ``force`` is set.
+    (kind, law, parameters, axis values, ``t_end``, ``rtol`` and ``settings``), or ``force`` is set.
+
+    The one rule of every command that writes an archive (``--out`` of ``sweep``, ``atlas``,
+    ``critical-curve``; ``--archive`` of ``train``, ``orbit-diagram``, ``map-continuation``, ``basins``).
 
     Parameters
     ----------
     path : str or path-like
         The file a command would write.
     kind, law, params, axes, t_end, rtol
-        The work asked for, as for :func:`same_work`.
+        The work asked for, as for :func:`same_work`. A critical curve's ``axes`` are the values asked
+        for (the archive also holds its continuation's intermediate steps).
     force : bool, default False
         Allow any replacement (the command line's ``--force``).
     name : str, default "out"
         How the message names ``path`` (the command line's option).
+    settings : dict, optional
+        Compared too where given: a train result's settings as :func:`save` stores them (``period``,
+        ``impacts``, ...), or a critical curve's ``{"what": ...}``.
 
     Raises
     ------
@@ -2753,6 +2930,11 @@ def check_overwrite(path, kind: str, law: ContactLaw, params: Parameters, axes: 
         return
     try:
         held = describe(path)
+        if held["kind"] == kind and settings is not None:
+            held_settings = _retrying(_stored_settings, path)
+            if kind == "critical-curve":
+                curve = load(path)
+                held["axes"] = {curve.param: np.asarray(curve.values)[np.asarray(curve.requested, dtype=bool)]}
     except DamagedArchiveError as error:
         raise ValueError(f"{name} = {path!r} exists and is a damaged phaseimpact archive ({error.reason}); refusing "
                          "to overwrite it (choose another path, or add --force to replace it)") from None
@@ -2760,6 +2942,18 @@ def check_overwrite(path, kind: str, law: ContactLaw, params: Parameters, axes: 
         raise ValueError(f"{name} = {path!r} exists and is not a phaseimpact archive; refusing to overwrite it "
                          "(choose another path, or add --force to replace it)") from None
     differences = same_work(held, kind, law, params, axes, t_end, rtol)
+    if held["kind"] == kind and settings is not None:
+        asked = json.loads(_json(settings))
+        differences += [f"{key} {held_settings.get(key)!r} (asked {asked.get(key)!r})"
+                        for key in sorted(set(asked) | set(held_settings)) if held_settings.get(key) != asked.get(key)]
     if differences:
         raise ValueError(f"{name} = {path!r} holds other work ({'; '.join(differences)}); refusing to overwrite it "
                          "(choose another path, or add --force to replace it)")
+
+
+def _stored_settings(path: str) -> dict:
+    """What identifies an archive's work beyond :func:`describe`: a train result's settings, a curve's ``what``."""
+    with _reading(path) as f:
+        if _attr_str(f, "kind") == "critical-curve":
+            return {"what": _attr_str(f, "what")} if "what" in f.attrs else {}
+        return _json_attr(f, "settings", dict) if "settings" in f.attrs else {}

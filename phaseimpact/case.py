@@ -39,6 +39,7 @@ from __future__ import annotations
 import dataclasses
 import json
 import math
+import os
 import sys
 from collections.abc import Mapping
 from dataclasses import dataclass, field
@@ -593,6 +594,8 @@ def load_case(name_or_path) -> Case:
 
     Raises
     ------
+    TypeError
+        If ``name_or_path`` is neither a str nor a path.
     ValueError
         Unknown name (the message lists the shipped ones), missing file, TOML syntax error (with
         the file name and the parser's message), or any schema error (see :func:`case_from_dict`).
@@ -610,6 +613,9 @@ def load_case(name_or_path) -> Case:
         ...
     ValueError: unknown case 'nope'; shipped cases: ..., seed (or give a path to a .toml file)
     """
+    if not isinstance(name_or_path, (str, os.PathLike)):
+        raise TypeError(f"name_or_path = {name_or_path!r} has the wrong type ({type(name_or_path).__name__}); "
+                        "allowed: a shipped case name (str) or the path of a .toml case file")
     text = str(name_or_path)
     is_name = isinstance(name_or_path, str) and not text.endswith(".toml") and "/" not in text and "\\" not in text
     if is_name:
@@ -858,6 +864,11 @@ def hertz_scales(params: Parameters, plate_material: Material | None = None) -> 
         (``M1`` for a rigid target). The last two are ``None`` when ``params.R`` is ``None``;
         for ``alpha != 3/2`` they are Hertz estimates only.
 
+    Raises
+    ------
+    TypeError
+        If ``params`` is not a Parameters, or ``plate_material`` neither a Material nor None.
+
     Examples
     --------
     >>> from phaseimpact.case import hertz_scales, load_case
@@ -870,6 +881,11 @@ def hertz_scales(params: Parameters, plate_material: Material | None = None) -> 
     >>> print(f"{hertz_scales(case.parameters(), case.plate)['pressure_to_first_yield']:.3g}")
     7.61
     """
+    if not isinstance(params, Parameters):
+        raise TypeError(f"params has the wrong type ({type(params).__name__}); allowed: Parameters")
+    if plate_material is not None and not isinstance(plate_material, Material):
+        raise TypeError(f"plate_material has the wrong type ({type(plate_material).__name__}); allowed: Material "
+                        "or None")
     delta = params.hertz_indentation
     force = params.K * delta**params.alpha
     out = {

@@ -100,11 +100,22 @@ class _Parser(argparse.ArgumentParser):
             self.error(str(error))
         return super().parse_args(args, namespace)
 
+    def parse_known_args(self, args=None, namespace=None):
+        self._given = list(sys.argv[1:] if args is None else args)  # a subcommand's parser gets its own words
+        return super().parse_known_args(args, namespace)
+
     def error(self, message):
         choice = re.fullmatch(r"(argument (\S+)): invalid choice: (.*) \(choose from (.*)\)", message)
         if choice:  # the same wording as every other range message
             label, option, value, allowed = choice.groups()
             message = f"{label}: {option.lstrip('-')} = {value} is out of range; allowed: one of {allowed}"
+        missing = re.fullmatch(r"argument (--[\w.-]+): expected one argument", message)
+        given = getattr(self, "_given", [])
+        if missing:  # argparse takes a value starting with '-' for an option
+            for option, value in zip(given, given[1:], strict=False):
+                if option == missing.group(1) and value.startswith("-"):
+                    message += f" (a value that starts with '-' is written {option}={value})"
+                    break
         self.exit(EXIT_USAGE, f"{self.prog}: error: {message}\n")
 
 
@@ -1092,33 +1103,6 @@ def _curve_values(args, setup: Setup):
     return param, values
 
 
-def _check_curve_overwrite(out, args, setup: Setup, param, values, what) -> None:
-    """Like ``archive.check_overwrite``, comparing the values asked for (a curve also stores the
-    intermediate steps of its continuation) and what it continues."""
-    import numpy as np
-
-    from . import archive
-
-    if args.force or not os.path.exists(out):
-        return
-    try:
-        held = archive.describe(out)
-        curve = archive.load(out) if held["kind"] == "critical-curve" else None
-    except ValueError:
-        raise ValueError(f"out = {out!r} exists and is not a phaseimpact archive; refusing to overwrite it "
-                         "(choose another path, or add --force to replace it)") from None
-    differences = []
-    if curve is not None:
-        held["axes"] = {curve.param: np.asarray(curve.values)[np.asarray(curve.requested, dtype=bool)]}
-        if curve.what != what:
-            differences.append(f"what {curve.what!r}, not {what!r}")
-    differences += archive.same_work(held, "critical-curve", setup.law, setup.params, {param: values}, None,
-                                     args.kappa_rtol)
-    if differences:
-        raise ValueError(f"out = {out!r} holds other work ({'; '.join(differences)}); refusing to overwrite it "
-                         "(choose another path, or add --force to replace it)")
-
-
 def cmd_critical_curve(args) -> int:
     import numpy as np
 
@@ -1158,7 +1142,8 @@ def cmd_critical_curve(args) -> int:
     archive.created_timestamp()
     samples = args.samples or DEFAULT_SAMPLES
     with exclusive(out, "out"):
-        _check_curve_overwrite(out, args, setup, param, values, what)
+        archive.check_overwrite(out, "critical-curve", law, setup.params, {param: values}, None, args.kappa_rtol,
+                                force=args.force, settings={"what": what})
         start, index = None, 1
         if what == "grazing":
             first = setup.case.parameters(**{param: float(values[0])})
@@ -1797,27 +1782,42 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
-def _check_archive_target(args) -> None:
-    """Before any work: ``--archive`` may replace an archive, another file only with ``--force``."""
-    if args.archive is None or args.force or not os.path.exists(args.archive):
+@dataclasses.dataclass(frozen=True)
+class _TrainWork:
+    """What a train command's ``--archive`` holds: its kind, axes (an orbit diagram's), horizon (the period,
+    NaN over ``T``) and settings, as :func:`phaseimpact.archive.save` stores them."""
+
+    kind: str
+    axes: dict
+    t_end: float
+    settings: dict
+
+
+def _train_work(args, kind: str, axes: dict | None = None, **settings) -> _TrainWork:
+    over_t = "T" in (axes or {}) or settings.get("param") == "T"
+    return _TrainWork(kind, axes or {}, math.nan if over_t else args.period, {"rtol": args.rtol, **settings})
+
+
+def _check_archive_target(args, setup: Setup, work: _TrainWork) -> None:
+    """``--archive`` follows ``--out``'s rule (:func:`phaseimpact.archive.check_overwrite`): a file holding
+    other work is replaced only with ``--force``. Checked before any work, and again under the lock."""
+    if args.archive is None:
         return
     from . import archive
 
-    try:
-        archive.describe(args.archive)
-    except (ValueError, OSError):
-        raise ValueError(f"archive = {args.archive!r} exists and is not a phaseimpact archive; allowed: a new path, "
-                         "an archive to replace, or --force") from None
+    archive.check_overwrite(args.archive, work.kind, setup.law, setup.params, work.axes, work.t_end, args.rtol,
+                            force=args.force, name="archive", settings=work.settings)
 
 
-def _save_train_archive(args, setup: Setup, result, **settings) -> None:
+def _save_train_archive(args, setup: Setup, result, work: _TrainWork) -> None:
     if args.archive is None:
         return
     from . import archive
 
     with exclusive(args.archive, "archive"):
-        archive.save(result, args.archive, force=getattr(args, "force", False), params=setup.case, law=setup.law,
-                     settings={"rtol": args.rtol, **settings})
+        _check_archive_target(args, setup, work)  # another process may have written it meanwhile
+        archive.save(result, args.archive, force=args.force, params=setup.case, law=setup.law,
+                     settings=work.settings)
 
 
 def cmd_train(args) -> int:
@@ -1825,11 +1825,12 @@ def cmd_train(args) -> int:
     from .train import impact_train, map_fixed_point
 
     setup = _setup(args)
-    _check_archive_target(args)
+    work = _train_work(args, "impact-train", period=args.period, impacts=args.impacts)
+    _check_archive_target(args, setup, work)
     p, law = setup.params, setup.law
     _note(f"{args.impacts} impacts of {law.label()}, one every {args.period:g} s")
     train = impact_train(p, law, args.period, args.impacts, rtol=args.rtol)
-    _save_train_archive(args, setup, train, period=args.period, impacts=args.impacts)
+    _save_train_archive(args, setup, train, work)
     orbit = map_fixed_point(p, law, args.period) if args.fixed_point else None
     out = {**_case_fields(setup), "plate_period": scales(p).plate_period, **train.as_dict(),
            "fixed_point": None if orbit is None else orbit.as_dict(), "case": setup.case.as_dict()}
@@ -1866,13 +1867,15 @@ def cmd_orbit_diagram(args) -> int:
     if args.out is not None:
         _check_figure_target(args.out, args.force)
     setup = _setup(args)
-    _check_archive_target(args)
     param, values = _train_axis(args, setup)
+    work = _train_work(args, "orbit-diagram", {param: values}, period=args.period, transients=args.transients,
+                       samples=args.samples)
+    _check_archive_target(args, setup, work)
     _note(f"orbit diagram of {setup.law.label()} over {param}: {len(values)} values x "
           f"{args.transients + args.samples} impacts")
     diagram = orbit_diagram(setup.params, setup.law, param, values, period=args.period,
                             transients=args.transients, samples=args.samples, rtol=args.rtol, n_jobs=args.jobs)
-    _save_train_archive(args, setup, diagram, period=args.period, transients=args.transients, samples=args.samples)
+    _save_train_archive(args, setup, diagram, work)
     if args.out is not None:
         with exclusive(args.out, "out"):
             title = f"{setup.law.label()}, {setup.case.name}, v = {setup.params.v:g} m/s"
@@ -1930,18 +1933,21 @@ def cmd_map_continuation(args) -> int:
     from .train import continue_map_orbit
 
     setup = _setup(args)
-    _check_archive_target(args)
     param, values = _train_axis(args, setup)
     if len(values) < 2:
         raise ValueError(f"axis {param!r} has {len(values)} value; allowed: START:STOP:NUM with NUM >= 2 (the "
                          "branch runs from START to STOP, its largest step the axis's spacing)")
     start, stop = float(values[0]), float(values[-1])
+    step = float(np.max(np.abs(np.diff(values))))
+    work = _train_work(args, "map-branch", period=args.period, k=args.k, xtol=args.xtol, param=param, start=start,
+                       stop=stop, step=step, max_points=args.max_points)
+    _check_archive_target(args, setup, work)
     p, law = setup.params, setup.law
     _note(f"period-{args.k} orbits of {law.label()} over {param} from {start:g} to {stop:g}")
     branch = continue_map_orbit(p, law, param, start, stop, period=args.period, k=args.k,
-                                step=float(np.max(np.abs(np.diff(values)))), max_points=args.max_points,
+                                step=step, max_points=args.max_points,
                                 xtol=args.xtol, rtol=args.rtol)
-    _save_train_archive(args, setup, branch, period=args.period, k=args.k, xtol=args.xtol)
+    _save_train_archive(args, setup, branch, work)
     out = {**_case_fields(setup), "plate_period": scales(p).plate_period, "period": args.period, "param": param,
            "from": start, "to": stop, "num": len(values), **branch.as_dict(), "case": setup.case.as_dict()}
     if args.json:
@@ -1974,7 +1980,6 @@ def cmd_basins(args) -> int:
     if args.out is not None:
         _check_figure_target(args.out, args.force)
     setup = _setup(args)
-    _check_archive_target(args)
     p, law = setup.params, setup.law
     omega = math.sqrt(p.Kb / p.M2) if p.target == "plate" and p.Kb > 0 else None
     if args.x2_max is None and omega is None:
@@ -1983,11 +1988,13 @@ def cmd_basins(args) -> int:
     x2_max = args.x2_max if args.x2_max is not None else 1.5 * p.v / omega
     x2dot_max = args.x2dot_max if args.x2dot_max is not None else 1.5 * p.v
     xs, vs = np.linspace(-x2_max, x2_max, args.grid), np.linspace(-x2dot_max, x2dot_max, args.grid)
+    work = _train_work(args, "basins", period=args.period, iterations=args.iterations, max_period=args.max_period,
+                       grid=args.grid, x2_max=x2_max, x2dot_max=x2dot_max)
+    _check_archive_target(args, setup, work)
     _note(f"basins of {law.label()} at T = {args.period:g} s: {args.grid} x {args.grid} initial states")
     result = basins(p, law, args.period, xs, vs, iterations=args.iterations, max_period=args.max_period,
                     rtol=args.rtol, n_jobs=args.jobs)
-    _save_train_archive(args, setup, result, period=args.period, iterations=args.iterations,
-                        max_period=args.max_period)
+    _save_train_archive(args, setup, result, work)
     if args.out is not None:
         with exclusive(args.out, "out"):
             title = f"{law.label()}, {setup.case.name}, v = {p.v:g} m/s, T = {args.period:g} s"
@@ -2044,6 +2051,36 @@ def _load_law_files(argv) -> list:
 _ANSI_ESCAPE = re.compile(r"\x1b\[[0-9;]*[A-Za-z]")
 
 
+class _StandardOutput:
+    """``sys.stdout`` for a command: a failed write names the standard output (``> /dev/full``: the disk
+    is full, but no file of ours); characters its encoding lacks are written as escapes
+    (``PYTHONIOENCODING=ascii``), not an error half way through the output."""
+
+    def __init__(self, stream):
+        self._stream = stream
+
+    def write(self, text: str) -> int:
+        try:
+            return self._stream.write(text)
+        except UnicodeEncodeError as error:
+            return self._stream.write(text.encode(error.encoding, "backslashreplace").decode(error.encoding))
+        except BrokenPipeError:
+            raise
+        except OSError as error:
+            raise OSError(error.errno, error.strerror or str(error), "standard output") from None
+
+    def flush(self) -> None:
+        try:
+            self._stream.flush()
+        except BrokenPipeError:
+            raise
+        except OSError as error:
+            raise OSError(error.errno, error.strerror or str(error), "standard output") from None
+
+    def __getattr__(self, name):
+        return getattr(self._stream, name)
+
+
 def main(argv=None) -> int:
     # Ctrl-C and SIGTERM, wherever they arrive (compiled runs included): one line, exit 130 or 143
     previous_term = signal.getsignal(signal.SIGTERM)
@@ -2057,7 +2094,13 @@ def main(argv=None) -> int:
             from . import _signals
 
             _signals.install_command_line()
-        return args.func(args)
+        stdout, sys.stdout = sys.stdout, _StandardOutput(sys.stdout)
+        try:
+            code = args.func(args)
+            sys.stdout.flush()  # a full standard output fails here, named, not at the interpreter's exit
+        finally:
+            sys.stdout = stdout
+        return code
     except ValueError as error:  # one line, without the colour escapes numba puts in its messages
         print(f"phaseimpact: error: {_ANSI_ESCAPE.sub('', str(error))}", file=sys.stderr)
         return EXIT_USAGE

@@ -220,3 +220,21 @@ def test_a_garbled_scheduler_reply_is_reported_as_no_answer(monkeypatch):
     with pytest.raises(ValueError) as info:
         check_scheduler("tcp://10.255.255.1:8786")
     assert "no answer within 5 s" in str(info.value) and "EiB" not in str(info.value)
+
+
+@pytest.mark.parametrize(("call", "error", "name"), [  # audits/inputs-2026-11b.md: api-*-none, api-plane-bad
+    (lambda: importlib.import_module("phaseimpact.archive").load(None), TypeError, "path = None"),
+    (lambda: importlib.import_module("phaseimpact.archive").describe(None), TypeError, "path = None"),
+    (lambda: importlib.import_module("phaseimpact.case").load_case(None), TypeError, "name_or_path = None"),
+    (lambda: importlib.import_module("phaseimpact.case").hertz_scales(None, None), TypeError, "params"),
+    (lambda: importlib.import_module("phaseimpact.case").hertz_scales(SEED, 3.0), TypeError, "plate_material"),
+    (lambda: importlib.import_module("phaseimpact.case").validity(None, None, None, None), TypeError, "params"),
+    (lambda: importlib.import_module("phaseimpact.analysis").find_asymptotic_points(None), TypeError, "trajectory"),
+    (lambda: importlib.import_module("phaseimpact.analysis").plane_coordinates(np.zeros((5, 3)),
+                                                                               ("delta", "deltadot")),
+     ValueError, "y has shape (5, 3)"),
+])
+def test_none_and_misshapen_arguments_are_named(call, error, name):
+    with pytest.raises(error) as raised:
+        call()
+    assert name in str(raised.value) and type(raised.value) is error

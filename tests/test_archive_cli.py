@@ -506,3 +506,48 @@ def test_train_archive_refuses_a_foreign_file_before_any_work(tmp_path, capsys, 
     assert main(["train", "--law", "hunt-crossley", "--kappa", "3e9", "--period", "3e-3", "--archive",
                  str(notes)]) == 2
     assert "not a phaseimpact archive" in capsys.readouterr().err and notes.read_text() == "my notes"
+
+
+HC = ["--law", "hunt-crossley", "--kappa", "3e9"]
+TRAIN_WRITERS = {  # the audit's commands (train-archive-sweep, M-archive-over-atlas-*)
+    "train": ["train", *HC, "--period", "3e-3", "--impacts", "2"],
+    "orbit-diagram": ["orbit-diagram", *HC, "--axis", "T=1e-3:2e-3:3", "--transients", "3", "--samples", "3"],
+    "basins": ["basins", *HC, "--period", "1e-3", "--grid", "2", "--iterations", "5"],
+    "map-continuation": ["map-continuation", *HC, "--axis", "T=0.99e-3:0.975e-3:4"],
+}
+
+
+@pytest.mark.parametrize("command", list(TRAIN_WRITERS))
+def test_archive_of_train_commands_refuses_other_work_unless_force(tmp_path, capsys, command, small_sweep):
+    """``--archive`` follows ``--out``'s rule: a sweep archive (other work) is refused, byte for byte
+    unchanged, before any work; ``--force`` replaces it; the same command again replaces its own archive."""
+    path = tmp_path / "a.nc"
+    archive.save(small_sweep, path)
+    before = path.read_bytes()
+    argv = [*TRAIN_WRITERS[command], "--archive", str(path)]
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert "holds other work" in err and "kind 'sweep'" in err and "--force" in err and len(err.splitlines()) == 1
+    assert path.read_bytes() == before
+    assert main([*argv, "--force"]) in (0, 1)
+    replaced = archive.describe(path)["kind"]
+    assert replaced != "sweep"
+    assert main(argv) in (0, 1)  # the same work: replaced without --force
+    assert archive.describe(path)["kind"] == replaced
+
+
+def test_archive_of_a_train_with_other_settings_is_other_work(tmp_path, capsys):
+    path = tmp_path / "t.nc"
+    assert main([*TRAIN_WRITERS["train"], "--archive", str(path)]) == 0
+    before = path.read_bytes()
+    capsys.readouterr()
+    assert main(["train", *HC, "--period", "3e-3", "--impacts", "3", "--archive", str(path)]) == 2
+    assert "impacts 2 (asked 3)" in capsys.readouterr().err and path.read_bytes() == before
+
+
+def test_critical_curve_out_refuses_other_work_through_the_same_rule(tmp_path, capsys, small_sweep):
+    path = tmp_path / "c.nc"
+    archive.save(small_sweep, path)
+    before = path.read_bytes()
+    assert main(["critical-curve", "--axis", "v=0.5:1:2:log", "--out", str(path)]) == 2
+    assert "holds other work" in capsys.readouterr().err and path.read_bytes() == before

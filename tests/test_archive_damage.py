@@ -202,13 +202,23 @@ def test_a_changed_text_attribute_is_refused_even_where_hdf5_has_no_checksum(tmp
         archive.describe(path)
 
 
-def test_a_partial_archive_is_not_damage(tmp_path, results):
-    """Not-computed points may hold anything a killed checkpoint left (here: codes out of range), and
-    unused stick rows are free: neither is damage."""
+def test_a_partial_archive_is_not_damage(tmp_path, results, monkeypatch):
+    """Not-computed points may hold anything a killed checkpoint left (here: its new data without their
+    commit, and codes out of range), and unused stick rows are free: neither is damage. The killed
+    checkpoint left the data digests marked in progress: such a file loads unverified."""
     path = tmp_path / "partial.h5"
     full = results["atlas"]
-    archive.Checkpoint(path)(_first_points(full, 3))
+    checkpoint = archive.Checkpoint(path)
+    checkpoint(_first_points(full, 3))
+
+    def killed(self, raw):  # after the new points' data, before their commit
+        raise KeyboardInterrupt
+
+    with monkeypatch.context() as patched, pytest.raises(KeyboardInterrupt):
+        patched.setattr(archive.Checkpoint, "_flush", killed)
+        checkpoint(_first_points(full, 5))
     with h5py.File(path, "a") as f:
+        assert json.loads(f.attrs["data_sha256"]) == {"checkpoint": "in progress"}
         for name in ("outcome", "stop_reason"):
             data = f[name][()]
             data.flat[5] = 99  # point 5 is not computed
@@ -352,3 +362,130 @@ def test_fuzz_flips_truncation_and_attribute_changes(tmp_path, files, kind):
         else:
             assert valid(result), f"trial {trial}: an invalid result loaded"
     assert outcomes["refused"] >= 20 and outcomes["same"] >= 1
+
+
+# ------------------------------------------------------------------------------------------------
+# Data digests: what Fletcher-32 lets through (a chunk and its checksum zeroed or 0xFF)
+# ------------------------------------------------------------------------------------------------
+
+def _overwrite_chunk(path, name, byte: bytes) -> None:
+    """Overwrite the first chunk of ``name``, data and Fletcher-32 checksum alike, with ``byte``."""
+    _, offset, size = next(c for c in chunks_of(path) if c[0] == name)
+    with open(path, "r+b") as handle:
+        handle.seek(offset)
+        handle.write(byte * size)
+
+
+def _refused_everywhere(path, tmp_path, message):
+    """``load``, ``plot`` and ``--resume`` refuse ``path`` in one line naming it and ``message``; the
+    resume leaves the file as it was."""
+    with pytest.raises(archive.DamagedArchiveError, match=re.escape(repr(path)) + ".*" + message):
+        archive.load(path)
+    code, err = run(["plot", path, "--out", tmp_path / "p.png"])
+    assert code == 2 and re.search(message, err) and path in err and len(err.strip().splitlines()) == 1, err
+    assert not (tmp_path / "p.png").exists()
+    before = open(path, "rb").read()
+    code, err = run([*SWEEP_ARGS, "--out", path, "--resume"])
+    assert code == 2 and re.search(message, err) and path in err, err
+    assert open(path, "rb").read() == before
+
+
+def test_fletcher32_passes_a_zeroed_chunk_with_its_checksum(tmp_path, files):
+    """Why the digests: HDF5 reads a chunk whose data and checksum are all zero without an error."""
+    path = copy(files["sweep"], tmp_path / "s.h5")
+    _overwrite_chunk(path, "max_force", b"\0")
+    with h5py.File(path, "r") as f:
+        assert (f["max_force"][()] == 0).all()
+
+
+@pytest.mark.parametrize("name", ["max_force", "n_stick", "outcome", "stick_t", "dissipated_energy"])
+def test_a_chunk_zeroed_with_its_checksum_is_refused_by_load_plot_and_resume(tmp_path, files, name):
+    path = copy(files["sweep"], tmp_path / "s.h5")
+    _overwrite_chunk(path, name, b"\0")
+    _refused_everywhere(path, tmp_path, f"variable {name}: its contents do not match their SHA-256 digest")
+
+
+def test_a_chunk_of_0xff_with_its_checksum_is_refused_by_load_plot_and_resume(tmp_path, files):
+    """The audit's corrupt_data.h5 (resume-corrupt, plot-corrupt_data, api-load-corrupt_data): NaN max
+    forces at computed points; the invariant names them before the digest does."""
+    path = copy(files["sweep"], tmp_path / "s.h5")
+    _overwrite_chunk(path, "max_force", b"\xff")
+    _refused_everywhere(path, tmp_path, r"max_force = nan at point 0 is out of range")
+
+
+@pytest.mark.parametrize(("name", "value", "message"), [
+    ("max_force", np.nan, r"max_force = nan at point 0 is out of range; allowed: a finite force"),
+    ("n_stick", -7, r"n_stick = -7 at point 0 is out of range; allowed: a count >= 0"),
+])
+def test_impossible_values_at_computed_points_are_refused_without_a_digest(tmp_path, files, name, value, message):
+    """The audit's plot-maxforce_nan, damage-plot-n_stick-neg, damage-resume-n_stick-neg: written through
+    h5py (every checksum right) into an archive without data digests (an older one)."""
+    path = copy(files["sweep"], tmp_path / "s.h5")
+    with h5py.File(path, "a") as f:
+        del f.attrs["data_sha256"]
+        data = f[name][()]
+        data[:] = value
+        f[name][...] = data
+    _refused_everywhere(path, tmp_path, message)
+
+
+def test_archives_without_data_digests_still_load(tmp_path, files, results):
+    path = copy(files["atlas"], tmp_path / "a.h5")
+    with h5py.File(path, "a") as f:
+        del f.attrs["data_sha256"]
+    assert same_result(archive.load(path), archive.load(files["atlas"]))
+
+
+def test_the_digest_is_of_the_values_whatever_the_chunks_or_filters(tmp_path, files):
+    """SHA-256 over the dtype, the shape and each 8192 elements' bytes in C order, computed here
+    independently; a copy of each dataset with other chunks and gzip has the same digests."""
+    import hashlib
+
+    path = files["atlas"]
+    with h5py.File(path, "r") as f:
+        stored = json.loads(f.attrs["data_sha256"])
+        datasets = {name: f[name][()] for name in _names(f)}
+    assert set(stored) == set(datasets) and {"max_force", "status", "stick_t", "kappa", "v"} <= set(stored)
+    other = tmp_path / "rechunked.h5"
+    with h5py.File(other, "w") as g:
+        for name, data in datasets.items():
+            flat = np.ascontiguousarray(data).reshape(-1)
+            h = hashlib.sha256(json.dumps([data.dtype.str, list(data.shape)], sort_keys=True).encode())
+            for i in range(0, max(flat.size, 1), 8192):
+                h.update(hashlib.sha256(flat[i:i + 8192].tobytes()).digest())
+            assert stored[name] == h.hexdigest(), name
+            if data.ndim and data.size:
+                g.create_dataset(name, data=data, chunks=tuple(max(1, n // 2) for n in data.shape), compression="gzip")
+            else:
+                g.create_dataset(name, data=data)
+    with h5py.File(other, "r") as g:
+        pieces = archive._file_pieces(g)
+    assert {name: archive._dataset_digest(*entry) for name, entry in pieces.items()} == stored
+
+
+def test_a_checkpoint_keeps_the_digests_true_and_a_killed_one_is_rewritten_whole(tmp_path, results, monkeypatch):
+    """Each in-place checkpoint ends with the digests of what the file holds (load verifies them); a file
+    killed in the middle of one is taken unverified, and the next checkpoint rewrites it whole."""
+    path = tmp_path / "a.h5"
+    full = results["atlas"]
+    checkpoint = archive.Checkpoint(path)
+    for n in (2, 4):
+        checkpoint(_first_points(full, n))
+    assert (checkpoint.rewrites, checkpoint.in_place) == (1, 1)
+    assert archive.load(path).done.sum() == 4
+    _overwrite_chunk(path, "n_stick", b"\0")  # damage after an in-place checkpoint: found
+    with pytest.raises(archive.DamagedArchiveError, match="variable n_stick: its contents do not match"):
+        archive.load(path)
+    fresh = archive.Checkpoint(path)  # a file whose digests fail is not written in place: rewritten whole
+    fresh(_first_points(full, 5))
+    assert (fresh.rewrites, fresh.in_place) == (1, 0) and archive.load(path).done.sum() == 5
+    with monkeypatch.context() as patched, pytest.raises(KeyboardInterrupt):
+        patched.setattr(archive.Checkpoint, "_flush", lambda self, raw: (_ for _ in ()).throw(KeyboardInterrupt))
+        fresh(_first_points(full, 6))
+    assert archive.load(path).done.sum() == 5  # unverified, the committed points intact
+    again = archive.Checkpoint(path)
+    again(_first_points(full, 6))
+    assert (again.rewrites, again.in_place) == (1, 0)
+    with h5py.File(path, "r") as f:
+        assert "checkpoint" not in json.loads(f.attrs["data_sha256"])
+    assert same_result(archive.load(path), _first_points(full, 6))

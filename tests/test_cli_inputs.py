@@ -457,3 +457,60 @@ def test_python_dash_m_runs_the_command_line():
     done = subprocess.run([sys.executable, "-m", "phaseimpact", "--version"], capture_output=True, text=True,
                           timeout=120)
     assert done.returncode == 0 and done.stdout.split()[-1] == __import__("phaseimpact").__version__
+
+
+# ------------------------------------------------------------------------------------------------
+# audits/inputs-2026-11b.md: paths, standard output
+# ------------------------------------------------------------------------------------------------
+
+def test_an_out_value_starting_with_a_dash_gets_the_equals_form():
+    """path-dash: argparse reads ``-s.nc`` as an option; the message says how to give it."""
+    code, _, err = run([*SWEEP, "--out", "-s.nc"])
+    assert code == 2 and "expected one argument" in err and "--out=-s.nc" in err and len(err.splitlines()) == 1
+
+
+def test_a_255_byte_out_name_is_written_and_its_lock_name_fits(tmp_path):
+    """path-255: the sidecar lock and temporary file of a name of NAME_MAX bytes are shortened with a digest."""
+    out = tmp_path / ("a" * 255)
+    code, _, err = run(["sweep", "--law", "paper", "--axis", "kappa=1e9:1e11:3:log", "--no-progress", "--out",
+                        str(out)])
+    assert code == 0, err
+    assert [p.name for p in tmp_path.iterdir()] == [out.name]  # nothing left beside it
+
+
+def test_stdout_on_a_full_device_is_named():
+    """devfull-cases: the error names the standard output (no file of ours is on the full disk)."""
+    if not os.path.exists("/dev/full"):
+        pytest.skip("no /dev/full here")
+    with open("/dev/full", "w") as full:
+        done = subprocess.run([*CLI, "cases"], stdout=full, stderr=subprocess.PIPE, text=True, timeout=120)
+    assert done.returncode == 1
+    assert done.stderr.strip() == "phaseimpact: error: [Errno 28] No space left on device: 'standard output'"
+
+
+def test_an_ascii_standard_output_gets_escapes_not_an_error():
+    """env-ioenc-ascii: 'µm' in the case list is written as an escape; the whole list, exit 0."""
+    done = subprocess.run([*CLI, "cases"], capture_output=True, timeout=120,
+                          env={**os.environ, "PYTHONIOENCODING": "ascii"})
+    assert done.returncode == 0, done.stderr
+    assert b"100 \\xb5m quartz sand" in done.stdout and b"phaseimpact COMMAND --case NAME" in done.stdout
+
+
+def test_plot_of_an_unreadable_file_says_permission_denied(tmp_path, monkeypatch):
+    """nb-plot-unreadable: not 'not a readable HDF5 file (truncated, damaged or foreign)'."""
+    from phaseimpact import archive
+
+    path = tmp_path / "s.nc"
+    path.write_bytes(b"\x89HDF\r\n\x1a\n" + bytes(100))
+    path.chmod(0)
+    if os.geteuid() == 0:  # root reads anything: refuse this one path as the kernel would for another user
+        real_open = os.open
+
+        def denied(name, flags, *args, **kwargs):
+            if os.fspath(name) == str(path):
+                raise PermissionError(13, "Permission denied", str(path))
+            return real_open(name, flags, *args, **kwargs)
+
+        monkeypatch.setattr(archive.os, "open", denied)
+    code, _, err = run(["plot", str(path), "--out", str(tmp_path / "p.png")])
+    assert code == 2 and err.strip() == f"phaseimpact: error: archive {str(path)!r} cannot be read: Permission denied"

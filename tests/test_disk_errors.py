@@ -159,6 +159,34 @@ def test_commands_on_a_disk_already_full_name_the_path_and_leave_no_lock(tiny_di
         assert sorted(p.name for p in tiny_disk.iterdir()) == ["filler"]
 
 
+#: A checkpoint of a 40,000-point sweep (about 5 MB): on a 2 MiB tmpfs it fails part way, with 1.0-1.3 MB free.
+_CHECKPOINT_40000 = """
+import errno, sys
+import numpy as np
+from phaseimpact import archive, seed_parameters
+from phaseimpact.continuation import SweepResult
+from phaseimpact.continuation.grid import Axis, Grid
+from phaseimpact.model import ContactLaw
+grid = Grid(seed_parameters(), ContactLaw("paper"), (Axis("kappa", np.geomspace(1e9, 1e14, 40000), True),))
+try:
+    archive.Checkpoint(sys.argv[1])(SweepResult(grid, None, {"rtol": 1e-10}))
+except OSError as error:
+    sys.exit(3 if error.errno == errno.ENOSPC else 4)
+"""
+
+
+@pytest.mark.parametrize("filler_kib", [950, 1000, 1040])
+def test_a_checkpoint_meeting_a_full_disk_part_way_raises_and_does_not_crash(tiny_disk, filler_kib):
+    """The audit's segfault (rc 139 with 1.0-1.3 MB free): a reservation that fails on tmpfs gives back
+    the room kept for the file's close, whose writes then failed inside HDF5. The file is emptied before
+    it is closed: ENOSPC, nothing left behind."""
+    (tiny_disk / "filler").write_bytes(b"\0" * (filler_kib * 1024))
+    done = subprocess.run([sys.executable, "-c", _CHECKPOINT_40000, str(tiny_disk / "s.nc")], capture_output=True,
+                          text=True, timeout=300)
+    assert done.returncode == 3, (done.returncode, done.stderr[-2000:])  # ENOSPC raised; not 139
+    assert sorted(p.name for p in tiny_disk.iterdir()) == ["filler"]
+
+
 # ------------------------------------------------------------------------------------------------
 # Non-regular files
 # ------------------------------------------------------------------------------------------------
