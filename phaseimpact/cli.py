@@ -79,12 +79,13 @@ _NEGATIVE_NUMBER = re.compile(r"^-(\d+\.?\d*|\.\d+)(e[-+]?\d+)?$|^-(inf|infinity
 
 def _check_environment() -> None:
     """The environment this process runs in, checked before any work (``ValueError`` names it)."""
-    from ._environment import source_date_epoch
+    from ._environment import numba_num_threads, source_date_epoch
     from ._jit import processes
 
     if sys.stdout is None:  # started with stdout closed (cmd >&-): nothing could be reported
         raise ValueError("stdout is closed; allowed: an open standard output (redirect it to a file or /dev/null)")
     source_date_epoch()
+    numba_num_threads()
     processes()  # PHASEIMPACT_COMPILE_PROCESSES: read only by a first-ever compile, checked every time
 
 

@@ -396,7 +396,7 @@ def test_thickness_is_not_judged_without_the_plate_s_springs():
     assert code == 0 and json.loads(out)["validity"] == "ok"
 
 
-@pytest.mark.parametrize("epoch", ["abc", "1e20", "99999999999999999"])
+@pytest.mark.parametrize("epoch", ["abc", "-5", "1e20", "99999999999999999"])
 def test_bad_source_date_epoch_refused_before_numpy_reads_it(epoch, tmp_path):
     """NumPy's f2py crashed at import on these, before the project's own check could run."""
     result = subprocess.run([*CLI, *SWEEP, "--out", "s.h5"], capture_output=True, text=True, cwd=tmp_path,
@@ -407,6 +407,32 @@ def test_bad_source_date_epoch_refused_before_numpy_reads_it(epoch, tmp_path):
         "since 1970-01-01 UTC, 0 <= SOURCE_DATE_EPOCH <= 253402300799 (the year 9999), as 'date +%s' prints it, "
         "or unset"]
     assert not (tmp_path / "s.h5").exists()
+
+
+def test_empty_source_date_epoch_means_unset(tmp_path):
+    """What `VAR=$(git log ...)` leaves outside a git checkout: NumPy's f2py crashed at import on it (every
+    computing command, and `import phaseimpact.continuation`); empty means unset."""
+    env = {**os.environ, "SOURCE_DATE_EPOCH": ""}
+    result = subprocess.run([*CLI, *SWEEP, "--out", "s.h5"], capture_output=True,
+                            text=True, cwd=tmp_path, timeout=300, env=env)
+    assert result.returncode == 0, result.stderr
+    assert (tmp_path / "s.h5").exists()
+    api = subprocess.run([sys.executable, "-c", "import phaseimpact.continuation, os; "
+                          "print(os.environ.get('SOURCE_DATE_EPOCH', 'unset'))"],
+                         capture_output=True, text=True, timeout=120, env=env)
+    assert api.returncode == 0 and api.stdout.strip() == "unset", api.stderr
+
+
+@pytest.mark.parametrize("threads", ["0", "abc", "-2"])
+def test_bad_numba_num_threads_named(threads, tmp_path):
+    """numba said 'Number of threads specified must be > 0.' (0) or printed a warning with a traceback
+    and ran on (abc), without naming the variable."""
+    result = subprocess.run([*CLI, "simulate", "--t-end", "1e-4"], capture_output=True, text=True, cwd=tmp_path,
+                            timeout=120, env={**os.environ, "NUMBA_NUM_THREADS": threads})
+    assert result.returncode == 2
+    lines = result.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith(
+        f"phaseimpact: error: NUMBA_NUM_THREADS = {threads!r} is out of range; allowed: an integer >= 1"), lines
 
 
 def test_bad_compile_processes_refused(monkeypatch, no_work):
