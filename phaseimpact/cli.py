@@ -620,7 +620,7 @@ def _contact_reading(trajectory, setup: Setup) -> dict:
     case = setup.case
     if setup.law.entry.plastic:  # the pressure is capped at p_y: Hertz's reading does not apply
         return {**plastic_contact(force, setup.params),
-                "validity": plastic_validity(force, setup.params, case.geometry)}
+                "validity": plastic_validity(force, setup.params, case.geometry, case.plate, case.projectile)}
     return {**hertz_contact(force, setup.params),
             "validity": validity_for_force(force, setup.params, case.plate, case.projectile, case.geometry)}
 
@@ -1315,6 +1315,19 @@ def _settable_help() -> str:
     return ", ".join(f"{name} ({unit})" if unit else name for name, (unit, _) in SETTABLE.items())
 
 
+class _Removed(argparse.Action):
+    """An option of an earlier version: refused with the ``--axis`` that replaces it (hidden from the help)."""
+
+    def __init__(self, option_strings, dest, example="kappa=1e9:1e14:50:log", **kwargs):
+        self.example = example
+        super().__init__(option_strings, dest, nargs="?", help=argparse.SUPPRESS, **kwargs)
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        example = f"{values}" if option_string == "--range" and values and "=" in values else self.example
+        parser.error(f"{option_string} was removed; allowed: --axis {RANGE_METAVAR} (NUM values from START to "
+                     f"STOP, log spaced with :log) or --axis NAME=V1,V2,..., e.g. --axis {example}")
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = _Parser(prog="phaseimpact", description="Impact models analysed as dynamical systems: one impact, "
                                                      "the critical damping and the other transitions, sweeps, "
@@ -1575,6 +1588,8 @@ def build_parser() -> argparse.ArgumentParser:
         target(p)
         axis_option(p, "the sweep's values" if name == "sweep" else "one axis of the grid (repeat for each)",
                     repeat=True)
+        for removed in ("--kappa-min", "--kappa-max", "--num", "--range"):
+            p.add_argument(removed, action=_Removed)
         p.add_argument("--refine", default=None, metavar="AXIS",
                        help="after the grid, locate every class boundary between neighbours along AXIS (one of the "
                             "--axis names) by bisection, to --refine-rtol, and store the boundary points in the "
@@ -1599,6 +1614,8 @@ def build_parser() -> argparse.ArgumentParser:
     curve_params = ", ".join([*CURVE_PARAMETERS, *(n for n in QUANTITIES if n not in CURVE_PARAMETERS)])
     axis_option(p, "the parameter the curve runs over and its values, increasing, in its SI unit (e.g. "
                 "v=0.5:10:20:log)", names=curve_params, limit=MAX_CURVE_POINTS)
+    for removed in ("--param", "--values"):
+        p.add_argument(removed, action=_Removed, example="v=0.5:10:20:log")
     p.add_argument("--what", choices=CURVE_WHATS, default="kappa_c",
                    help="what is continued: kappa_c or kappa_2 (law paper), or grazing (a unilateral law: the first "
                         "grazing value in [KAPPA_MIN, KAPPA_MAX] at the first value) (default: %(default)s)")

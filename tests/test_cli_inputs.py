@@ -20,7 +20,7 @@ from hypothesis import strategies as st
 
 import phaseimpact.continuation as continuation
 import phaseimpact.integrate as integrate
-from phaseimpact.cli import build_parser, main
+from phaseimpact.cli import RANGE_METAVAR, build_parser, main
 
 CLI = [sys.executable, "-m", "phaseimpact.cli"]
 SWEEP = ["sweep", "--law", "paper", "--v", "1", "--axis", "kappa=1e9:1e12:20:log",
@@ -140,6 +140,16 @@ BAD = [
     (["atlas", "--axis", "plate.yield_strength=1e7:1e9:3", "--axis", "v=1,2", "--out", "a.h5"],
      "plate.yield_strength"),
     (["atlas", "--axis", "kappa=1e9,1e9", "--axis", "v=1,2", "--out", "a.h5"], "distinct values"),
+    # issue 37: old spellings point at --axis; NUM named; a yield strength out of its range under thornton
+    (["sweep", "--kappa-min", "1e9", "--kappa-max", "1e14", "--out", "a.h5"], "--kappa-min was removed"),
+    (["sweep", "--axis", "kappa=1e9:1e14:5:log", "--num", "5", "--out", "a.h5"], "--num was removed"),
+    (["atlas", "--range", "kappa=1e9:1e14:5", "--out", "a.h5"], "--range was removed"),
+    (["critical-curve", "--param", "v", "--values", "1,2", "--out", "a.h5"], "--param was removed"),
+    (["sweep", "--axis", "kappa=1e9:1e14:nan", "--out", "a.h5"], "NUM = 'nan'"),
+    (["sweep", "--case", "sand-gelcoat", "--law", "thornton", "--axis", "plate.yield_strength=1:1e9:5:log",
+      "--out", "a.h5"], "yield_strength = 1.0"),
+    (["sweep", "--case", "sand-gelcoat", "--law", "hunt-crossley", "--axis", "plate.yield_strength=1e7:1e9:3:log",
+      "--out", "a.h5"], "plate.yield_strength"),
 ]
 
 
@@ -483,3 +493,55 @@ def test_python_dash_m_runs_the_command_line():
     done = subprocess.run([sys.executable, "-m", "phaseimpact", "--version"], capture_output=True, text=True,
                           timeout=120)
     assert done.returncode == 0 and done.stdout.split()[-1] == __import__("phaseimpact").__version__
+
+
+def test_old_range_options_show_the_axis_that_replaces_them(no_work):
+    code, _, err = run(["atlas", "--range", "kappa=1e9:1e14:5", "--out", "a.h5"])
+    assert code == 2 and "e.g. --axis kappa=1e9:1e14:5" in err and RANGE_METAVAR in err
+    code, _, err = run(["critical-curve", "--param", "v", "--values", "1,2", "--out", "a.h5"])
+    assert code == 2 and "--axis NAME=V1,V2" in err
+
+
+def test_case_file_with_a_byte_order_mark_is_read(tmp_path):
+    """Windows editors write a UTF-8 BOM; tomllib called it 'Invalid statement (at line 1, column 1)'."""
+    text = (Path(__file__).resolve().parents[1] / "phaseimpact" / "cases" / "seed.toml").read_text(encoding="utf-8")
+    (tmp_path / "bom.toml").write_bytes(b"\xef\xbb\xbf" + text.encode("utf-8"))
+    (tmp_path / "plain.toml").write_text(text, encoding="utf-8")
+    with_bom = run(["params", "--case", str(tmp_path / "bom.toml"), "--json"])
+    plain = run(["params", "--case", str(tmp_path / "plain.toml"), "--json"])
+    assert with_bom[0] == 0, with_bom[2]
+    assert json.loads(with_bom[1]) == json.loads(plain[1])
+
+
+def test_resume_refusal_shows_the_spacing_of_both_axes(tmp_path):
+    """The stored log axis and an asked linear one have the same ends and NUM: only the spacing differs."""
+    out = str(tmp_path / "s.h5")
+    base = ["sweep", "--law", "paper", "--v", "1", "--t-end", "2e-4", "--no-progress", "--out", out]
+    assert run([*base, "--axis", "kappa=1e9:1e12:3:log"])[0] == 0
+    code, _, err = run([*base, "--axis", "kappa=1e9:1e12:3", "--resume"])
+    assert code == 2
+    assert "1000000000.0 to 1000000000000.0, log spaced (asked kappa: 3 values from 1000000000.0 to " \
+           "1000000000000.0, linear)" in err, err
+
+
+def test_thornton_sweeps_the_yield_strength_it_reads(tmp_path):
+    """Under thornton the yield strength sets p_y = 1.6 Y: an axis of it was refused as 'not read by the
+    equations of motion'. The peak force falls as the yield strength falls (the pressure is capped lower)."""
+    from phaseimpact import archive
+
+    out = tmp_path / "y.h5"
+    code, _, err = run(["sweep", "--case", "sand-gelcoat", "--law", "thornton", "--axis",
+                        "plate.yield_strength=1e6:1e9:3:log", "--no-progress", "--out", str(out)])
+    assert code == 0, err
+    force = archive.load(out).max_force
+    assert force[0] < force[1] < force[2], force
+
+
+@pytest.mark.parametrize("command", [["simulate", "--law", "thornton"], ["params"]])
+def test_yield_strength_above_young_s_modulus_gets_a_verdict(command):
+    code, out, _ = run([*command, "--set", "plate.yield_strength=5e11", "--json"])
+    assert code == 0
+    assert "yield strength 5e+11 Pa of the target exceeds its Young's modulus E = 2.1e+11 Pa" in \
+        json.loads(out)["validity"]
+    _, out, _ = run([*command, "--set", "plate.yield_strength=2e11", "--json"])
+    assert "Young's modulus" not in json.loads(out)["validity"]
