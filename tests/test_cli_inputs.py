@@ -545,3 +545,43 @@ def test_yield_strength_above_young_s_modulus_gets_a_verdict(command):
         json.loads(out)["validity"]
     _, out, _ = run([*command, "--set", "plate.yield_strength=2e11", "--json"])
     assert "Young's modulus" not in json.loads(out)["validity"]
+
+
+HC_TRAIN = ["--law", "hunt-crossley", "--kappa", "3e9"]
+OD = ["orbit-diagram", *HC_TRAIN, "--transients", "5", "--samples", "3"]
+BASINS = ["basins", *HC_TRAIN, "--grid", "3", "--iterations", "20"]
+
+
+@pytest.mark.parametrize("args, message", [
+    # issue 37: the user's option is named, not the engine's t_end, initial state or grid arrays
+    (["train", *HC_TRAIN, "--impacts", "2", "--period", "1e-308"], "period = 1e-308 is out of range"),
+    (["train", *HC_TRAIN, "--impacts", "2", "--period", "1e308"], "period = 1e+308 is out of range"),
+    ([*OD, "--axis", "T=1e308,1e308"], "T = 1e+308 is out of range"),
+    ([*OD, "--axis", "T=1e-308,2e-308"], "T = 1e-308 is out of range"),
+    ([*OD, "--axis", "v=1:2:3", "--period", "1e-308"], "period = 1e-308 is out of range"),
+    ([*OD, "--axis", "v=1:2:3", "--period", "1e308"], "period = 1e+308 is out of range"),
+    ([*OD, "--axis", "T=1e-3:2e-3:3", "--period", "5e-3"], "period = 0.005 s contradicts --axis T"),
+    (["orbit-diagram", *HC_TRAIN, "--axis", "T=1e-3:2e-3:1000", "--transients", "100000", "--samples", "100000"],
+     "--transients + --samples <= 100000"),
+    (["map-continuation", *HC_TRAIN, "--axis", "T=1e-3:1e308:3"], "T = 1e+308 is out of range"),
+    (["map-continuation", *HC_TRAIN, "--axis", "v=1:2:3", "--period", "1e-308"], "period = 1e-308 is out of range"),
+    (["map-continuation", *HC_TRAIN, "--axis", "v=1:2:3", "--period", "1e308"], "period = 1e+308 is out of range"),
+    ([*BASINS, "--period", "1e-3", "--x2-max", "1e308"], "x2-max = 1e+308 m is out of range"),
+    ([*BASINS, "--period", "1e-3", "--x2dot-max", "1e308"], "x2dot-max = 1e+308 m/s is out of range"),
+    ([*BASINS, "--period", "1e308"], "period = 1e+308 is out of range"),
+    ([*BASINS, "--period", "1e-308"], "period = 1e-308 is out of range"),
+], ids=lambda value: " ".join(value) if isinstance(value, list) else None)
+def test_train_family_inputs_named_before_any_work(args, message, tmp_path, monkeypatch):
+    import phaseimpact.train as train_module
+
+    def forbidden(*args, **kwargs):
+        raise AssertionError("work started before the input was refused")
+
+    monkeypatch.setattr(train_module, "simulate", forbidden)
+    monkeypatch.chdir(tmp_path)
+    code, out, err = run(args)
+    lines = err.strip().splitlines()
+    assert code == 2 and len(lines) == 1 and "Traceback" not in err, err
+    assert message in lines[0] and ("allowed" in lines[0]), lines[0]
+    for internal in ("t_end", "initial", "x2_values", "x2dot_values", "impacts ="):
+        assert internal not in lines[0]
