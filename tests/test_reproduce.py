@@ -173,3 +173,11 @@ def test_a_study_runs_from_git_archive_output(tmp_path):
     assert written == ["data/fig04_force_indentation.h5", "fig04_force_indentation.pdf",
                        "fig04_force_indentation.png"], written
     assert "3 file(s) changed beyond the tolerance" in result.stdout  # new files: nothing to compare with
+
+
+def test_readme_states_the_tolerance_the_comparison_uses():
+    text = " ".join((ROOT / "README.md").read_text(encoding="utf-8").split())
+    rtol = f"{_settle.RTOL:.0e}".replace("e-0", "e-")  # as written: 1e-9
+    assert float(rtol) == _settle.RTOL
+    assert f"within a relative {rtol} (or {rtol} of the dataset's largest magnitude" in text
+    assert f"within {_settle.PIXEL_LEVELS} levels of 255 per channel" in text
