@@ -439,8 +439,8 @@ def test_portrait_writes_svg_and_refuses_other_formats_before_computing(tmp_path
     assert exit_.value.code == 2
 
 
-def test_quick_previews_go_to_the_preview_folder():
-    sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "studies"))  # _cli imports _settle
+def test_quick_previews_go_to_the_preview_folder(monkeypatch):
+    monkeypatch.syspath_prepend(os.path.join(os.path.dirname(__file__), "..", "studies"))  # _cli imports _settle
     spec = importlib.util.spec_from_file_location("studies_cli", os.path.join(os.path.dirname(__file__), "..",
                                                                              "studies", "_cli.py"))
     study_cli = importlib.util.module_from_spec(spec)

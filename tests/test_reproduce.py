@@ -5,6 +5,7 @@ Regenerated files replace the committed ones only when they differ beyond the to
 (1e-6) replaces them. And the Makefile's recipe works outside a git checkout (``git archive``).
 """
 
+import importlib.util
 import os
 import shutil
 import stat
@@ -16,15 +17,23 @@ import h5py
 import numpy as np
 import pytest
 
+from phaseimpact import archive, seed_parameters
+from phaseimpact.continuation import sweep
+from phaseimpact.model import ContactLaw
+from phaseimpact.plotting import save_h5
+
 ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT / "studies"))
 
-import _settle  # noqa: E402
 
-from phaseimpact import archive, seed_parameters  # noqa: E402
-from phaseimpact.continuation import sweep  # noqa: E402
-from phaseimpact.model import ContactLaw  # noqa: E402
-from phaseimpact.plotting import save_h5  # noqa: E402
+def _study_module(name):
+    """A module of studies/ by its file (studies/ on sys.path would shadow tests/_cli.py with studies/_cli.py)."""
+    spec = importlib.util.spec_from_file_location(f"studies_{name}", ROOT / "studies" / f"{name}.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+_settle = _study_module("_settle")
 
 
 def _scaled(path: Path, out: Path, dataset: str, factor: float) -> Path:
