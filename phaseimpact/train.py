@@ -47,7 +47,27 @@ MAX_PERIOD_SWINGS = 1e6
 
 
 def period_range(params: Parameters) -> tuple[float, float, str]:
-    """``(shortest, longest, why)``: the periods between arrivals (s) the impact map can resolve for ``params``."""
+    """The periods between arrivals the impact map can resolve for ``params``.
+
+    Parameters
+    ----------
+    params : Parameters
+        The case: its contact time (Hertz, at its ``v``) and its plate period.
+
+    Returns
+    -------
+    (float, float, str)
+        The shortest and the longest period (s), and why, in words for a message: from
+        ``MIN_HORIZON_CONTACT_TIMES`` contact times to :data:`MAX_PERIOD_SWINGS` plate periods
+        (contact times on a rigid or free target).
+
+    Examples
+    --------
+    >>> from phaseimpact import seed_parameters
+    >>> shortest, longest, _ = period_range(seed_parameters(v=1.0))
+    >>> print(f"{shortest:.3g} s to {longest:.4g} s")
+    1.08e-17 s to 1004 s
+    """
     from .integrate import scales
     from .integrate.api import MIN_HORIZON_CONTACT_TIMES
 
