@@ -1924,13 +1924,17 @@ def _train_axis(args, setup: Setup):
     for x in (low, high):
         if param == "v":
             _check_in_range("v", x, *V_RANGE, "m/s", "axis v")
-            _check_train_period("period", args.period, setup.params.replace(v=x))  # the contact time is v's
         elif param == "kappa":
             _check_in_range("kappa", x, 0.0, KAPPA_MAX, KAPPA_UNIT, "axis kappa")
         elif x <= 0:
             raise ValueError(f"T = {x!r} is out of range; allowed: T > 0 (s)")
     if param == "kappa":
         _check_train_period("period", args.period, setup.params)
+    elif param == "v":  # the contact time is v's: the longest at the lowest v (the one warning)
+        from .train import _check_period
+
+        _check_period(args.period, setup.params.replace(v=high), "period")
+        _check_train_period("period", args.period, setup.params.replace(v=low))
     elif param == "T":
         for x in sorted({low, high}):
             _check_train_period("T", x, setup.params)
