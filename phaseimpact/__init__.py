@@ -24,8 +24,10 @@ from typing import TYPE_CHECKING
 from . import _environment, _lazy
 
 # NumPy's f2py reads SOURCE_DATE_EPOCH once, when it is first imported (SciPy and numba import it),
-# and crashes on a bad value; so a bad value is hidden while f2py imports here, then put back for
-# phaseimpact's own check to refuse with a message. (Only then: f2py costs 0.1 s of start-up.)
+# and crashes on a bad value; so an empty one is unset (it means unset) and a malformed one is hidden
+# while f2py imports here, then put back for phaseimpact's own check to refuse with a message. (Only
+# then: f2py costs 0.1 s of start-up.)
+_environment.unset_empty()
 _hidden = _environment.hide_bad_source_date_epoch()
 if _hidden is not None:
     try:

@@ -2,9 +2,15 @@
 
 ``SOURCE_DATE_EPOCH`` (reproducible builds: the ``created`` time of an archive) is also read by
 NumPy's f2py when SciPy imports it, and a value that is not an integer crashes that import with a
-traceback from inside NumPy. The package hides a bad value while it imports its dependencies
+traceback from inside NumPy. Set but empty (what ``VAR=$(git log ...)`` leaves outside a git
+checkout) means unset, as the reproducible-builds specification says: the package removes it from
+the environment on import (:func:`unset_empty`). A malformed value is hidden while the package imports its dependencies
 (:func:`hide_bad_source_date_epoch`, :func:`restore_source_date_epoch`), so that phaseimpact's own
 check refuses it with a message: the command line at once, an archive when it is written.
+
+``NUMBA_NUM_THREADS`` is read by numba: 0 fails deep inside its first parallel call and a
+non-integer is replaced by a warning with a traceback in it; the command line refuses both
+(:func:`numba_num_threads`), and an empty one is unset too.
 """
 
 from __future__ import annotations
@@ -12,9 +18,11 @@ from __future__ import annotations
 import os
 import re
 
-__all__ = ["EPOCH_MAX", "source_date_epoch", "hide_bad_source_date_epoch", "restore_source_date_epoch"]
+__all__ = ["EPOCH_MAX", "source_date_epoch", "hide_bad_source_date_epoch", "restore_source_date_epoch",
+           "numba_num_threads", "unset_empty"]
 
 VARIABLE = "SOURCE_DATE_EPOCH"
+THREADS_VARIABLE = "NUMBA_NUM_THREADS"
 #: The last second a timestamp can hold (9999-12-31T23:59:59 UTC), s since 1970.
 EPOCH_MAX = 253_402_300_799
 
@@ -37,6 +45,14 @@ def source_date_epoch() -> int | None:
     return int(text)
 
 
+def unset_empty() -> None:
+    """Remove ``SOURCE_DATE_EPOCH`` and ``NUMBA_NUM_THREADS`` when set but empty: unset, for NumPy, numba
+    and child processes too (NumPy's f2py crashes on an empty one, numba warns)."""
+    for name in (VARIABLE, THREADS_VARIABLE):
+        if name in os.environ and not os.environ[name].strip():
+            del os.environ[name]
+
+
 def hide_bad_source_date_epoch() -> str | None:
     """Remove a bad ``SOURCE_DATE_EPOCH`` from the environment and return it (None if fine)."""
     try:
@@ -50,3 +66,21 @@ def restore_source_date_epoch(value: str | None) -> None:
     """Put back what :func:`hide_bad_source_date_epoch` removed."""
     if value is not None:
         os.environ[VARIABLE] = value
+
+
+def numba_num_threads() -> int | None:
+    """``NUMBA_NUM_THREADS`` (numba's thread pool), or None when it is not set (empty means unset).
+
+    Raises
+    ------
+    ValueError
+        Naming the variable, its value and the allowed range.
+    """
+    text = os.environ.get(THREADS_VARIABLE, "").strip()
+    if not text:
+        return None
+    if not re.fullmatch(r"[0-9]+", text) or int(text) < 1:
+        cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1
+        raise ValueError(f"{THREADS_VARIABLE} = {text!r} is out of range; allowed: an integer >= 1 (threads of "
+                         f"numba's pool; this machine has {cores} cores), or unset")
+    return int(text)

@@ -2809,8 +2809,20 @@ def _same_number(a, b) -> bool:
 
 def _axis_text(name, values) -> str:
     values = np.asarray(values, dtype=float).ravel()
+    if not values.size:
+        return f"{name}: empty"
+    # the spacing too: a log and a linear axis with the same ends and NUM must not print alike
+    spacing = ""
+    if values.size > 2:
+        steps = np.diff(values)
+        if np.all(values > 0) and np.allclose(np.diff(np.log(values)), np.log(values[1] / values[0]), rtol=1e-9):
+            spacing = ", log spaced"
+        elif np.allclose(steps, steps[0], rtol=1e-9):
+            spacing = ", linear"
+        else:
+            spacing = ", listed"
     # repr digits: a difference in the 11th digit must show in the message
-    return f"{name}: {len(values)} values from {values[0]!r} to {values[-1]!r}" if values.size else f"{name}: empty"
+    return f"{name}: {len(values)} values from {float(values[0])!r} to {float(values[-1])!r}{spacing}"
 
 
 def _t_end_text(t_end) -> str:

@@ -628,7 +628,7 @@ def load_case(name_or_path) -> Case:
     if path.exists() and not path.is_file():  # a FIFO would block the read forever
         raise ValueError(f"{path}: not a regular file (a case file is a .toml file)")
     try:
-        content = path.read_text(encoding="utf-8")
+        content = path.read_text(encoding="utf-8-sig")  # a byte-order mark (Windows editors) is not TOML: dropped
     except OSError as exc:
         raise ValueError(f"{path}: cannot read the case file ({exc.strerror or exc})") from None
     except UnicodeDecodeError as exc:
@@ -966,10 +966,22 @@ def _reasons(pressure: float, radius: float, params: Parameters, plate_material,
         reasons.append(f"contact radius {radius:.3g} m is {ratio:.2g} R (Hertz needs a << R; limit "
                        f"{CONTACT_RATIO_LIMIT:g} R)")
     verdicts = ["; ".join(reasons) + ": elastic Hertz contact is out of its range"] if reasons else []
+    verdicts += _strength_reasons(plate_material, projectile_material)
     plate = _plate_reasons(geometry, params.target) if geometry is not None else []
     if plate:
         verdicts.append("; ".join(plate) + ": the plate model is out of its range")
     return "; ".join(verdicts) or "ok"
+
+
+def _strength_reasons(plate_material: Material | None, projectile_material: Material | None) -> list:
+    """A yield strength above the material's Young's modulus: no solid yields there (metals at about
+    E/1000, the strongest ceramics near E/10), so it is a typo or a unit slip (and leaves thornton elastic)."""
+    implausible = [f"yield strength {m.yield_strength:.3g} Pa of the {role} exceeds its Young's modulus "
+                   f"E = {m.E:.3g} Pa" for role, m in (("target", plate_material), ("projectile", projectile_material))
+                   if m is not None and m.yield_strength is not None and m.yield_strength > m.E]
+    if not implausible:
+        return []
+    return ["; ".join(implausible) + ": no solid yields above E (check the value and its unit, Pa)"]
 
 
 def _plate_reasons(g: Geometry, target: str) -> list:
@@ -1089,7 +1101,8 @@ def plastic_contact(force: float, params: Parameters) -> dict:
     return {"contact_radius": math.sqrt((2.0 * force + f_y) / (2.0 * math.pi * p_y)), "peak_pressure": p_y}
 
 
-def plastic_validity(force: float, params: Parameters, geometry: Geometry | None = None) -> str:
+def plastic_validity(force: float, params: Parameters, geometry: Geometry | None = None,
+                     plate_material: Material | None = None, projectile_material: Material | None = None) -> str:
     """The regime of an impact under Thornton's law (its peak force ``force``, N): elastic below the
     yield velocity ``v_y``, elastic-plastic above (the model's own range: the pressure is capped at
     ``p_y``); then, as :func:`validity`, a contact radius beyond ``CONTACT_RATIO_LIMIT * R`` and a
@@ -1104,6 +1117,8 @@ def plastic_validity(force: float, params: Parameters, geometry: Geometry | None
         :attr:`~phaseimpact.parameters.Parameters.yield_velocity`.
     geometry : Geometry, optional
         Checked against the plate model as in :func:`validity`.
+    plate_material, projectile_material : Material, optional
+        A yield strength above the material's Young's modulus is reported (no solid yields there).
 
     Returns
     -------
@@ -1142,6 +1157,7 @@ def plastic_validity(force: float, params: Parameters, geometry: Geometry | None
         plate = _plate_reasons(geometry, params.target)
         if plate:
             reasons.append("; ".join(plate) + ": the plate model is out of its range")
+    reasons += _strength_reasons(plate_material, projectile_material)
     return "; ".join([regime, *reasons])
 
 

@@ -44,6 +44,10 @@ RESTITUTION_RANGE = (1e-6, 1.0)
 MAX_SWEEP_POINTS = 10_000_000
 #: Values of one critical curve (each is a root search).
 MAX_CURVE_POINTS = 1000
+#: Impacts of one train (phaseimpact.train.impact_train's limit).
+MAX_TRAIN_IMPACTS = 100_000
+#: Largest initial plate state of ``basins``, in the grid's natural scales (the plate's swing at speed v, 1.5 v).
+MAX_BASIN_SCALES = 1e6
 #: The range syntax every command that computes over values takes (``--axis``).
 RANGE_METAVAR = "NAME=START:STOP:NUM[:log]"
 #: kappa samples of a transition search (each is one run), and the default.
@@ -79,12 +83,13 @@ _NEGATIVE_NUMBER = re.compile(r"^-(\d+\.?\d*|\.\d+)(e[-+]?\d+)?$|^-(inf|infinity
 
 def _check_environment() -> None:
     """The environment this process runs in, checked before any work (``ValueError`` names it)."""
-    from ._environment import source_date_epoch
+    from ._environment import numba_num_threads, source_date_epoch
     from ._jit import processes
 
     if sys.stdout is None:  # started with stdout closed (cmd >&-): nothing could be reported
         raise ValueError("stdout is closed; allowed: an open standard output (redirect it to a file or /dev/null)")
     source_date_epoch()
+    numba_num_threads()
     processes()  # PHASEIMPACT_COMPILE_PROCESSES: read only by a first-ever compile, checked every time
 
 
@@ -662,7 +667,7 @@ def _contact_reading(trajectory, setup: Setup) -> dict:
     case = setup.case
     if setup.law.entry.plastic:  # the pressure is capped at p_y: Hertz's reading does not apply
         return {**plastic_contact(force, setup.params),
-                "validity": plastic_validity(force, setup.params, case.geometry)}
+                "validity": plastic_validity(force, setup.params, case.geometry, case.plate, case.projectile)}
     return {**hertz_contact(force, setup.params),
             "validity": validity_for_force(force, setup.params, case.plate, case.projectile, case.geometry)}
 
@@ -1340,6 +1345,19 @@ def _settable_help() -> str:
     return ", ".join(f"{name} ({unit})" if unit else name for name, (unit, _) in SETTABLE.items())
 
 
+class _Removed(argparse.Action):
+    """An option of an earlier version: refused with the ``--axis`` that replaces it (hidden from the help)."""
+
+    def __init__(self, option_strings, dest, example="kappa=1e9:1e14:50:log", **kwargs):
+        self.example = example
+        super().__init__(option_strings, dest, nargs="?", help=argparse.SUPPRESS, **kwargs)
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        example = f"{values}" if option_string == "--range" and values and "=" in values else self.example
+        parser.error(f"{option_string} was removed; allowed: --axis {RANGE_METAVAR} (NUM values from START to "
+                     f"STOP, log spaced with :log) or --axis NAME=V1,V2,..., e.g. --axis {example}")
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = _Parser(prog="phaseimpact", description="Impact models analysed as dynamical systems: one impact, "
                                                      "the critical damping and the other transitions, sweeps, "
@@ -1603,6 +1621,8 @@ def build_parser() -> argparse.ArgumentParser:
         target(p)
         axis_option(p, "the sweep's values" if name == "sweep" else "one axis of the grid (repeat for each)",
                     repeat=True)
+        for removed in ("--kappa-min", "--kappa-max", "--num", "--range"):
+            p.add_argument(removed, action=_Removed)
         p.add_argument("--refine", default=None, metavar="AXIS",
                        help="after the grid, locate every class boundary between neighbours along AXIS (one of the "
                             "--axis names) by bisection, to --refine-rtol, and store the boundary points in the "
@@ -1627,6 +1647,8 @@ def build_parser() -> argparse.ArgumentParser:
     curve_params = ", ".join([*CURVE_PARAMETERS, *(n for n in QUANTITIES if n not in CURVE_PARAMETERS)])
     axis_option(p, "the parameter the curve runs over and its values, increasing, in its SI unit (e.g. "
                 "v=0.5:10:20:log)", names=curve_params, limit=MAX_CURVE_POINTS)
+    for removed in ("--param", "--values"):
+        p.add_argument(removed, action=_Removed, example="v=0.5:10:20:log")
     p.add_argument("--what", choices=CURVE_WHATS, default="kappa_c",
                    help="what is continued: kappa_c or kappa_2 (law paper), or grazing (a unilateral law: the first "
                         "grazing value in [KAPPA_MIN, KAPPA_MAX] at the first value) (default: %(default)s)")
@@ -1798,6 +1820,30 @@ def _train_work(args, kind: str, axes: dict | None = None, **settings) -> _Train
     return _TrainWork(kind, axes or {}, math.nan if over_t else args.period, {"rtol": args.rtol, **settings})
 
 
+def _cell(value, width: int, spec: str = ".6g") -> str:
+    """A number of a text table, right-aligned; NaN or inf (no separation, a failed run) as 'undefined'."""
+    return f"{value:{width}{spec}}" if math.isfinite(value) else f"{'undefined':>{width}}"
+
+
+def _plate_period_text(params) -> str:
+    period = params.target_period
+    return f"plate period {period:.6g} s" if math.isfinite(period) else f"no plate period: a {params.target} target"
+
+
+def _check_train_period(name: str, period: float, params) -> None:
+    """A period between arrivals (``--period``, or an end of ``--axis T``), checked before any work: one the
+    map can resolve, and a warning when projectiles would arrive while the last is still in contact."""
+    from .integrate import scales
+    from .train import _check_period
+
+    _check_period(period, params, name)
+    contact_time = scales(params).contact_time
+    if period < contact_time:
+        print(f"phaseimpact: warning: {name} = {period:g} s is shorter than the contact time {contact_time:.3g} s "
+              "(Hertz): each projectile arrives while the last is still in contact, whose restitution is then "
+              "undefined", file=sys.stderr)
+
+
 def _check_archive_target(args, setup: Setup, work: _TrainWork) -> None:
     """``--archive`` follows ``--out``'s rule (:func:`phaseimpact.archive.check_overwrite`): a file holding
     other work is replaced only with ``--force``. Checked before any work, and again under the lock."""
@@ -1828,6 +1874,7 @@ def cmd_train(args) -> int:
     work = _train_work(args, "impact-train", period=args.period, impacts=args.impacts)
     _check_archive_target(args, setup, work)
     p, law = setup.params, setup.law
+    _check_train_period("period", args.period, p)
     _note(f"{args.impacts} impacts of {law.label()}, one every {args.period:g} s")
     train = impact_train(p, law, args.period, args.impacts, rtol=args.rtol)
     _save_train_archive(args, setup, train, work)
@@ -1839,19 +1886,22 @@ def cmd_train(args) -> int:
         _print_json(args, out)
     else:
         print(f"{law.label()} on a {p.target} target ({setup.case.name}), v = {p.v:g} m/s, one impact every "
-              f"{args.period:g} s (plate period {out['plate_period']:.6g} s)")
+              f"{args.period:g} s ({_plate_period_text(p)})")
         print(f"  {'n':>5} {'x2 before (m)':>14} {'x2dot (m/s)':>12} {'amplitude (m)':>14} {'peak force (N)':>14} "
               f"{'dissipated (J)':>14} {'restitution':>11}")
         for n in range(args.impacts):
-            print(f"  {n:5d} {train.plate[n, 0]:14.6g} {train.plate[n, 1]:12.6g} {train.amplitude[n]:14.6g} "
-                  f"{train.peak_force[n]:14.6g} {train.dissipated_energy[n]:14.6g} {train.restitution[n]:11.6g}")
+            print(f"  {n:5d} {_cell(train.plate[n, 0], 14)} {_cell(train.plate[n, 1], 12)} "
+                  f"{_cell(train.amplitude[n], 14)} {_cell(train.peak_force[n], 14)} "
+                  f"{_cell(train.dissipated_energy[n], 14)} {_cell(train.restitution[n], 11)}")
         if train.overlap.any():
             print(f"  note: {int(train.overlap.sum())} projectile(s) still in contact when the next one arrived")
         if orbit is not None:
-            print(f"  period-1 orbit: x2 = {orbit.plate[0]:.9g} m, x2dot = {orbit.plate[1]:.9g} m/s before each "
-                  f"impact; multipliers {_multiplier_text(orbit.multipliers)} "
-                  f"({'stable' if orbit.stable else 'unstable'})"
-                  + ("" if orbit.converged else f"; {orbit.message}"))
+            if orbit.converged:
+                print(f"  period-1 orbit: x2 = {orbit.plate[0]:.9g} m, x2dot = {orbit.plate[1]:.9g} m/s before each "
+                      f"impact; multipliers {_multiplier_text(orbit.multipliers)} "
+                      f"({'stable' if orbit.stable else 'unstable'})")
+            else:
+                print(f"  period-1 orbit: not found; {' '.join(orbit.message.split())}")  # SciPy wraps its lines
     if failed:
         print(f"phaseimpact: {len(failed)} run(s) of the train failed ({failed[0]})", file=sys.stderr)
         return EXIT_FAILURE
@@ -1866,6 +1916,9 @@ def cmd_orbit_diagram(args) -> int:
 
     if args.out is not None:
         _check_figure_target(args.out, args.force)
+    if args.transients + args.samples > MAX_TRAIN_IMPACTS:
+        raise ValueError(f"transients + samples = {args.transients} + {args.samples} is out of range; allowed: "
+                         f"--transients + --samples <= {MAX_TRAIN_IMPACTS} (the impacts of each value's train)")
     setup = _setup(args)
     param, values = _train_axis(args, setup)
     work = _train_work(args, "orbit-diagram", {param: values}, period=args.period, transients=args.transients,
@@ -1909,6 +1962,9 @@ def _train_axis(args, setup: Setup):
         raise ValueError(f"axis {param!r} has {len(values)} values; allowed: at most {MAX_CURVE_POINTS}")
     if param != "T" and args.period is None:
         raise ValueError(f"period = None is out of range for axis {param}; allowed: --period T (s) > 0")
+    if param == "T" and args.period is not None:
+        raise ValueError(f"period = {args.period:g} s contradicts --axis T, which gives the period of each value; "
+                         "allowed: --period with an axis kappa or v only")
     if param == "kappa":
         _check_reads_kappa(setup.law, f"{args.command} value")
     low, high = float(np.min(values)), float(np.max(values))
@@ -1919,11 +1975,31 @@ def _train_axis(args, setup: Setup):
             _check_in_range("kappa", x, 0.0, KAPPA_MAX, KAPPA_UNIT, "axis kappa")
         elif x <= 0:
             raise ValueError(f"T = {x!r} is out of range; allowed: T > 0 (s)")
+    if param == "kappa":
+        _check_train_period("period", args.period, setup.params)
+    elif param == "v":  # the contact time is v's: the longest at the lowest v (the one warning)
+        from .train import _check_period
+
+        _check_period(args.period, setup.params.replace(v=high), "period")
+        _check_train_period("period", args.period, setup.params.replace(v=low))
+    elif param == "T":
+        for x in sorted({low, high}):
+            _check_train_period("T", x, setup.params)
     return param, values
 
 
 def _multiplier_text(multipliers) -> str:
     return ", ".join(f"{m.real:.6g}{m.imag:+.3g}i" for m in multipliers)
+
+
+def _located(point, branch_values) -> bool:
+    """False for a bifurcation whose bracket is still the whole step between two points of the branch
+    (the corrector failed at the first bisection): where it lies in that step is unknown."""
+    import numpy as np
+
+    steps = np.abs(np.diff(np.asarray(branch_values, dtype=float)))
+    at = np.flatnonzero(np.asarray(branch_values[:-1], dtype=float) == point.value)
+    return not any(point.bracket >= steps[i] * (1 - 1e-9) for i in at)
 
 
 def cmd_map_continuation(args) -> int:
@@ -1948,8 +2024,11 @@ def cmd_map_continuation(args) -> int:
                                 step=step, max_points=args.max_points,
                                 xtol=args.xtol, rtol=args.rtol)
     _save_train_archive(args, setup, branch, work)
+    located = [_located(point, branch.values) for point in branch.points]
     out = {**_case_fields(setup), "plate_period": scales(p).plate_period, "period": args.period, "param": param,
            "from": start, "to": stop, "num": len(values), **branch.as_dict(), "case": setup.case.as_dict()}
+    for point, is_located in zip(out["points"], located, strict=True):
+        point["located"] = is_located
     if args.json:
         _print_json(args, out)
     else:
@@ -1958,7 +2037,12 @@ def cmd_map_continuation(args) -> int:
               f"{int(branch.stable.sum())} stable; {branch.message}")
         if not branch.points:
             print("  no bifurcation located")
-        for point in branch.points:
+        for point, is_located in zip(branch.points, located, strict=True):
+            if not is_located:
+                print(f"  {point.kind:16s} not located: between {param} = {point.value:.12g} and the next point of "
+                      f"the branch (bracket {point.bracket:.2g}, the whole step: the bisection did not narrow it; "
+                      "a smaller step (a larger NUM) may locate it)")
+                continue
             print(f"  {point.kind:16s} {param} = {point.value:.12g} (bracket {point.bracket:.2g}); "
                   f"x2 = {point.plate[0]:.6g} m, x2dot = {point.plate[1]:.6g} m/s; multipliers "
                   f"{_multiplier_text(point.multipliers)}"
@@ -1981,11 +2065,22 @@ def cmd_basins(args) -> int:
         _check_figure_target(args.out, args.force)
     setup = _setup(args)
     p, law = setup.params, setup.law
+    _check_train_period("period", args.period, p)
     omega = math.sqrt(p.Kb / p.M2) if p.target == "plate" and p.Kb > 0 else None
     if args.x2_max is None and omega is None:
         raise ValueError(f"x2-max = None is out of range for a {p.target} target without springs; allowed: "
                          "--x2-max X (m) > 0")
-    x2_max = args.x2_max if args.x2_max is not None else 1.5 * p.v / omega
+    # the grid's scales: the plate's swing at speed v (the indentation without springs) and v; far
+    # beyond them the states overflow the integrator (1e308 made NaN of the grid itself)
+    swing = 1.5 * p.v / omega if omega is not None else p.hertz_indentation
+    for name, given, scale, unit, what in (("x2-max", args.x2_max, swing, "m", "the plate's swing at speed v"
+                                            if omega is not None else "the Hertz indentation"),
+                                           ("x2dot-max", args.x2dot_max, 1.5 * p.v, "m/s", "1.5 v")):
+        if given is not None and given > MAX_BASIN_SCALES * scale:
+            raise ValueError(f"{name} = {given:g} {unit} is out of range; allowed: 0 < {name} <= "
+                             f"{MAX_BASIN_SCALES * scale:.3g} {unit} ({MAX_BASIN_SCALES:g} times {what}, "
+                             f"{scale:.3g} {unit})")
+    x2_max = args.x2_max if args.x2_max is not None else swing
     x2dot_max = args.x2dot_max if args.x2dot_max is not None else 1.5 * p.v
     xs, vs = np.linspace(-x2_max, x2_max, args.grid), np.linspace(-x2dot_max, x2dot_max, args.grid)
     work = _train_work(args, "basins", period=args.period, iterations=args.iterations, max_period=args.max_period,

@@ -31,7 +31,8 @@ from .parameters import Parameters, is_number
 __all__ = ["ImpactTrain", "MapFixedPoint", "OrbitDiagram", "impact_map", "impact_train", "map_fixed_point",
            "map_jacobian", "orbit_diagram", "lyapunov_exponent", "TRAIN_PARAMETERS", "MapBifurcation", "MapBranch",
            "BifurcationCurve", "Attractor", "Basins", "continue_map_orbit", "continue_map_bifurcation", "basins",
-           "BIFURCATION_KINDS", "NOT_CONVERGED", "NO_MAP", "ATTRACTOR_MATCH"]
+           "BIFURCATION_KINDS", "NOT_CONVERGED", "NO_MAP", "ATTRACTOR_MATCH", "period_range",
+           "MAX_PERIOD_SWINGS"]
 
 #: Parameters an orbit diagram runs over (the period ``T``, s; the damping ``kappa``; the speed ``v``, m/s).
 TRAIN_PARAMETERS = ("T", "kappa", "v")
@@ -40,9 +41,52 @@ TRAIN_PARAMETERS = ("T", "kappa", "v")
 JACOBIAN_STEP = 1e-6
 
 
-def _check_period(period, params: Parameters) -> float:
+#: Longest period between arrivals, in plate periods (contact times without the plate's springs):
+#: beyond it the phase of the plate's swing at the next arrival is lost to rounding.
+MAX_PERIOD_SWINGS = 1e6
+
+
+def period_range(params: Parameters) -> tuple[float, float, str]:
+    """The periods between arrivals the impact map can resolve for ``params``.
+
+    Parameters
+    ----------
+    params : Parameters
+        The case: its contact time (Hertz, at its ``v``) and its plate period.
+
+    Returns
+    -------
+    (float, float, str)
+        The shortest and the longest period (s), and why, in words for a message: from
+        ``MIN_HORIZON_CONTACT_TIMES`` contact times to :data:`MAX_PERIOD_SWINGS` plate periods
+        (contact times on a rigid or free target).
+
+    Examples
+    --------
+    >>> from phaseimpact import seed_parameters
+    >>> shortest, longest, _ = period_range(seed_parameters(v=1.0))
+    >>> print(f"{shortest:.3g} s to {longest:.4g} s")
+    1.08e-17 s to 1004 s
+    """
+    from .integrate import scales
+    from .integrate.api import MIN_HORIZON_CONTACT_TIMES
+
+    contact_time = scales(params).contact_time
+    swing = params.target_period if math.isfinite(params.target_period) else contact_time
+    swing_name = "plate periods" if math.isfinite(params.target_period) else "contact times"
+    why = (f"from {MIN_HORIZON_CONTACT_TIMES:g} of the contact time {contact_time:.3g} s, below which nothing can be "
+           f"resolved, to {MAX_PERIOD_SWINGS:g} {swing_name} ({swing:.3g} s), beyond which the plate's state at the "
+           "next arrival is lost to rounding")
+    return MIN_HORIZON_CONTACT_TIMES * contact_time, MAX_PERIOD_SWINGS * swing, why
+
+
+def _check_period(period, params: Parameters, name: str = "period") -> float:
     if not (is_number(period) and math.isfinite(period) and period > 0):
-        raise ValueError(f"period = {period!r} is out of range; allowed: a finite number > 0 (s)")
+        raise ValueError(f"{name} = {period!r} is out of range; allowed: a finite number > 0 (s)")
+    shortest, longest, why = period_range(params)
+    if not shortest <= period <= longest:
+        raise ValueError(f"{name} = {period!r} is out of range; allowed: {shortest:.3g} <= {name} <= {longest:.3g} s "
+                         f"({why})")
     return float(period)
 
 
@@ -498,6 +542,9 @@ def orbit_diagram(params: Parameters, law, param: str, values, *, period: float 
         raise ValueError("values must be a non-empty 1-d sequence of finite numbers")
     if param != "T":
         period = _check_period(period, params)
+    else:
+        for value in (values.min(), values.max()):
+            _check_period(float(value), params, "T")
     for name, n in (("transients", transients), ("samples", samples)):
         if not (isinstance(n, (int, np.integer)) and 0 <= n <= 100_000 and (name == "transients" or n >= 1)):
             raise ValueError(f"{name} = {n!r} is out of range; allowed: an integer, "
@@ -810,6 +857,8 @@ def _check_param_value(params, param, value, name):
     if param == "T" and value <= 0 or param == "v" and value <= 0 or param == "kappa" and value < 0:
         raise ValueError(f"{name} = {value!r} is out of range; allowed: {param} "
                          f"{'>= 0' if param == 'kappa' else '> 0'}")
+    if param == "T":
+        _check_period(value, params, name)
 
 
 def continue_map_orbit(params: Parameters, law, param: str, start: float, stop: float, *,

@@ -4,14 +4,20 @@ Full runs write into ``figures/`` (committed); ``--quick`` previews go to ``figu
 (git-ignored), so a preview never replaces a committed figure, archive or table. Each figure is
 written for print (PNG and a PDF beside it, checked for legibility: ``phaseimpact.plotting.for_print``).
 Time stamps in the files come from ``SOURCE_DATE_EPOCH`` (the last commit's time when unset and in
-a git checkout), so regenerating unchanged results leaves ``git status`` clean.
+a git checkout), and a regenerated file replaces the one there only when it differs beyond the
+tolerance of :mod:`_settle`, so regenerating unchanged results leaves ``git status`` clean, also on
+another machine whose libraries change the last bits.
 """
 
 import argparse
 import os
+import shutil
 import subprocess
+import tempfile
 import time
 from pathlib import Path
+
+from _settle import settle
 
 from phaseimpact.plotting import for_print
 
@@ -26,22 +32,48 @@ def output_folder(quick: bool) -> Path:
     return PREVIEW if quick else FIGURES
 
 
-def redirect(namespace: dict, quick: bool) -> None:
-    """Point a study's output folder (its ``FIGURES`` or ``ROOT`` global) at the preview folder."""
-    if not quick:
-        return
+def redirect(namespace: dict, folder: Path) -> None:
+    """Point a study's output folder (its ``FIGURES`` or ``ROOT`` global) at ``folder``."""
     for name in OUTPUT_NAMES:
         if name in namespace:
-            namespace[name] = PREVIEW
+            namespace[name] = folder
+
+
+def run_study(main, namespace: dict, quick: bool, jobs: int) -> tuple[Path, list[str]]:
+    """Run a study's ``main`` into a staging folder, then move into the output folder only the files that
+    differ from those there beyond the tolerance of :mod:`_settle` (README.md, "Reproducing").
+
+    Returns the file ``main`` names, in the output folder, and the files replaced (relative to it).
+    """
+    folder = output_folder(quick)
+    PREVIEW.mkdir(parents=True, exist_ok=True)  # git-ignored, so an interrupted run leaves git clean
+    staging = Path(tempfile.mkdtemp(prefix=".staging-", dir=PREVIEW))
+    try:
+        redirect(namespace, staging)
+        with for_print():
+            out = Path(main(quick=quick, jobs=jobs))
+        changed = settle(staging, folder)
+    finally:
+        shutil.rmtree(staging, ignore_errors=True)
+    return (folder / out.relative_to(staging) if out.is_relative_to(staging) else out), changed
+
+
+def report(changed: list[str]) -> str:
+    """What :func:`run_study` replaced, in words."""
+    if not changed:
+        return "no file changed beyond the tolerance"
+    return f"{len(changed)} file(s) changed beyond the tolerance: " + ", ".join(changed)
 
 
 def set_source_date_epoch() -> None:
-    """Use the last commit's time for time stamps in archives unless ``SOURCE_DATE_EPOCH`` is set."""
-    if os.environ.get("SOURCE_DATE_EPOCH"):
+    """Use the time of the last commit of the code (``phaseimpact/``, ``studies/``) for time stamps in
+    archives unless ``SOURCE_DATE_EPOCH`` is set; outside a git checkout leave it unset (an empty value
+    means unset: phaseimpact removes it on import)."""
+    if os.environ.get("SOURCE_DATE_EPOCH", "").strip():
         return
     try:
-        stamp = subprocess.run(["git", "log", "-1", "--format=%ct"], cwd=ROOT, capture_output=True, text=True,
-                               timeout=30).stdout.strip()
+        stamp = subprocess.run(["git", "log", "-1", "--format=%ct", "--", "phaseimpact", "studies"], cwd=ROOT,
+                               capture_output=True, text=True, timeout=30).stdout.strip()
     except (OSError, subprocess.SubprocessError):
         return
     if stamp.isdigit():
@@ -71,8 +103,6 @@ def parser(doc: str, default_jobs: int = 1) -> argparse.ArgumentParser:
 def run(main, doc: str) -> None:
     args = parser(doc).parse_args()
     set_source_date_epoch()
-    redirect(main.__globals__, args.quick)
     start = time.perf_counter()
-    with for_print():
-        out = main(quick=args.quick, jobs=args.jobs)
-    print(out, f"({time.perf_counter() - start:.1f} s)")
+    out, changed = run_study(main, main.__globals__, args.quick, args.jobs)
+    print(out, f"({time.perf_counter() - start:.1f} s): {report(changed)}")

@@ -1,6 +1,8 @@
 """Run every study: regenerate all figures, data archives and the claims table (``make reproduce``).
 
-Full runs write into ``figures/``; ``--quick`` previews into ``figures/preview/`` (git-ignored).
+Full runs write into ``figures/``; ``--quick`` previews into ``figures/preview/`` (git-ignored). A
+regenerated file replaces the one there only when it differs beyond the tolerance of ``_settle.py``
+(stated in README.md): each study's line, and the last, name the files that did.
 """
 
 import importlib.util
@@ -49,16 +51,17 @@ def main() -> int:
     folder = _cli.output_folder(args.quick)
     print(f"writing {'previews' if args.quick else 'figures'} to {folder.relative_to(HERE.parent)}/", flush=True)
     start = time.perf_counter()
+    replaced = []
     bar = tqdm(STUDIES, desc="studies", unit="study", disable=not sys.stderr.isatty())  # no bar in a log
     for name in bar:
         bar.set_postfix_str(name)
         t0 = time.perf_counter()
         module = load(name)
-        _cli.redirect(vars(module), args.quick)
-        with _cli.for_print():
-            out = module.main(quick=args.quick, jobs=args.jobs)
-        tqdm.write(f"{name:32s} {time.perf_counter() - t0:6.1f} s  -> {Path(out).relative_to(HERE.parent)}")
-    print(f"all studies done in {time.perf_counter() - start:.1f} s")
+        out, changed = _cli.run_study(module.main, vars(module), args.quick, args.jobs)
+        replaced.extend(changed)
+        tqdm.write(f"{name:32s} {time.perf_counter() - t0:6.1f} s  -> {out.relative_to(HERE.parent)}: "
+                   f"{_cli.report(changed)}")
+    print(f"all studies done in {time.perf_counter() - start:.1f} s; {_cli.report(replaced)}")
     return 0
 
 

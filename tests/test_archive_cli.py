@@ -439,19 +439,19 @@ def test_portrait_writes_svg_and_refuses_other_formats_before_computing(tmp_path
     assert exit_.value.code == 2
 
 
-def test_quick_previews_go_to_the_preview_folder():
+def test_quick_previews_go_to_the_preview_folder(monkeypatch):
+    monkeypatch.syspath_prepend(os.path.join(os.path.dirname(__file__), "..", "studies"))  # _cli imports _settle
     spec = importlib.util.spec_from_file_location("studies_cli", os.path.join(os.path.dirname(__file__), "..",
                                                                              "studies", "_cli.py"))
     study_cli = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(study_cli)
     figures = study_cli.FIGURES
+    assert study_cli.output_folder(False) == figures and study_cli.output_folder(True) == figures / "preview"
     study = {"FIGURES": figures, "NAME": "x"}
-    study_cli.redirect(study, quick=False)
-    assert study["FIGURES"] == figures
-    study_cli.redirect(study, quick=True)
-    assert study["FIGURES"] == figures / "preview" and study_cli.output_folder(True) == figures / "preview"
+    study_cli.redirect(study, figures / "preview")
+    assert study["FIGURES"] == figures / "preview"
     other = {"ROOT": figures}
-    study_cli.redirect(other, quick=True)
+    study_cli.redirect(other, figures / "preview")
     assert other["ROOT"] == figures / "preview"
     ignored = subprocess.run(["git", "check-ignore", "-q", "figures/preview/x.png"],
                              cwd=study_cli.ROOT)

@@ -20,7 +20,7 @@ from hypothesis import strategies as st
 
 import phaseimpact.continuation as continuation
 import phaseimpact.integrate as integrate
-from phaseimpact.cli import build_parser, main
+from phaseimpact.cli import RANGE_METAVAR, build_parser, main
 
 CLI = [sys.executable, "-m", "phaseimpact.cli"]
 SWEEP = ["sweep", "--law", "paper", "--v", "1", "--axis", "kappa=1e9:1e12:20:log",
@@ -140,6 +140,16 @@ BAD = [
     (["atlas", "--axis", "plate.yield_strength=1e7:1e9:3", "--axis", "v=1,2", "--out", "a.h5"],
      "plate.yield_strength"),
     (["atlas", "--axis", "kappa=1e9,1e9", "--axis", "v=1,2", "--out", "a.h5"], "distinct values"),
+    # issue 37: old spellings point at --axis; NUM named; a yield strength out of its range under thornton
+    (["sweep", "--kappa-min", "1e9", "--kappa-max", "1e14", "--out", "a.h5"], "--kappa-min was removed"),
+    (["sweep", "--axis", "kappa=1e9:1e14:5:log", "--num", "5", "--out", "a.h5"], "--num was removed"),
+    (["atlas", "--range", "kappa=1e9:1e14:5", "--out", "a.h5"], "--range was removed"),
+    (["critical-curve", "--param", "v", "--values", "1,2", "--out", "a.h5"], "--param was removed"),
+    (["sweep", "--axis", "kappa=1e9:1e14:nan", "--out", "a.h5"], "NUM = 'nan'"),
+    (["sweep", "--case", "sand-gelcoat", "--law", "thornton", "--axis", "plate.yield_strength=1:1e9:5:log",
+      "--out", "a.h5"], "yield_strength = 1.0"),
+    (["sweep", "--case", "sand-gelcoat", "--law", "hunt-crossley", "--axis", "plate.yield_strength=1e7:1e9:3:log",
+      "--out", "a.h5"], "plate.yield_strength"),
 ]
 
 
@@ -214,8 +224,8 @@ def test_every_option_has_help_with_default_and_the_two_tolerances_are_named_apa
     subparsers = next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction))
     for name, sub in subparsers.choices.items():
         for action in sub._actions:
-            if isinstance(action, argparse._HelpAction):
-                continue
+            if isinstance(action, argparse._HelpAction) or action.help == argparse.SUPPRESS:
+                continue  # hidden: removed options, refused with their replacement
             assert action.help, (name, action.option_strings)
             takes_value = action.nargs != 0
             if takes_value and not action.required:
@@ -396,7 +406,7 @@ def test_thickness_is_not_judged_without_the_plate_s_springs():
     assert code == 0 and json.loads(out)["validity"] == "ok"
 
 
-@pytest.mark.parametrize("epoch", ["abc", "1e20", "99999999999999999"])
+@pytest.mark.parametrize("epoch", ["abc", "-5", "1e20", "99999999999999999"])
 def test_bad_source_date_epoch_refused_before_numpy_reads_it(epoch, tmp_path):
     """NumPy's f2py crashed at import on these, before the project's own check could run."""
     result = subprocess.run([*CLI, *SWEEP, "--out", "s.h5"], capture_output=True, text=True, cwd=tmp_path,
@@ -407,6 +417,32 @@ def test_bad_source_date_epoch_refused_before_numpy_reads_it(epoch, tmp_path):
         "since 1970-01-01 UTC, 0 <= SOURCE_DATE_EPOCH <= 253402300799 (the year 9999), as 'date +%s' prints it, "
         "or unset"]
     assert not (tmp_path / "s.h5").exists()
+
+
+def test_empty_source_date_epoch_means_unset(tmp_path):
+    """What `VAR=$(git log ...)` leaves outside a git checkout: NumPy's f2py crashed at import on it (every
+    computing command, and `import phaseimpact.continuation`); empty means unset."""
+    env = {**os.environ, "SOURCE_DATE_EPOCH": ""}
+    result = subprocess.run([*CLI, *SWEEP, "--out", "s.h5"], capture_output=True,
+                            text=True, cwd=tmp_path, timeout=300, env=env)
+    assert result.returncode == 0, result.stderr
+    assert (tmp_path / "s.h5").exists()
+    api = subprocess.run([sys.executable, "-c", "import phaseimpact.continuation, os; "
+                          "print(os.environ.get('SOURCE_DATE_EPOCH', 'unset'))"],
+                         capture_output=True, text=True, timeout=120, env=env)
+    assert api.returncode == 0 and api.stdout.strip() == "unset", api.stderr
+
+
+@pytest.mark.parametrize("threads", ["0", "abc", "-2"])
+def test_bad_numba_num_threads_named(threads, tmp_path):
+    """numba said 'Number of threads specified must be > 0.' (0) or printed a warning with a traceback
+    and ran on (abc), without naming the variable."""
+    result = subprocess.run([*CLI, "simulate", "--t-end", "1e-4"], capture_output=True, text=True, cwd=tmp_path,
+                            timeout=120, env={**os.environ, "NUMBA_NUM_THREADS": threads})
+    assert result.returncode == 2
+    lines = result.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith(
+        f"phaseimpact: error: NUMBA_NUM_THREADS = {threads!r} is out of range; allowed: an integer >= 1"), lines
 
 
 def test_bad_compile_processes_refused(monkeypatch, no_work):
@@ -514,3 +550,95 @@ def test_plot_of_an_unreadable_file_says_permission_denied(tmp_path, monkeypatch
         monkeypatch.setattr(archive.os, "open", denied)
     code, _, err = run(["plot", str(path), "--out", str(tmp_path / "p.png")])
     assert code == 2 and err.strip() == f"phaseimpact: error: archive {str(path)!r} cannot be read: Permission denied"
+
+
+def test_old_range_options_show_the_axis_that_replaces_them(no_work):
+    code, _, err = run(["atlas", "--range", "kappa=1e9:1e14:5", "--out", "a.h5"])
+    assert code == 2 and "e.g. --axis kappa=1e9:1e14:5" in err and RANGE_METAVAR in err
+    code, _, err = run(["critical-curve", "--param", "v", "--values", "1,2", "--out", "a.h5"])
+    assert code == 2 and "--axis NAME=V1,V2" in err
+
+
+def test_case_file_with_a_byte_order_mark_is_read(tmp_path):
+    """Windows editors write a UTF-8 BOM; tomllib called it 'Invalid statement (at line 1, column 1)'."""
+    text = (Path(__file__).resolve().parents[1] / "phaseimpact" / "cases" / "seed.toml").read_text(encoding="utf-8")
+    (tmp_path / "bom.toml").write_bytes(b"\xef\xbb\xbf" + text.encode("utf-8"))
+    (tmp_path / "plain.toml").write_text(text, encoding="utf-8")
+    with_bom = run(["params", "--case", str(tmp_path / "bom.toml"), "--json"])
+    plain = run(["params", "--case", str(tmp_path / "plain.toml"), "--json"])
+    assert with_bom[0] == 0, with_bom[2]
+    assert json.loads(with_bom[1]) == json.loads(plain[1])
+
+
+def test_resume_refusal_shows_the_spacing_of_both_axes(tmp_path):
+    """The stored log axis and an asked linear one have the same ends and NUM: only the spacing differs."""
+    out = str(tmp_path / "s.h5")
+    base = ["sweep", "--law", "paper", "--v", "1", "--t-end", "2e-4", "--no-progress", "--out", out]
+    assert run([*base, "--axis", "kappa=1e9:1e12:3:log"])[0] == 0
+    code, _, err = run([*base, "--axis", "kappa=1e9:1e12:3", "--resume"])
+    assert code == 2
+    assert "1000000000.0 to 1000000000000.0, log spaced (asked kappa: 3 values from 1000000000.0 to " \
+           "1000000000000.0, linear)" in err, err
+
+
+def test_thornton_sweeps_the_yield_strength_it_reads(tmp_path):
+    """Under thornton the yield strength sets p_y = 1.6 Y: an axis of it was refused as 'not read by the
+    equations of motion'. The peak force falls as the yield strength falls (the pressure is capped lower)."""
+    from phaseimpact import archive
+
+    out = tmp_path / "y.h5"
+    code, _, err = run(["sweep", "--case", "sand-gelcoat", "--law", "thornton", "--axis",
+                        "plate.yield_strength=1e6:1e9:3:log", "--no-progress", "--out", str(out)])
+    assert code == 0, err
+    force = archive.load(out).max_force
+    assert force[0] < force[1] < force[2], force
+
+
+@pytest.mark.parametrize("command", [["simulate", "--law", "thornton"], ["params"]])
+def test_yield_strength_above_young_s_modulus_gets_a_verdict(command):
+    code, out, _ = run([*command, "--set", "plate.yield_strength=5e11", "--json"])
+    assert code == 0
+    assert "yield strength 5e+11 Pa of the target exceeds its Young's modulus E = 2.1e+11 Pa" in \
+        json.loads(out)["validity"]
+    _, out, _ = run([*command, "--set", "plate.yield_strength=2e11", "--json"])
+    assert "Young's modulus" not in json.loads(out)["validity"]
+
+
+HC_TRAIN = ["--law", "hunt-crossley", "--kappa", "3e9"]
+OD = ["orbit-diagram", *HC_TRAIN, "--transients", "5", "--samples", "3"]
+BASINS = ["basins", *HC_TRAIN, "--grid", "3", "--iterations", "20"]
+
+
+@pytest.mark.parametrize("args, message", [
+    # issue 37: the user's option is named, not the engine's t_end, initial state or grid arrays
+    (["train", *HC_TRAIN, "--impacts", "2", "--period", "1e-308"], "period = 1e-308 is out of range"),
+    (["train", *HC_TRAIN, "--impacts", "2", "--period", "1e308"], "period = 1e+308 is out of range"),
+    ([*OD, "--axis", "T=1e308,1e308"], "T = 1e+308 is out of range"),
+    ([*OD, "--axis", "T=1e-308,2e-308"], "T = 1e-308 is out of range"),
+    ([*OD, "--axis", "v=1:2:3", "--period", "1e-308"], "period = 1e-308 is out of range"),
+    ([*OD, "--axis", "v=1:2:3", "--period", "1e308"], "period = 1e+308 is out of range"),
+    ([*OD, "--axis", "T=1e-3:2e-3:3", "--period", "5e-3"], "period = 0.005 s contradicts --axis T"),
+    (["orbit-diagram", *HC_TRAIN, "--axis", "T=1e-3:2e-3:1000", "--transients", "100000", "--samples", "100000"],
+     "--transients + --samples <= 100000"),
+    (["map-continuation", *HC_TRAIN, "--axis", "T=1e-3:1e308:3"], "T = 1e+308 is out of range"),
+    (["map-continuation", *HC_TRAIN, "--axis", "v=1:2:3", "--period", "1e-308"], "period = 1e-308 is out of range"),
+    (["map-continuation", *HC_TRAIN, "--axis", "v=1:2:3", "--period", "1e308"], "period = 1e+308 is out of range"),
+    ([*BASINS, "--period", "1e-3", "--x2-max", "1e308"], "x2-max = 1e+308 m is out of range"),
+    ([*BASINS, "--period", "1e-3", "--x2dot-max", "1e308"], "x2dot-max = 1e+308 m/s is out of range"),
+    ([*BASINS, "--period", "1e308"], "period = 1e+308 is out of range"),
+    ([*BASINS, "--period", "1e-308"], "period = 1e-308 is out of range"),
+], ids=lambda value: " ".join(value) if isinstance(value, list) else None)
+def test_train_family_inputs_named_before_any_work(args, message, tmp_path, monkeypatch):
+    import phaseimpact.train as train_module
+
+    def forbidden(*args, **kwargs):
+        raise AssertionError("work started before the input was refused")
+
+    monkeypatch.setattr(train_module, "simulate", forbidden)
+    monkeypatch.chdir(tmp_path)
+    code, out, err = run(args)
+    lines = err.strip().splitlines()
+    assert code == 2 and len(lines) == 1 and "Traceback" not in err, err
+    assert message in lines[0] and ("allowed" in lines[0]), lines[0]
+    for internal in ("t_end", "initial", "x2_values", "x2dot_values", "impacts ="):
+        assert internal not in lines[0]

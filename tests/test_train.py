@@ -1,6 +1,7 @@
 """Trains of impacts as a map (phaseimpact.train): REFERENCE.md §7's impulsive limit, the energy
 balance of a periodic orbit, and fixed points against long iteration."""
 
+import json
 import math
 
 import numpy as np
@@ -254,3 +255,74 @@ def test_bad_continuation_and_basin_input_is_refused():
     assert code == 2 and "period" in err
     code, _, err = run(["basins", "--law", HC, "--period", "1e-3", "--grid", "0"])
     assert code == 2 and "grid = '0'" in err
+
+
+# ------------------------------------------------------------------------------------------------
+# Text output of the train commands: no nan or inf (issue 37)
+# ------------------------------------------------------------------------------------------------
+
+def _numbers_in(text):
+    return [w for line in text.splitlines() for w in line.split() if w.lower().strip(",;()") in ("nan", "inf")]
+
+
+def test_train_table_says_undefined_for_a_restitution_without_separation():
+    """paper sticks for good at kappa = 3e9: no separation, so no restitution (simulate says 'undefined')."""
+    code, out, _ = run(["train", "--law", "paper", "--kappa", "3e9", "--period", "3e-3", "--impacts", "2"])
+    assert code == 0 and not _numbers_in(out), out
+    rows = [line.split() for line in out.splitlines() if line.split() and line.split()[0] in ("0", "1")]
+    assert len(rows) == 2 and all(row[-1] == "undefined" for row in rows), out
+
+
+@pytest.mark.parametrize("target", ["rigid", "free"])
+def test_train_header_of_a_target_without_springs_has_no_plate_period(target):
+    code, out, _ = run(["train", "--law", HC, "--kappa", "3e9", "--period", "3e-3", "--impacts", "2",
+                        "--target", target])
+    assert code == 0 and not _numbers_in(out), out
+    assert f"(no plate period: a {target} target)" in out.splitlines()[0]
+
+
+def test_train_period_shorter_than_the_contact_time_is_warned_about():
+    code, out, err = run(["train", "--law", HC, "--kappa", "3e9", "--period", "1e-12", "--impacts", "2"])
+    assert code == 0 and not _numbers_in(out), out
+    assert err.strip().splitlines() == [
+        "phaseimpact: warning: period = 1e-12 s is shorter than the contact time 0.000108 s (Hertz): each projectile "
+        "arrives while the last is still in contact, whose restitution is then undefined"]
+    _, _, err = run(["train", "--law", HC, "--kappa", "3e9", "--period", "3e-3", "--impacts", "2"])
+    assert "warning" not in err
+
+
+def test_failed_runs_of_a_train_print_undefined(monkeypatch):
+    """A user law returning NaN failed every run: the table printed 'nan' in each column."""
+    import phaseimpact.train as train_module
+
+    def failed_train(params, law, period, impacts, **kwargs):
+        nan = np.full(impacts, np.nan)
+        return train_module.ImpactTrain(period, np.vstack([[0.0, 0.0], np.full((impacts, 2), np.nan)]), nan, nan,
+                                        nan, nan, np.zeros(impacts, int), np.append(0.0, nan),
+                                        np.zeros(impacts, bool), ["step-size-collapse"] * impacts)
+
+    monkeypatch.setattr(train_module, "impact_train", failed_train)
+    code, out, err = run(["train", "--law", HC, "--kappa", "3e9", "--period", "3e-3", "--impacts", "3"])
+    assert code == 1 and "3 run(s) of the train failed (step-size-collapse)" in err
+    assert not _numbers_in(out) and out.count("undefined") == 3 * 6 - 3, out  # row 0: the plate at rest
+
+
+def test_map_continuation_calls_an_unnarrowed_bracket_not_located():
+    """kappa from 0 to 1e18 in 3 values: the corrector fails at once, and the bifurcations' brackets are the
+    whole first step (5e16): they were printed as found 'at kappa = 0'."""
+    args = ["map-continuation", "--law", HC, "--kappa", "3e9", "--axis", "kappa=0:1e18:3", "--period", "1e-3"]
+    code, out, _ = run(args)
+    assert code == 0
+    lines = [line for line in out.splitlines()[1:] if line.strip()]
+    assert lines and all("not located: between kappa = 0 and the next point" in line for line in lines), out
+    code, out, _ = run([*args, "--json"])
+    points = json.loads(out)["points"]
+    assert points and not any(point["located"] for point in points)
+
+
+def test_map_continuation_located_points_stay_located():
+    code, out, _ = run(["map-continuation", "--law", HC, "--kappa", "3e9", "--axis", "T=0.99e-3:0.975e-3:4",
+                        "--json"])
+    points = json.loads(out)["points"]
+    assert code == 0 and points and all(point["located"] for point in points)
+    assert all(point["bracket"] < 1e-6 for point in points)

@@ -160,9 +160,11 @@ def parse_axis(text: str) -> Axis:
     except ValueError:
         raise ValueError(f"axis {name} = {spec!r} is out of range; allowed: START:STOP:NUM[:log] with numbers, "
                          "or V1,V2,...") from None
-    if not (math.isfinite(start) and math.isfinite(stop)) or num != int(num) or not 1 <= num <= MAX_POINTS:
-        raise ValueError(f"axis {name} = {spec!r} is out of range; allowed: finite START and STOP, "
-                         f"an integer 1 <= NUM <= {MAX_POINTS}")
+    if not (math.isfinite(num) and num == int(num) and 1 <= num <= MAX_POINTS):  # NaN has no int()
+        raise ValueError(f"axis {name} = {spec!r}: NUM = {parts[2]!r} is out of range; allowed: an integer "
+                         f"1 <= NUM <= {MAX_POINTS}")
+    if not (math.isfinite(start) and math.isfinite(stop)):
+        raise ValueError(f"axis {name} = {spec!r} is out of range; allowed: finite START and STOP")
     if log and not (start > 0 and stop > 0):
         raise ValueError(f"axis {name} = {spec!r} is out of range; allowed: START > 0 and STOP > 0 with :log")
     values = np.geomspace(start, stop, int(num)) if log else np.linspace(start, stop, int(num))
@@ -303,6 +305,8 @@ class Grid:
         names = ("kappa", "v", *[n for n in _NUMERIC_FIELDS if n not in ("kappa", "v")])
         if isinstance(self.base, Case):
             names += tuple(n for n in QUANTITIES if n not in names)
+            if self.law.entry.plastic:  # its limiting pressure is 1.6 Y of the weaker body
+                names += ("projectile.yield_strength", "plate.yield_strength")
         return names
 
     @property
