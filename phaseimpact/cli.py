@@ -715,7 +715,7 @@ def cmd_critical(args) -> int:
     _note(f"locating kappa_c and kappa_2 of {law.label()} at v = {params.v:g} m/s"
           + (" and measuring the exponents (about 1 s)" if args.exponents else ""))
     result = critical_damping(params, law, kappa_min=args.kappa_min, kappa_max=args.kappa_max,
-                              rtol=args.kappa_rtol, integrator_rtol=args.rtol, with_kappa_2=True,
+                              kappa_rtol=args.kappa_rtol, rtol=args.rtol, with_kappa_2=True,
                               with_exponents=args.exponents)
     out = {**_law_fields(setup), "v": result.v, "kappa_c": result.kappa_c,
            "kappa_c_accuracy": result.kappa_c_accuracy, "kappa_2": result.kappa_2,
@@ -780,8 +780,8 @@ def cmd_transitions(args) -> int:
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", SamplingWarning)
         try:
-            found = transitions(params, law, args.kappa_min, args.kappa_max, rtol=args.kappa_rtol,
-                                integrator_rtol=args.rtol, num=args.samples, progress=sys.stderr.isatty())
+            found = transitions(params, law, args.kappa_min, args.kappa_max, kappa_rtol=args.kappa_rtol,
+                                rtol=args.rtol, num=args.samples, progress=sys.stderr.isatty())
         except RunFailed as error:  # every input was checked: this is the search's own failure
             print(f"phaseimpact: the transition search failed: {error}", file=sys.stderr)
             return EXIT_FAILURE
@@ -1014,7 +1014,7 @@ def cmd_atlas(args) -> int:
 
         _note(f"refining the class boundaries along {args.refine}")
         try:
-            found = refine_boundaries(result, args.refine, rtol=args.refine_rtol, integrator_rtol=args.rtol)
+            found = refine_boundaries(result, args.refine, refine_rtol=args.refine_rtol, rtol=args.rtol)
         except KeyboardInterrupt as stop:
             print(f"phaseimpact: {_stopped(stop)} while refining; the atlas is saved in {args.out} without its "
                   f"boundaries; resume with: {_resume_command(args.argv)}", file=sys.stderr)
@@ -1130,8 +1130,8 @@ def cmd_critical_curve(args) -> int:
         if what == "grazing":
             first = setup.case.parameters(**{param: float(values[0])})
             _note(f"looking for the first grazing of {law.label()} at {param} = {values[0]:g}")
-            found = [t for t in transitions(first, law, args.kappa_min, args.kappa_max, rtol=args.kappa_rtol,
-                                            integrator_rtol=args.rtol, num=samples) if t.kind == "grazing"]
+            found = [t for t in transitions(first, law, args.kappa_min, args.kappa_max, kappa_rtol=args.kappa_rtol,
+                                            rtol=args.rtol, num=samples) if t.kind == "grazing"]
             if not found:
                 print(f"phaseimpact: the curve failed to start: no grazing value of {law.label()} for kappa in "
                       f"[{args.kappa_min:g}, {args.kappa_max:g}] at {param} = {values[0]:g} (with {samples} samples); "
@@ -1140,8 +1140,8 @@ def cmd_critical_curve(args) -> int:
             start, index = found[0].kappa, int(found[0].extremum)
         _note(f"continuing {what} of {law.label()} over {len(values)} values of {param}")
         try:
-            curve = critical_curve(setup.case, law, param, values, what=what, rtol=args.kappa_rtol,
-                                   integrator_rtol=args.rtol, contact_index=index, kappa_start=start,
+            curve = critical_curve(setup.case, law, param, values, what=what, kappa_rtol=args.kappa_rtol,
+                                   rtol=args.rtol, contact_index=index, kappa_start=start,
                                    progress=_progress(args))
         except RunFailed as error:  # every input was checked: this is the curve's own failure
             print(f"phaseimpact: the curve failed to start: {error}; nothing written", file=sys.stderr)
