@@ -500,10 +500,11 @@ def critical_damping(params: Parameters, law: ContactLaw | str = "paper", *, kap
     return _replace(result, search_range=(kappa_min, kappa_max))
 
 
-def check_rtol_of_kappa(kappa_rtol) -> float:
-    if not (is_number(kappa_rtol) and 1e-14 <= kappa_rtol <= 1e-2):
-        raise ValueError(f"kappa_rtol = {kappa_rtol!r} is out of range; allowed: 1e-14 <= kappa_rtol <= 1e-2")
-    return float(kappa_rtol)
+def check_rtol_of_kappa(value) -> float:
+    """``kappa_rtol`` as a float, or ValueError naming it and its range, 1e-14 to 1e-2."""
+    if not (is_number(value) and 1e-14 <= value <= 1e-2):
+        raise ValueError(f"kappa_rtol = {value!r} is out of range; allowed: 1e-14 <= kappa_rtol <= 1e-2")
+    return float(value)
 
 
 def default_kappa_range(params: Parameters, kappa_min=None, kappa_max=None,
