@@ -69,16 +69,17 @@ def fenced(page) -> list[Block]:
 
 
 def command_lines(code):
-    """The commands of a shell block, as argument lists (comments and blank lines dropped)."""
-    for line in code.splitlines():
+    """``(line, words)`` of each command of a shell block (continued lines joined; comments and blank
+    lines dropped)."""
+    for line in code.replace("\\\n", " ").splitlines():
         words = shlex.split(line, comments=True)
         if words:
-            yield words
+            yield line, words
 
 
 def commands(code):
     """The ``phaseimpact`` command lines of a shell block, as argument lists."""
-    for words in command_lines(code):
+    for _, words in command_lines(code):
         if words[0] == "phaseimpact":
             yield words[1:]
 
@@ -106,15 +107,15 @@ def run_page(page) -> int:
             continue
         if block.lang in PYTHON:
             exec(compile(block.code, where, "exec"), namespace)
-        for words in command_lines(block.code) if block.lang in SHELL else ():
-            print(f"$ {shlex.join(words)}", flush=True)
+        for line, words in command_lines(block.code) if block.lang in SHELL else ():
+            print(f"$ {line}", flush=True)
             if words[0] == "phaseimpact":
                 status = main(words[1:])
-            else:  # as a reader's shell runs it, with this Python first on the PATH
+            else:  # verbatim, as a reader's shell runs it, with this Python first on the PATH
                 path = os.pathsep.join((str(Path(sys.executable).parent), os.environ.get("PATH", "")))
-                status = subprocess.run(["bash", "-c", shlex.join(words)], env={**os.environ, "PATH": path}).returncode
+                status = subprocess.run(["bash", "-c", line], env={**os.environ, "PATH": path}).returncode
             if status != 0:
-                raise SystemExit(f"{where}: {shlex.join(words)} exited {status}")
+                raise SystemExit(f"{where}: {line.strip()} exited {status}")
         ran += 1
     return ran
 
@@ -139,13 +140,15 @@ def test_the_markers_are_counted(tmp_path, monkeypatch):
     """The marker is honoured: a marked block is not run, an unmarked one is, whatever its text."""
     page = tmp_path / "page.md"
     page.write_text("<!-- no-run: needs the internet -->\n```sh\npip install x\n```\n\n```python\nx = 1\n```\n"
-                    "\n- item\n\n  <!-- no-run: an output -->\n  ```python\n  1 / 0\n  ```\n", encoding="utf-8")
+                    "\n- item\n\n  <!-- no-run: an output -->\n  ```python\n  1 / 0\n  ```\n"
+                    "\n```sh\necho \"$((6 * 7))\" > answer.txt   # verbatim, through bash\n```\n", encoding="utf-8")
     blocks = fenced(page)
     assert [(b.lang, b.no_run, b.runs) for b in blocks] == [
-        ("sh", "needs the internet", False), ("python", None, True), ("python", "an output", False)]
-    assert counts(page) == (1, 2) and blocks[2].code == "1 / 0\n"
+        ("sh", "needs the internet", False), ("python", None, True), ("python", "an output", False),
+        ("sh", None, True)]
+    assert counts(page) == (2, 2) and blocks[2].code == "1 / 0\n"
     monkeypatch.chdir(tmp_path)
-    assert run_page(page) == 1
+    assert run_page(page) == 2 and (tmp_path / "answer.txt").read_text() == "42\n"
 
 
 def test_every_documented_command_parses(tmp_path, monkeypatch):
