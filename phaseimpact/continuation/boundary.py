@@ -38,7 +38,7 @@ class Boundaries:
     below, above : ndarray of int8, shape (n,)
         Outcome class codes on the low and high side along ``axis``.
     rtol : float
-        Relative width of each refined bracket.
+        Relative width of each refined bracket: the call's ``refine_rtol``.
 
     Examples
     --------

@@ -62,7 +62,8 @@ class CriticalCurve:
     base : Parameters or Case
         The case whose ``param`` was varied.
     rtol : float
-        Relative tolerance of each located value.
+        Relative tolerance of each located value: the call's ``kappa_rtol`` (the archive's ``rtol``
+        attribute of a curve).
     contact_index : int
         ``grazing``: which extremum of ``delta`` touches zero.
     message : str

@@ -318,7 +318,7 @@ class CriticalDamping:
     kappa_c : float or None
         Root of the first stick's margin, N s/m^(1+alpha); None when not found.
     rtol : float
-        Relative tolerance asked of ``kappa_c``.
+        Relative tolerance asked of ``kappa_c``: the call's ``kappa_rtol``.
     closed_form : float or None
         docs/physics.md §5's closed-form estimate.
     bracket : tuple of float
