@@ -22,7 +22,7 @@ test: $(STAMP)
 	$(BIN)/python -m pytest -q
 
 # The documentation site (mkdocs.yml, docs/) into site/; --strict: any warning fails the build
-# (make test builds it too, strict, in tests/test_docs.py, and runs every tutorial).
+# (make test builds it too, strict, in tests/test_docs.py, and runs every code block of its pages and the README).
 MKDOCS = NO_MKDOCS_2_WARNING=1 $(BIN)/python -m mkdocs build --strict
 docs: $(STAMP)
 	$(MKDOCS)

@@ -1,7 +1,7 @@
 """Transitions: ``kappa_c`` (and its pieces), ``kappa_2``, a ``kappa_c(v)`` curve and the grazing
 values, each against the brute-force way (a dense grid of runs and the count's changes on it).
 
-- ``critical_damping(seed_parameters(), "paper", rtol=1e-10)``: kappa_c to 1e-10 relative. Its
+- ``critical_damping(seed_parameters(), "paper", kappa_rtol=1e-10)``: kappa_c to 1e-10 relative. Its
   time is split by instrumenting the runs it makes: the margin root (runs to the first stick,
   Brent on the margin) and the two confirming runs at ``kappa_c (1 -+ 1e-3)`` (until settled).
   Brute force: ``simulate_many`` over N kappa in [1e12, 2e12] (2 threads), the bracket where
@@ -105,13 +105,13 @@ def main(argv=None) -> int:
     rows, targets = [], []
 
     # kappa_c and its pieces
-    critical_damping(params, "paper", rtol=RTOL)  # warm-up
+    critical_damping(params, "paper", kappa_rtol=RTOL)  # warm-up
     splits = []
     times = []
     for _ in range(repeats):
         with Split() as split:
             start = time.perf_counter()
-            cd = critical_damping(params, "paper", rtol=RTOL)
+            cd = critical_damping(params, "paper", kappa_rtol=RTOL)
             times.append(time.perf_counter() - start)
         splits.append(split)
     t_kc = statistics.median(times)
@@ -120,7 +120,7 @@ def main(argv=None) -> int:
     width = f"{cd.rtol:.0e}; margin {m_lo:+.1e} at (1-1e-10), {m_hi:+.1e} at (1+1e-10)"
     pieces = {k: statistics.median(s.time[k] for s in splits) for k in splits[0].time}
     counts = splits[0].count
-    rows.append(("kappa_c: critical_damping(seed, 'paper', rtol=1e-10)", f"{t_kc * 1e3:.3g}", cd.evaluations,
+    rows.append(("kappa_c: critical_damping(seed, 'paper', kappa_rtol=1e-10)", f"{t_kc * 1e3:.3g}", cd.evaluations,
                  f"{cd.kappa_c:.12g}", width, f"{cd.status}; closed form {cd.closed_form:.6g} "
                  f"({cd.kappa_c / cd.closed_form - 1:+.2%})"))
     for kind, t in pieces.items():
@@ -144,8 +144,8 @@ def main(argv=None) -> int:
     # kappa_2
     for samples in (0, 24):
         t2, (kappa_2, _, ev) = median_time(
-            lambda s=samples: locate_kappa_2(params, "paper", cd.kappa_c, rtol=1e-8, samples=s), repeats)
-        rows.append((f"kappa_2: locate_kappa_2(rtol=1e-8, samples={samples})", f"{t2 * 1e3:.3g}", ev + samples,
+            lambda s=samples: locate_kappa_2(params, "paper", cd.kappa_c, kappa_rtol=1e-8, samples=s), repeats)
+        rows.append((f"kappa_2: locate_kappa_2(kappa_rtol=1e-8, samples={samples})", f"{t2 * 1e3:.3g}", ev + samples,
                      f"{kappa_2:.10g}", "1e-08", f"kappa_2 / kappa_c - 1 = {kappa_2 / cd.kappa_c - 1:.4g}"))
         emit(f"kappa_2 = {kappa_2!r} ({samples} staircase samples) in {t2 * 1e3:.3g} ms")
 
@@ -156,7 +156,7 @@ def main(argv=None) -> int:
     t_curve = time.perf_counter() - start
     sub = speeds[:: max(1, n_curve // 10)]
     start = time.perf_counter()
-    independent = [critical_damping(params.replace(v=float(v)), "paper", rtol=RTOL).kappa_c for v in sub]
+    independent = [critical_damping(params.replace(v=float(v)), "paper", kappa_rtol=RTOL).kappa_c for v in sub]
     t_indep = (time.perf_counter() - start) / len(sub) * n_curve
     on_curve = np.interp(np.log(sub), np.log(curve.v), np.log(curve.kappa_c))
     dis = float(np.max(np.abs(np.log(np.array(independent, float)) - on_curve)))

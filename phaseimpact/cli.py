@@ -536,7 +536,16 @@ def cmd_cases(args) -> int:
 def cmd_completion(args) -> int:
     import shtab
 
-    print(shtab.complete(build_parser(), shell=args.shell, root_prefix="phaseimpact"))
+    parser = build_parser()
+    preamble = _complete_values(parser)
+    script = shtab.complete(parser, shell=args.shell, root_prefix="phaseimpact", preamble=preamble)
+    if args.shell == "bash":
+        # "--set NAME=" is followed by its value, not by a space: shtab's function runs its helpers in a
+        # subshell, where compopt has no effect, so a wrapper says it after them
+        script += ("\n_phaseimpact() {\n  _shtab_phaseimpact \"$@\"\n"
+                   "  [[ ${#COMPREPLY[@]} -gt 0 && ${COMPREPLY[0]} == *= ]] && compopt -o nospace 2>/dev/null\n"
+                   "  return 0\n}\ncomplete -o bashdefault -F _phaseimpact phaseimpact\n")
+    print(script)
     return EXIT_OK
 
 
@@ -573,6 +582,56 @@ def _checked_law_file(path: str) -> list:
                          "only define laws (phaseimpact.define_law); nothing was checked") from None
     finally:
         os._exit = exit_now
+
+
+def _complete_values(parser) -> dict:
+    """Tell shtab what each value completes to (an action's ``complete``): files for paths, the shipped
+    cases and ``.toml`` files for ``--case``, the laws and ``.py`` files for ``check-law``, ``.py`` files
+    for ``--law-file``, ``NAME=`` for ``--set``. Returns the shell functions this needs, by shell."""
+    from .case import list_cases
+    from .model import REGISTRY
+
+    cases, laws = " ".join(c["name"] for c in list_cases()), " ".join(REGISTRY)
+    names = " ".join(f"{name}=" for name in SETTABLE)
+    kinds = {  # dest -> (bash function, zsh action); bash functions named *_file complete as file names
+        "case": ("_phaseimpact_compgen_case_file", "_phaseimpact_case"),
+        "set": ("_phaseimpact_compgen_setting", "_phaseimpact_setting"),
+        "law_file": ("_phaseimpact_compgen_py_file", "_files -g '*.py'"),
+        "law": ("_phaseimpact_compgen_law_file", "_phaseimpact_law_or_file"),
+        "out": ("_shtab_compgen_files", "_files"), "archive": ("_shtab_compgen_files", "_files"),
+        "curve": ("_shtab_compgen_files", "_files"),
+    }
+    for command in next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction)).choices.values():
+        for action in command._actions:
+            if action.dest in kinds and not (action.dest == "law" and action.option_strings):  # --law: choices
+                bash, zsh = kinds[action.dest]
+                action.complete = {"bash": bash, "zsh": zsh}
+    bash = f"""
+_phaseimpact_compgen_case_file() {{
+  compgen -W "{cases}" -- "$1"; compgen -d -- "$1"; compgen -f -X '!*.toml' -- "$1"
+}}
+_phaseimpact_compgen_py_file() {{
+  compgen -d -- "$1"; compgen -f -X '!*.py' -- "$1"
+}}
+_phaseimpact_compgen_law_file() {{
+  compgen -W "{laws}" -- "$1"; compgen -d -- "$1"; compgen -f -X '!*.py' -- "$1"
+}}
+_phaseimpact_compgen_setting() {{
+  compgen -W "{names}" -- "$1"
+}}
+"""
+    zsh = f"""
+_phaseimpact_case() {{
+  _alternative 'cases:shipped case:({cases})' 'files:case file:_files -g "*.toml"'
+}}
+_phaseimpact_law_or_file() {{
+  _alternative 'laws:law:({laws})' 'files:law file:_files -g "*.py"'
+}}
+_phaseimpact_setting() {{
+  compadd -S '' -- {names}
+}}
+"""
+    return {"bash": bash, "zsh": zsh}
 
 
 def cmd_check_law(args) -> int:
@@ -764,7 +823,7 @@ def cmd_critical(args) -> int:
     _note(f"locating kappa_c and kappa_2 of {law.label()} at v = {params.v:g} m/s"
           + (" and measuring the exponents (about 1 s)" if args.exponents else ""))
     result = critical_damping(params, law, kappa_min=args.kappa_min, kappa_max=args.kappa_max,
-                              rtol=args.kappa_rtol, integrator_rtol=args.rtol, with_kappa_2=True,
+                              kappa_rtol=args.kappa_rtol, rtol=args.rtol, with_kappa_2=True,
                               with_exponents=args.exponents)
     out = {**_law_fields(setup), "v": result.v, "kappa_c": result.kappa_c,
            "kappa_c_accuracy": result.kappa_c_accuracy, "kappa_2": result.kappa_2,
@@ -829,8 +888,8 @@ def cmd_transitions(args) -> int:
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", SamplingWarning)
         try:
-            found = transitions(params, law, args.kappa_min, args.kappa_max, rtol=args.kappa_rtol,
-                                integrator_rtol=args.rtol, num=args.samples, progress=sys.stderr.isatty())
+            found = transitions(params, law, args.kappa_min, args.kappa_max, kappa_rtol=args.kappa_rtol,
+                                rtol=args.rtol, num=args.samples, progress=sys.stderr.isatty())
         except RunFailed as error:  # every input was checked: this is the search's own failure
             print(f"phaseimpact: the transition search failed: {error}", file=sys.stderr)
             return EXIT_FAILURE
@@ -1063,7 +1122,7 @@ def cmd_atlas(args) -> int:
 
         _note(f"refining the class boundaries along {args.refine}")
         try:
-            found = refine_boundaries(result, args.refine, rtol=args.refine_rtol, integrator_rtol=args.rtol)
+            found = refine_boundaries(result, args.refine, refine_rtol=args.refine_rtol, rtol=args.rtol)
         except KeyboardInterrupt as stop:
             print(f"phaseimpact: {_stopped(stop)} while refining; the atlas is saved in {args.out} without its "
                   f"boundaries; resume with: {_resume_command(args.argv)}", file=sys.stderr)
@@ -1153,8 +1212,8 @@ def cmd_critical_curve(args) -> int:
         if what == "grazing":
             first = setup.case.parameters(**{param: float(values[0])})
             _note(f"looking for the first grazing of {law.label()} at {param} = {values[0]:g}")
-            found = [t for t in transitions(first, law, args.kappa_min, args.kappa_max, rtol=args.kappa_rtol,
-                                            integrator_rtol=args.rtol, num=samples) if t.kind == "grazing"]
+            found = [t for t in transitions(first, law, args.kappa_min, args.kappa_max, kappa_rtol=args.kappa_rtol,
+                                            rtol=args.rtol, num=samples) if t.kind == "grazing"]
             if not found:
                 print(f"phaseimpact: the curve failed to start: no grazing value of {law.label()} for kappa in "
                       f"[{args.kappa_min:g}, {args.kappa_max:g}] at {param} = {values[0]:g} (with {samples} samples); "
@@ -1163,8 +1222,8 @@ def cmd_critical_curve(args) -> int:
             start, index = found[0].kappa, int(found[0].extremum)
         _note(f"continuing {what} of {law.label()} over {len(values)} values of {param}")
         try:
-            curve = critical_curve(setup.case, law, param, values, what=what, rtol=args.kappa_rtol,
-                                   integrator_rtol=args.rtol, contact_index=index, kappa_start=start,
+            curve = critical_curve(setup.case, law, param, values, what=what, kappa_rtol=args.kappa_rtol,
+                                   rtol=args.rtol, contact_index=index, kappa_start=start,
                                    progress=_progress(args))
         except RunFailed as error:  # every input was checked: this is the curve's own failure
             print(f"phaseimpact: the curve failed to start: {error}; nothing written", file=sys.stderr)
@@ -1467,8 +1526,8 @@ def build_parser() -> argparse.ArgumentParser:
 
     def out_options(p, resume):
         p.add_argument("--out", type=_path("out"), required=True, metavar="FILE.nc",
-                       help="HDF5 archive to write (written atomically; refused if it exists and is not an "
-                            "archive of the same work, unless --force)")
+                       help="netCDF-4/CF archive to write, .nc (docs/archive.md; written atomically; refused if it "
+                            "exists and is not an archive of the same work, unless --force)")
         p.add_argument("--force", action="store_true",
                        help="replace --out even if it holds something else (default: refuse)")
         if resume:
@@ -1603,14 +1662,14 @@ def build_parser() -> argparse.ArgumentParser:
     p.set_defaults(func=cmd_transitions)
 
     grid_commands = (
-        ("sweep", "one axis: a sweep of kappa (or any parameter), archived to HDF5",
+        ("sweep", "one axis: a sweep of kappa (or any parameter), archived to netCDF-4 (.nc)",
          "Every value of one axis (usually kappa: --axis kappa=1e9:1e12:50:log), each run until its outcome settles "
-         "(or to --t-end): outcome class, stick phases, contacts, T_run, max force... Archived to HDF5 and "
+         "(or to --t-end): outcome class, stick phases, contacts, T_run, max force... Archived to netCDF-4 (.nc) and "
          "checkpointed after every chunk. The same as atlas with one axis."),
-        ("atlas", "outcomes over a grid of any parameters, archived to HDF5",
+        ("atlas", "outcomes over a grid of any parameters, archived to netCDF-4 (.nc)",
          "Every point of a grid over named parameters (kappa, v, M1, ..., and every settable quantity of the "
          "case), each run until its outcome settles (or to --t-end): outcome class, stick phases, contacts, "
-         "T_run, max force... Archived to HDF5 and checkpointed after every chunk."),
+         "T_run, max force... Archived to netCDF-4 (.nc) and checkpointed after every chunk."),
     )
     for name, summary, description in grid_commands:
         p = add(name, summary, description)
@@ -1636,7 +1695,7 @@ def build_parser() -> argparse.ArgumentParser:
         json_option(p)
         p.set_defaults(func=cmd_atlas)
 
-    p = add("critical-curve", "kappa_c, kappa_2 or a grazing value against a parameter, archived to HDF5",
+    p = add("critical-curve", "kappa_c, kappa_2 or a grazing value against a parameter, archived to netCDF-4 (.nc)",
             "A transition continued over a second parameter (v, a material or a geometry quantity): kappa_c or "
             "kappa_2 of law paper, or a grazing value of a unilateral law; each point predicted from the previous "
             "ones and corrected, with step control.")
@@ -1771,7 +1830,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.set_defaults(func=cmd_map_continuation)
 
     p = add("basins", "basins of attraction of the impact map over the plate's initial state",
-            "From each initial plate state (x2, x2dot) of a NUM x NUM grid the impact map is iterated until a "
+            "From each initial plate state (x2, x2dot) of an N x N grid (--grid N: evenly spaced positions from "
+            "-X to X by velocities from -V to V, --x2-max X, --x2dot-max V) the impact map is iterated until a "
             "period up to --max-period repeats (docs/physics.md §7); each state is labelled by the attractor it "
             "reaches (attractors told apart by their points and period), or as reaching none.")
     case_options(p)
@@ -1786,8 +1846,8 @@ def build_parser() -> argparse.ArgumentParser:
                                      "sqrt(Kb/M2): the plate's swing at speed v)")
     p.add_argument("--x2dot-max", type=_real("x2dot-max", 0.0, None, low_open=True, unit="m/s"), default=None,
                    metavar="V", help="initial velocities from -V to V, m/s, V > 0 (default: 1.5 v)")
-    p.add_argument("--grid", type=_integer("grid", 1, 400), default=21,
-                   help="initial states per axis, 1 to 400 (default: %(default)s)")
+    p.add_argument("--grid", type=_integer("grid", 1, 400), default=21, metavar="N",
+                   help="initial states per axis, 1 <= N <= 400: N x N states in all (default: %(default)s)")
     p.add_argument("--iterations", type=_integer("iterations", 1, 100_000), default=500,
                    help="impacts at most from each state, 1 to 100000 (default: %(default)s)")
     p.add_argument("--max-period", type=_integer("max-period", 1, 64), default=16,

@@ -26,7 +26,7 @@ KAPPA_2_V7 = 416864914634.6 * (1 + 4.6e-7)
 
 @pytest.fixture(scope="module")
 def seed_kappa_c():
-    return critical_damping(seed_parameters(v=1.0), "paper", rtol=1e-13, integrator_rtol=1e-13).kappa_c
+    return critical_damping(seed_parameters(v=1.0), "paper", kappa_rtol=1e-13, rtol=1e-13).kappa_c
 
 
 @pytest.mark.parametrize(("offset", "count"), [(1e-5, 3358), (5e-6, 10396)])

@@ -1,10 +1,14 @@
-"""The documentation site (mkdocs.yml, docs/): every page with code runs as written, and the site builds
-with ``mkdocs build --strict``, its generated command-line reference and gallery complete.
+"""The documentation site (mkdocs.yml, docs/) and the README: every code block runs as written, and
+the site builds with ``mkdocs build --strict``, its generated command-line reference and gallery
+complete.
 
 A page runs top to bottom in an empty folder, in a process of its own (so the laws it defines stay
-there): a block with a title (```toml title="case.toml") is written to that file, the ```python
-blocks run as one script, and the lines of the ```sh blocks that start with ``phaseimpact`` go
-through the command line's ``main`` (as tests/test_readme.py does for README.md).
+there): a block with a title (```toml title="case.toml") is written to that file, each ```python
+block runs in the page's one namespace, and each line of a ```sh block runs: ``phaseimpact ...``
+through the command line's ``main`` (exit 0 required), any other command in bash. A block that
+cannot run here (``make``, ``pip install`` from the internet, a cluster's address, output) says so
+where the reader sees it, on the line before its fence: ``<!-- no-run: why -->``; the test honours
+the marker, counts it, and still checks that its ``phaseimpact`` commands parse.
 By hand, in a scratch folder: ``python PATH/TO/tests/test_docs.py PATH/TO/docs/tutorials/atlas.md``.
 """
 
@@ -16,6 +20,8 @@ import re
 import shlex
 import subprocess
 import sys
+import textwrap
+from dataclasses import dataclass
 from pathlib import Path
 
 import pytest
@@ -23,33 +29,68 @@ import pytest
 ROOT = Path(__file__).resolve().parents[1]
 DOCS = ROOT / "docs"
 TUTORIALS = sorted((DOCS / "tutorials").glob("*.md"))
-RUNNABLE = ("python", "sh", "bash")
+#: Every page with code: the README and the site's pages.
+PAGES = [ROOT / "README.md", *sorted(DOCS.rglob("*.md"))]
+#: The languages of the blocks that run; a block of another language is data (toml, json, text).
+PYTHON, SHELL = ("python",), ("sh", "bash", "shell", "console")
+#: The marker of a block that does not run, on the line before its fence, with the reason.
+NO_RUN = re.compile(r"^\s*<!--\s*no-run:\s*(?P<why>\S.*?)\s*-->\s*$")
+FENCE = re.compile(r"^(?P<indent>[ \t]*)```(?P<lang>[\w-]*)(?P<attrs>[^\n]*)\n(?P<code>.*?)^(?P=indent)```[ \t]*$",
+                   flags=re.S | re.M)
 
 
-def fenced(page):
-    """``(language, title, code)`` of every fenced block of ``page``, in order (title: "" if none)."""
-    found = re.findall(r"^```(\w*)([^\n]*)\n(.*?)^```", Path(page).read_text(encoding="utf-8"), flags=re.S | re.M)
-    return [(lang, "".join(re.findall(r'title="([^"]+)"', attrs)), code) for lang, attrs, code in found]
+@dataclass(frozen=True)
+class Block:
+    """A fenced block: its language, the file it is written to ("" if none), its code (dedented),
+    the line of its fence and the reason it does not run (None: it runs)."""
+
+    lang: str
+    title: str
+    code: str
+    line: int
+    no_run: str | None
+
+    @property
+    def runs(self) -> bool:
+        return self.no_run is None and not self.title and self.lang in PYTHON + SHELL
 
 
-def blocks(page):
-    """``(language, code)`` of every block of ``page`` that runs (not those written to a file)."""
-    return [(lang, code) for lang, title, code in fenced(page) if not title]
+def fenced(page) -> list[Block]:
+    """Every fenced block of ``page``, in order (blocks inside list items too)."""
+    text = Path(page).read_text(encoding="utf-8")
+    found = []
+    for m in FENCE.finditer(text):
+        before = text[:m.start()].rstrip("\n").rsplit("\n", 1)[-1]
+        marker = NO_RUN.match(before)
+        code = textwrap.dedent(m["code"])
+        found.append(Block(m["lang"], "".join(re.findall(r'title="([^"]+)"', m["attrs"])), code,
+                           text.count("\n", 0, m.start()) + 1, marker["why"] if marker else None))
+    return found
+
+
+def command_lines(code):
+    """``(line, words)`` of each command of a shell block (continued lines joined; comments and blank
+    lines dropped)."""
+    for line in code.replace("\\\n", " ").splitlines():
+        words = shlex.split(line, comments=True)
+        if words:
+            yield line, words
 
 
 def commands(code):
-    """The ``phaseimpact`` command lines of a shell block, as argument lists (comments dropped)."""
-    for line in code.splitlines():
-        words = shlex.split(line, comments=True)
-        if words and words[0] == "phaseimpact":
+    """The ``phaseimpact`` command lines of a shell block, as argument lists."""
+    for _, words in command_lines(code):
+        if words[0] == "phaseimpact":
             yield words[1:]
 
 
-def runnable(page) -> bool:
-    return any(lang == "python" or (lang in RUNNABLE and list(commands(code))) for lang, code in blocks(page))
+def counts(page) -> tuple[int, int]:
+    """``(blocks that run, blocks marked no-run)`` of ``page``."""
+    found = fenced(page)
+    return sum(b.runs for b in found), sum(b.no_run is not None for b in found)
 
 
-PAGES = [p for p in (DOCS / "index.md", DOCS / "getting-started.md", DOCS / "archive.md", *TUTORIALS) if runnable(p)]
+RUN_PAGES = [p for p in PAGES if counts(p)[0]]
 
 
 def run_page(page) -> int:
@@ -58,42 +99,73 @@ def run_page(page) -> int:
 
     namespace = {"__name__": "__docs__"}
     ran = 0
-    for number, (lang, title, code) in enumerate(fenced(page), 1):
-        if title:
-            Path(title).write_text(code, encoding="utf-8")
-        elif lang == "python":
-            exec(compile(code, f"{Path(page).name}, block {number}", "exec"), namespace)
-            ran += 1
-        elif lang in RUNNABLE:
-            for argv in commands(code):
-                print(f"$ phaseimpact {shlex.join(argv)}", flush=True)
-                status = main(argv)
-                if status != 0:
-                    raise SystemExit(f"{Path(page).name}, block {number}: phaseimpact {shlex.join(argv)} "
-                                     f"exited {status}")
-                ran += 1
+    for block in fenced(page):
+        where = f"{Path(page).name}, line {block.line}"
+        if block.title and block.no_run is None:
+            Path(block.title).write_text(block.code, encoding="utf-8")
+        if not block.runs:
+            continue
+        if block.lang in PYTHON:
+            exec(compile(block.code, where, "exec"), namespace)
+        for line, words in command_lines(block.code) if block.lang in SHELL else ():
+            print(f"$ {line}", flush=True)
+            if words[0] == "phaseimpact":
+                status = main(words[1:])
+            else:  # verbatim, as a reader's shell runs it, with this Python first on the PATH
+                path = os.pathsep.join((str(Path(sys.executable).parent), os.environ.get("PATH", "")))
+                status = subprocess.run(["bash", "-c", line], env={**os.environ, "PATH": path}).returncode
+            if status != 0:
+                raise SystemExit(f"{where}: {line.strip()} exited {status}")
+        ran += 1
     return ran
 
 
 def test_every_tutorial_is_runnable():
-    assert len(TUTORIALS) >= 6 and all(runnable(page) for page in TUTORIALS if page.name != "index.md")
+    assert len(TUTORIALS) >= 6 and all(counts(page)[0] for page in TUTORIALS if page.name != "index.md")
+
+
+@pytest.mark.parametrize("page", PAGES, ids=lambda p: p.relative_to(ROOT).as_posix())
+def test_every_block_runs_or_says_why(page):
+    """Python and shell blocks run, unless marked no-run with a reason; a block without a language
+    is marked (it cannot be told from code); a marker stands before a block."""
+    text = page.read_text(encoding="utf-8")
+    for block in fenced(page):
+        if not block.lang and not block.title:
+            assert block.no_run, f"{page.name}, line {block.line}: a block without a language and no no-run marker"
+    markers = sum(bool(NO_RUN.match(line)) for line in text.splitlines())
+    assert markers == counts(page)[1], f"{page.name}: a no-run marker that is not on the line before a fence"
+
+
+def test_the_markers_are_counted(tmp_path, monkeypatch):
+    """The marker is honoured: a marked block is not run, an unmarked one is, whatever its text."""
+    page = tmp_path / "page.md"
+    page.write_text("<!-- no-run: needs the internet -->\n```sh\npip install x\n```\n\n```python\nx = 1\n```\n"
+                    "\n- item\n\n  <!-- no-run: an output -->\n  ```python\n  1 / 0\n  ```\n"
+                    "\n```sh\necho \"$((6 * 7))\" > answer.txt   # verbatim, through bash\n```\n", encoding="utf-8")
+    blocks = fenced(page)
+    assert [(b.lang, b.no_run, b.runs) for b in blocks] == [
+        ("sh", "needs the internet", False), ("python", None, True), ("python", "an output", False),
+        ("sh", None, True)]
+    assert counts(page) == (2, 2) and blocks[2].code == "1 / 0\n"
+    monkeypatch.chdir(tmp_path)
+    assert run_page(page) == 2 and (tmp_path / "answer.txt").read_text() == "42\n"
 
 
 def test_every_documented_command_parses(tmp_path, monkeypatch):
-    """Fast: no placeholder or unknown option in any command of the pages (with the files the page
-    writes first; commands of a user law's file are checked by running the page)."""
+    """Fast: no placeholder or unknown option in any command of the pages, marked no-run or not (with
+    the files the page writes first; commands of a user law's file are checked by running the page)."""
     from phaseimpact.cli import build_parser
 
     parser = build_parser()
     for page in PAGES:
-        folder = tmp_path / page.relative_to(DOCS).with_suffix("")
+        folder = tmp_path / page.relative_to(ROOT).with_suffix("")
         folder.mkdir(parents=True)
         monkeypatch.chdir(folder)
-        for lang, title, code in fenced(page):
-            if title:
-                Path(title).write_text(code, encoding="utf-8")
-            elif lang in RUNNABLE:
-                for argv in commands(code):
+        for block in fenced(page):
+            if block.title:
+                Path(block.title).write_text(block.code, encoding="utf-8")
+            elif block.lang in SHELL:
+                for argv in commands(block.code):
                     if "--law-file" in argv:
                         continue
                     with contextlib.redirect_stderr(io.StringIO()) as err:
@@ -104,15 +176,16 @@ def test_every_documented_command_parses(tmp_path, monkeypatch):
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("page", PAGES, ids=lambda p: p.relative_to(DOCS).as_posix())
+@pytest.mark.parametrize("page", RUN_PAGES, ids=lambda p: p.relative_to(ROOT).as_posix())
 def test_page_runs_as_written(page, tmp_path):
     env = {**os.environ, "MPLBACKEND": "Agg"}
     proc = subprocess.run([sys.executable, __file__, str(page)], cwd=tmp_path, env=env, capture_output=True,
                           text=True, timeout=600)
     assert proc.returncode == 0, f"{page.name}:\n{proc.stdout[-4000:]}\n{proc.stderr[-4000:]}"
+    assert f"ran {counts(page)[0]} blocks" in proc.stdout  # every block that runs ran, none skipped
     if page.parent.name == "tutorials":
         written = [p.name for p in tmp_path.iterdir()]
-        for name in re.findall(r"\"([\w.-]+\.(?:png|h5|toml|py))\"", page.read_text(encoding="utf-8")):
+        for name in re.findall(r"\"([\w.-]+\.(?:png|nc|toml|py))\"", page.read_text(encoding="utf-8")):
             assert name in written, f"{page.name} does not write {name}"
 
 
@@ -191,4 +264,6 @@ def test_api_reference_covers_the_public_modules(site):
 
 
 if __name__ == "__main__":
-    sys.exit(0 if run_page(sys.argv[1]) else "no code block ran")
+    ran = run_page(sys.argv[1])
+    print(f"ran {ran} blocks, {counts(sys.argv[1])[1]} marked no-run")
+    sys.exit(0 if ran else "no code block ran")

@@ -46,7 +46,7 @@ def test_kappa_c_at_the_default_tolerance_is_converged(v):
     kappa_c; the plain integration was off by 7e-10 at v = 1."""
     p = seed_parameters(v=v)
     default = critical_damping(p, "paper").kappa_c
-    converged = critical_damping(p, "paper", integrator_rtol=1e-13).kappa_c
+    converged = critical_damping(p, "paper", kappa_rtol=1e-10, rtol=1e-13).kappa_c
     assert default == pytest.approx(converged, rel=5e-10)
 
 
@@ -224,7 +224,7 @@ def test_continued_grazing_matches_independent_solves(grazing):
 
 def test_refined_atlas_boundary_agrees_with_the_continued_curve():
     result = atlas(SEED, "paper", {"kappa": np.geomspace(1e11, 1e13, 9), "v": np.linspace(0.5, 13, 4)})
-    boundaries = refine_boundaries(result, "kappa", rtol=1e-8)
+    boundaries = refine_boundaries(result, "kappa", refine_rtol=1e-8)
     assert len(boundaries) == 4
     curve = critical_curve(SEED, "paper", "v", boundaries.points[:, 1])
     np.testing.assert_allclose(boundaries.points[:, 0], curve.kappa[curve.requested], rtol=1e-8)

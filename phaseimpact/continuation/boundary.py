@@ -17,6 +17,8 @@ import numpy as np
 
 from ..integrate import driver as drv
 from ..integrate import simulate
+from ..integrate.api import check_rtol
+from ._renamed import renamed_tolerances
 from .sweep import SweepResult
 from .transition import first_stick_margin
 
@@ -36,14 +38,14 @@ class Boundaries:
     below, above : ndarray of int8, shape (n,)
         Outcome class codes on the low and high side along ``axis``.
     rtol : float
-        Relative width of each refined bracket.
+        Relative width of each refined bracket: the call's ``refine_rtol``.
 
     Examples
     --------
     >>> from phaseimpact import seed_parameters
     >>> from phaseimpact.continuation import atlas, refine_boundaries
     >>> a = atlas(seed_parameters(), "paper", {"kappa": [1e11, 1e12, 1e13], "v": [1.0, 2.0]})
-    >>> b = refine_boundaries(a, "kappa", rtol=1e-4)
+    >>> b = refine_boundaries(a, "kappa", refine_rtol=1e-4)
     >>> len(b), b.axis, b.points.shape
     (2, 'kappa', (2, 2))
     """
@@ -58,14 +60,15 @@ class Boundaries:
         return len(self.below)
 
 
-def refine_boundaries(result: SweepResult, axis: str = "kappa", *, rtol: float = 1e-8,
-                      integrator_rtol: float | None = None) -> Boundaries:
+@renamed_tolerances("refine_rtol")
+def refine_boundaries(result: SweepResult, axis: str = "kappa", *, refine_rtol: float = 1e-8,
+                      rtol: float | None = None) -> Boundaries:
     """Locate every class change along ``axis`` between neighbouring points of ``result``.
 
     Where two neighbouring grid points along ``axis`` end in different outcome classes (both
     computed, neither failed), the boundary between them is located by bisection on the class
     (geometric midpoints on a log axis), all other coordinates held, until the bracket's
-    relative width is below ``rtol``. For a Filippov law's edge between a permanent stick and the
+    relative width is below ``refine_rtol``. For a Filippov law's edge between a permanent stick and the
     rest, the class is read from the sign of the first stick's margin (its root is ``kappa_c``,
     docs/physics.md §5), so no run has to reach the escape.
 
@@ -75,10 +78,13 @@ def refine_boundaries(result: SweepResult, axis: str = "kappa", *, rtol: float =
         A sweep or atlas (:func:`~phaseimpact.continuation.atlas`).
     axis : str, default "kappa"
         The axis to refine along; one of ``result.grid.names``.
-    rtol : float, default 1e-8
-        Relative width of each final bracket, ``1e-14 <= rtol <= 0.1``.
-    integrator_rtol : float, optional
-        Tolerance of the runs; default the result's own (``result.settings["rtol"]``).
+    refine_rtol : float, default 1e-8
+        Relative width of each final bracket, ``1e-14 <= refine_rtol <= 0.1`` (``rtol`` up to
+        0.2.0, as the command line's ``--refine-rtol``).
+    rtol : float, optional
+        The integrator's tolerance of the runs, within :data:`~phaseimpact.integrate.RTOL_RANGE`;
+        default the result's own (``result.settings["rtol"]``; ``integrator_rtol`` up to 0.2.0,
+        ``rtol=`` alone is refused for one release).
 
     Returns
     -------
@@ -89,7 +95,9 @@ def refine_boundaries(result: SweepResult, axis: str = "kappa", *, rtol: float =
     Raises
     ------
     ValueError
-        If ``axis`` is not an axis of ``result`` or ``rtol`` is out of range.
+        If ``axis`` is not an axis of ``result``, or ``refine_rtol`` or ``rtol`` is out of range.
+    TypeError
+        For the spellings of 0.2.0 (``integrator_rtol=``; ``rtol=`` without ``refine_rtol=``).
     RunFailed
         When a run of a Filippov law's margin fails numerically (naming its kappa).
 
@@ -98,7 +106,7 @@ def refine_boundaries(result: SweepResult, axis: str = "kappa", *, rtol: float =
     >>> from phaseimpact import seed_parameters
     >>> from phaseimpact.continuation import atlas, refine_boundaries
     >>> a = atlas(seed_parameters(), "paper", {"kappa": [1e11, 1e12, 1e13], "v": [1.0, 2.0]})
-    >>> b = refine_boundaries(a, "kappa", rtol=1e-4)
+    >>> b = refine_boundaries(a, "kappa", refine_rtol=1e-4)
     >>> for (kappa, v), lo, hi in zip(b.points, b.below, b.above):
     ...     print(f"v = {v} m/s: kappa_c = {kappa:.4g} N s/m^2.5, outcome {lo} -> {hi}")
     v = 1.0 m/s: kappa_c = 1.499e+12 N s/m^2.5, outcome 1 -> 2
@@ -108,9 +116,9 @@ def refine_boundaries(result: SweepResult, axis: str = "kappa", *, rtol: float =
     names = grid.names
     if axis not in names:
         raise ValueError(f"axis = {axis!r} is out of range; allowed: one of {', '.join(names)}")
-    if not (isinstance(rtol, float | int) and 1e-14 <= rtol <= 0.1):
-        raise ValueError(f"rtol = {rtol!r} is out of range; allowed: 1e-14 <= rtol <= 0.1")
-    integrator_rtol = integrator_rtol or result.settings.get("rtol", 1e-10)
+    if not (isinstance(refine_rtol, float | int) and 1e-14 <= refine_rtol <= 0.1):
+        raise ValueError(f"refine_rtol = {refine_rtol!r} is out of range; allowed: 1e-14 <= refine_rtol <= 0.1")
+    rtol = check_rtol(result.settings.get("rtol", 1e-10) if rtol is None else rtol)
     k = names.index(axis)
     values = grid.axes[k].values
     log = grid.axes[k].log and np.all(values > 0)
@@ -121,8 +129,8 @@ def refine_boundaries(result: SweepResult, axis: str = "kappa", *, rtol: float =
     def classify(point: dict) -> int:
         params = grid.parameters_at(point)
         if law.is_filippov and stuck in pair:
-            return stuck if first_stick_margin(params, law, rtol=integrator_rtol) >= 0 else -2
-        tr = simulate(params, law, result.t_end, rtol=integrator_rtol)
+            return stuck if first_stick_margin(params, law, rtol=rtol) >= 0 else -2
+        tr = simulate(params, law, result.t_end, rtol=rtol)
         return drv.OUTCOMES.index(tr.outcome) if tr.ok else drv.FAILED
 
     points, below, above = [], [], []
@@ -137,7 +145,7 @@ def refine_boundaries(result: SweepResult, axis: str = "kappa", *, rtol: float =
             others = {grid.axes[j].name: grid.axes[j].values[index[j - (j > k)]] for j in range(len(names)) if j != k}
             lo, hi = values[i], values[i + 1]
             side_lo = classify({**others, axis: lo})
-            while abs(hi - lo) > rtol * max(abs(lo), abs(hi)):
+            while abs(hi - lo) > refine_rtol * max(abs(lo), abs(hi)):
                 mid = math.sqrt(lo * hi) if log else 0.5 * (lo + hi)
                 if mid in (lo, hi):
                     break
@@ -151,4 +159,4 @@ def refine_boundaries(result: SweepResult, axis: str = "kappa", *, rtol: float =
             below.append(a)
             above.append(b)
     return Boundaries(axis, np.asarray(points, dtype=float).reshape(-1, len(names)),
-                      np.asarray(below, dtype=np.int8), np.asarray(above, dtype=np.int8), float(rtol))
+                      np.asarray(below, dtype=np.int8), np.asarray(above, dtype=np.int8), float(refine_rtol))

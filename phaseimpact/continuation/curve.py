@@ -16,10 +16,14 @@ import numpy as np
 from tqdm.auto import tqdm
 
 from ..case import Case
+from ..integrate.api import check_rtol
 from ..model.laws import ContactLaw, as_law
 from ..parameters import Parameters
+from ._renamed import renamed_tolerances
 from .transition import (
+    KAPPA_2_RTOL,
     RunFailed,
+    check_rtol_of_kappa,
     closed_form_kappa_c,
     critical_damping,
     delta_extremum,
@@ -58,7 +62,8 @@ class CriticalCurve:
     base : Parameters or Case
         The case whose ``param`` was varied.
     rtol : float
-        Relative tolerance of each located value.
+        Relative tolerance of each located value: the call's ``kappa_rtol`` (the archive's ``rtol``
+        attribute of a curve).
     contact_index : int
         ``grazing``: which extremum of ``delta`` touches zero.
     message : str
@@ -105,8 +110,9 @@ def _parameters(base, param, value) -> Parameters:
     return base.replace(**{param: float(value)})
 
 
+@renamed_tolerances("kappa_rtol")
 def critical_curve(base: Parameters | Case, law: ContactLaw | str, param: str, values, *,
-                   what: str = "kappa_c", rtol: float = 1e-10, integrator_rtol: float = 1e-10,
+                   what: str = "kappa_c", kappa_rtol: float = 1e-10, rtol: float = 1e-10,
                    contact_index: int = 1, kappa_start: float | None = None, max_halvings: int = 6,
                    progress: bool = False) -> CriticalCurve:
     """Continue ``what`` over ``values`` of ``param`` (see the module docstring).
@@ -134,10 +140,12 @@ def critical_curve(base: Parameters | Case, law: ContactLaw | str, param: str, v
         Its values, SI units: non-empty, 1-d, finite, distinct, in the order to walk.
     what : {"kappa_c", "kappa_2", "grazing"}, default "kappa_c"
         The quantity to continue (:data:`CURVE_QUANTITIES`).
+    kappa_rtol : float, default 1e-10
+        Relative tolerance of each located value, ``1e-14 <= kappa_rtol <= 1e-2`` (``rtol`` up to
+        0.2.0).
     rtol : float, default 1e-10
-        Relative tolerance of each located value (``kappa_c``'s start: ``1e-14 <= rtol <= 1e-2``).
-    integrator_rtol : float, default 1e-10
-        Tolerance of every run, within :data:`~phaseimpact.integrate.RTOL_RANGE`.
+        The integrator's tolerance of every run, within :data:`~phaseimpact.integrate.RTOL_RANGE`
+        (``integrator_rtol`` up to 0.2.0; ``rtol=`` alone is refused for one release).
     contact_index : int, default 1
         ``grazing``: which extremum of ``delta`` touches zero (the ``extremum`` of a
         :class:`~phaseimpact.continuation.Transition`).
@@ -159,8 +167,10 @@ def critical_curve(base: Parameters | Case, law: ContactLaw | str, param: str, v
     ------
     ValueError
         For ``what`` not in :data:`CURVE_QUANTITIES`, a law that does not fit ``what``,
-        ``param = "kappa"``, bad ``values`` (or a case invalid at either end), or ``grazing``
-        without ``kappa_start``.
+        ``param = "kappa"``, bad ``values`` (or a case invalid at either end), ``kappa_rtol`` or
+        ``rtol`` out of range, or ``grazing`` without ``kappa_start``.
+    TypeError
+        For the spellings of 0.2.0 (``integrator_rtol=``; ``rtol=`` without ``kappa_rtol=``).
     RunFailed
         When no start point is found, or a run of the walk fails numerically.
 
@@ -198,13 +208,15 @@ def critical_curve(base: Parameters | Case, law: ContactLaw | str, param: str, v
     values = np.asarray(values, dtype=float)
     if values.ndim != 1 or values.size == 0 or not np.all(np.isfinite(values)) or np.any(np.diff(values) == 0):
         raise ValueError("values are out of range; allowed: a non-empty 1-d array of distinct finite numbers")
+    check_rtol_of_kappa(kappa_rtol)
+    rtol = check_rtol(rtol)
     _parameters(base, param, values[0]), _parameters(base, param, values[-1])  # both ends valid: check first
 
     def defining(p: Parameters, quantity: str):
         """The smooth function whose root in log(kappa) is the quantity (kappa_2 rides on kappa_c)."""
         if quantity == "grazing":
-            return lambda x: delta_extremum(p.replace(kappa=math.exp(x)), law, contact_index, rtol=integrator_rtol)
-        return lambda x: first_stick_margin(p.replace(kappa=math.exp(x)), law, rtol=integrator_rtol)
+            return lambda x: delta_extremum(p.replace(kappa=math.exp(x)), law, contact_index, rtol=rtol)
+        return lambda x: first_stick_margin(p.replace(kappa=math.exp(x)), law, rtol=rtol)
 
     def correct(p: Parameters, guess: float, width: float) -> float | None:
         """Corrector: the root of the defining function within ``guess * exp(+-width)``."""
@@ -213,7 +225,7 @@ def critical_curve(base: Parameters | Case, law: ContactLaw | str, param: str, v
         f_lo, f_hi = f(lo), f(hi)
         if not (math.isfinite(f_lo) and math.isfinite(f_hi)) or (f_lo > 0) == (f_hi > 0):
             return None
-        return math.exp(brentq(f, lo, hi, xtol=rtol / 4, rtol=4 * np.finfo(float).eps))
+        return math.exp(brentq(f, lo, hi, xtol=kappa_rtol / 4, rtol=4 * np.finfo(float).eps))
 
     # the first point: an independent search (or the caller's start for a grazing value)
     p0 = _parameters(base, param, values[0])
@@ -223,7 +235,7 @@ def critical_curve(base: Parameters | Case, law: ContactLaw | str, param: str, v
                              "from transitions())")
         first = correct(p0, kappa_start, 1e-3) or kappa_start
     else:
-        found = critical_damping(p0, law, integrator_rtol=integrator_rtol, rtol=rtol)
+        found = critical_damping(p0, law, kappa_rtol=kappa_rtol, rtol=rtol)
         if found.kappa_c is None:
             raise RunFailed(f"no kappa_c at {param} = {values[0]:g} to start from: {found.message}")
         first = found.kappa_c
@@ -268,7 +280,7 @@ def critical_curve(base: Parameters | Case, law: ContactLaw | str, param: str, v
     bar.close()
     walk_k = np.asarray(walk_k, dtype=float)
     if what == "kappa_2":
-        found = [locate_kappa_2(_parameters(base, param, x), law, kc, integrator_rtol=integrator_rtol, samples=0)
+        found = [locate_kappa_2(_parameters(base, param, x), law, kc, kappa_rtol=KAPPA_2_RTOL, rtol=rtol, samples=0)
                  for x, kc in zip(walk_x, walk_k, strict=True)]
         # an unconfirmed kappa_2 (its bracket's counts move at a tighter tolerance) is left out, never guessed
         walk_k = np.array([f.kappa_2 if f.kappa_2 is not None and not f.reason else math.nan for f in found])
@@ -280,4 +292,4 @@ def critical_curve(base: Parameters | Case, law: ContactLaw | str, param: str, v
     closed = np.array([(closed_form_kappa_c(_parameters(base, param, x)) or math.nan) if what != "grazing"
                        else math.nan for x in walk_x])
     return CriticalCurve(param, walk_x, walk_k, np.asarray(walk_req), closed, np.asarray(walk_pred),
-                         what, law, base, rtol, contact_index, message)
+                         what, law, base, kappa_rtol, contact_index, message)

@@ -22,9 +22,11 @@ from dataclasses import asdict, dataclass, field
 import numpy as np
 
 from ..integrate import scales, simulate
+from ..integrate.api import check_rtol
 from ..integrate.events import EVENT_KINDS
 from ..model.laws import REGISTRY, ContactLaw, as_law
 from ..parameters import KAPPA_MAX, Parameters, is_number
+from ._renamed import renamed_tolerances
 from .confirm import confirmed_count, stick_sequence_violation, tighter
 
 __all__ = [
@@ -316,7 +318,7 @@ class CriticalDamping:
     kappa_c : float or None
         Root of the first stick's margin, N s/m^(1+alpha); None when not found.
     rtol : float
-        Relative tolerance asked of ``kappa_c``.
+        Relative tolerance asked of ``kappa_c``: the call's ``kappa_rtol``.
     closed_form : float or None
         docs/physics.md §5's closed-form estimate.
     bracket : tuple of float
@@ -417,15 +419,16 @@ class CriticalDamping:
         return asdict(self)
 
 
+@renamed_tolerances("kappa_rtol")
 def critical_damping(params: Parameters, law: ContactLaw | str = "paper", *, kappa_min: float | None = None,
-                     kappa_max: float | None = None, rtol: float = 1e-10, integrator_rtol: float = 1e-10,
+                     kappa_max: float | None = None, kappa_rtol: float = 1e-10, rtol: float = 1e-10,
                      with_kappa_2: bool = False, with_exponents: bool = False) -> CriticalDamping:
     """Locate ``kappa_c``, the root of the first stick's margin, for any case.
 
     The bracket is seeded by the closed form (docs/physics.md §5) and widened geometrically within
     ``[kappa_min, kappa_max]`` (default: from the damping number ``kappa v / K`` = 1e-8, below
     which the approach is undamped, up to the inputs' limit ``KAPPA_MAX`` = 1e18) until the margin
-    changes sign; Brent's method narrows it to ``rtol`` (relative). Counts either side confirm it:
+    changes sign; Brent's method narrows it to ``kappa_rtol`` (relative). Counts either side confirm it:
     one permanent stick just below, two or more stick phases just above. No root in the range
     gives status ``not-found``, ``kappa_c`` None and a message saying what was searched ("no
     root ... up to kappa = ...", the margins at both ends), never that the stick cannot break
@@ -440,10 +443,12 @@ def critical_damping(params: Parameters, law: ContactLaw | str = "paper", *, kap
     kappa_min, kappa_max : float, optional
         Search range, N s/m^(1+alpha), ``0 < kappa_min < kappa_max <= 1e18``; an end not given
         is the default above.
+    kappa_rtol : float, default 1e-10
+        Relative tolerance of ``kappa_c``, ``1e-14 <= kappa_rtol <= 1e-2`` (called ``rtol`` up to
+        0.2.0).
     rtol : float, default 1e-10
-        Relative tolerance of ``kappa_c``, ``1e-14 <= rtol <= 1e-2``.
-    integrator_rtol : float, default 1e-10
-        Tolerance of every run, within :data:`~phaseimpact.integrate.RTOL_RANGE`.
+        The integrator's tolerance of every run, within :data:`~phaseimpact.integrate.RTOL_RANGE`
+        (called ``integrator_rtol`` up to 0.2.0; ``rtol=`` alone is refused for one release).
     with_kappa_2 : bool, default False
         Also locate ``kappa_2`` and sample the staircase (:func:`locate_kappa_2`).
     with_exponents : bool, default False
@@ -461,7 +466,9 @@ def critical_damping(params: Parameters, law: ContactLaw | str = "paper", *, kap
         If ``params`` is not :class:`~phaseimpact.Parameters`.
     ValueError
         For a law that is not a Filippov law (unilateral laws have grazing transitions:
-        :func:`transitions`), ``rtol`` or the search range out of range.
+        :func:`transitions`), ``kappa_rtol``, ``rtol`` or the search range out of range.
+    TypeError
+        For the spellings of 0.2.0 (``integrator_rtol=``; ``rtol=`` without ``kappa_rtol=``).
 
     Examples
     --------
@@ -479,23 +486,25 @@ def critical_damping(params: Parameters, law: ContactLaw | str = "paper", *, kap
         allowed = ", ".join(name for name, entry in REGISTRY.items() if entry.filippov)
         raise ValueError(f"law = {law.name!r} is out of range for the critical damping; allowed: a Filippov law "
                          f"({allowed}; unilateral laws have grazing transitions: use transitions())")
-    check_rtol_of_kappa(rtol)
+    check_rtol_of_kappa(kappa_rtol)
+    rtol = check_rtol(rtol)
     kappa_min, kappa_max = default_kappa_range(params, kappa_min, kappa_max)
     closed = closed_form_kappa_c(params)
     try:
-        result = _critical_damping(params, law, kappa_min, kappa_max, rtol, integrator_rtol, with_kappa_2,
+        result = _critical_damping(params, law, kappa_min, kappa_max, kappa_rtol, rtol, with_kappa_2,
                                    with_exponents, closed)
     except RunFailed as error:
-        result = CriticalDamping(law.name, law.contact, params.v, None, rtol, closed, (kappa_min, kappa_max),
+        result = CriticalDamping(law.name, law.contact, params.v, None, kappa_rtol, closed, (kappa_min, kappa_max),
                                  (math.nan, math.nan), "failed", f"a run of the search failed: {error}", 0,
                                  kappa_c_status="failed")
     return _replace(result, search_range=(kappa_min, kappa_max))
 
 
-def check_rtol_of_kappa(rtol) -> float:
-    if not (is_number(rtol) and 1e-14 <= rtol <= 1e-2):
-        raise ValueError(f"kappa_rtol = {rtol!r} is out of range; allowed: 1e-14 <= kappa_rtol <= 1e-2")
-    return float(rtol)
+def check_rtol_of_kappa(value) -> float:
+    """``kappa_rtol`` as a float, or ValueError naming it and its range, 1e-14 to 1e-2."""
+    if not (is_number(value) and 1e-14 <= value <= 1e-2):
+        raise ValueError(f"kappa_rtol = {value!r} is out of range; allowed: 1e-14 <= kappa_rtol <= 1e-2")
+    return float(value)
 
 
 def default_kappa_range(params: Parameters, kappa_min=None, kappa_max=None,
@@ -517,7 +526,7 @@ def default_kappa_range(params: Parameters, kappa_min=None, kappa_max=None,
     return check_kappa_range(lo, hi, names)
 
 
-def _critical_damping(params, law, kappa_min, kappa_max, rtol, integrator_rtol, with_kappa_2, with_exponents,
+def _critical_damping(params, law, kappa_min, kappa_max, kappa_rtol, rtol, with_kappa_2, with_exponents,
                       closed) -> CriticalDamping:
     from scipy.optimize import brentq  # imported where used: 0.5 s at start-up
     evaluations = 0
@@ -525,7 +534,7 @@ def _critical_damping(params, law, kappa_min, kappa_max, rtol, integrator_rtol, 
     def margin(log_kappa):
         nonlocal evaluations
         evaluations += 1
-        return first_stick_margin(params.replace(kappa=math.exp(log_kappa)), law, rtol=integrator_rtol)
+        return first_stick_margin(params.replace(kappa=math.exp(log_kappa)), law, rtol=rtol)
 
     lo, hi = math.log(kappa_min), math.log(kappa_max)
     start = min(max(math.log(closed), lo), hi) if closed else 0.5 * (lo + hi)
@@ -543,17 +552,17 @@ def _critical_damping(params, law, kappa_min, kappa_max, rtol, integrator_rtol, 
     kappa_lo, kappa_hi = sorted((math.exp(a), math.exp(b)))
     if (m_a >= 0) == (m_b >= 0):
         m_min, m_max = (margin(lo), margin(hi))
-        return CriticalDamping(law.name, law.contact, params.v, None, rtol, closed, (kappa_min, kappa_max),
+        return CriticalDamping(law.name, law.contact, params.v, None, kappa_rtol, closed, (kappa_min, kappa_max),
                                (m_min, m_max), "not-found",
                                _not_found_message(params, kappa_min, kappa_max, m_min, m_max, closed), evaluations,
                                kappa_c_status="not-found")
-    root = brentq(margin, min(a, b), max(a, b), xtol=rtol / 4, rtol=4 * np.finfo(float).eps, maxiter=200)
+    root = brentq(margin, min(a, b), max(a, b), xtol=kappa_rtol / 4, rtol=4 * np.finfo(float).eps, maxiter=200)
     kappa_c = math.exp(root)
-    accuracy, spent = _kappa_c_accuracy(params, law, root, rtol, integrator_rtol)
+    accuracy, spent = _kappa_c_accuracy(params, law, root, kappa_rtol, rtol)
     evaluations += spent
     # confirm with the counts either side, far enough from kappa_c for short runs
-    below = confirmed_count(params.replace(kappa=kappa_c * (1 - SIDE_OFFSET)), law, integrator_rtol)
-    above = confirmed_count(params.replace(kappa=kappa_c * (1 + SIDE_OFFSET)), law, integrator_rtol)
+    below = confirmed_count(params.replace(kappa=kappa_c * (1 - SIDE_OFFSET)), law, rtol)
+    above = confirmed_count(params.replace(kappa=kappa_c * (1 + SIDE_OFFSET)), law, rtol)
     evaluations += 4
     ok = below.confirmed and above.confirmed and below.n_stick == 1 and not below.cut and above.n_stick >= 2
     message = (f"kappa_c = {kappa_c:.10g} N s/m^(1+alpha), estimated relative error {_fmt_accuracy(accuracy)} "
@@ -562,16 +571,16 @@ def _critical_damping(params, law, kappa_min, kappa_max, rtol, integrator_rtol, 
     if not ok:
         message += "; " + "; ".join(r for r in (below.reason, above.reason) if r) if (below.reason or above.reason) \
             else "; the counts either side do not show a permanent stick below and a break above"
-    result = CriticalDamping(law.name, law.contact, params.v, kappa_c, rtol, closed, (kappa_lo, kappa_hi),
+    result = CriticalDamping(law.name, law.contact, params.v, kappa_c, kappa_rtol, closed, (kappa_lo, kappa_hi),
                              (float(m_a), float(m_b)), "success" if ok else "unconfirmed", message, evaluations,
                              kappa_c_accuracy=accuracy, n_below=below.n_stick if below.confirmed else None,
                              n_above=above.n_stick if above.confirmed else None,
                              kappa_c_status="confirmed" if ok else "unconfirmed")
     if with_kappa_2 and ok:
-        result = _with_kappa_2(result, params, law, integrator_rtol)
+        result = _with_kappa_2(result, params, law, rtol)
     if with_exponents and ok:
         result = _replace(result, classification="adding-sliding",
-                          exponents=adding_sliding_exponents(params, law, kappa_c, integrator_rtol=integrator_rtol))
+                          exponents=adding_sliding_exponents(params, law, kappa_c, rtol=rtol))
     elif ok:
         result = _replace(result, classification="adding-sliding")
     return result
@@ -595,17 +604,19 @@ def _not_found_message(params, kappa_min, kappa_max, m_min, m_max, closed) -> st
 WIDENINGS = 12
 #: Offset of the two counts that confirm kappa_c (one permanent stick below, a break above).
 SIDE_OFFSET = 1e-3
+#: Relative width of kappa_2's final bracket, by default and wherever kappa_2 rides on kappa_c.
+KAPPA_2_RTOL = 1e-10
 
 
 def _fmt_accuracy(accuracy) -> str:
     return "unknown" if accuracy is None else f"{accuracy:.1e}"
 
 
-def _kappa_c_accuracy(params, law, log_root, rtol, integrator_rtol):
+def _kappa_c_accuracy(params, law, log_root, kappa_rtol, rtol):
     """Relative error estimate of kappa_c: the bracket width plus the root's move at a tighter
     integrator tolerance (Brent again, in a narrow bracket around the first root)."""
     from scipy.optimize import brentq
-    tight = tighter(integrator_rtol)
+    tight = tighter(rtol)
     spent = 0
 
     def margin(log_kappa):
@@ -617,14 +628,14 @@ def _kappa_c_accuracy(params, law, log_root, rtol, integrator_rtol):
         lo, hi = log_root - width, log_root + width
         m_lo, m_hi = margin(lo), margin(hi)
         if (m_lo >= 0) != (m_hi >= 0):
-            root = brentq(margin, lo, hi, xtol=rtol / 4, rtol=4 * np.finfo(float).eps, maxiter=200)
-            return rtol + abs(math.expm1(root - log_root)), spent
+            root = brentq(margin, lo, hi, xtol=kappa_rtol / 4, rtol=4 * np.finfo(float).eps, maxiter=200)
+            return kappa_rtol + abs(math.expm1(root - log_root)), spent
     return None, spent
 
 
-def _with_kappa_2(result: CriticalDamping, params, law, integrator_rtol) -> CriticalDamping:
+def _with_kappa_2(result: CriticalDamping, params, law, rtol) -> CriticalDamping:
     """``result`` with kappa_2, its accuracy and the staircase, and the status they allow."""
-    found = locate_kappa_2(params, law, result.kappa_c, integrator_rtol=integrator_rtol)
+    found = locate_kappa_2(params, law, result.kappa_c, kappa_rtol=KAPPA_2_RTOL, rtol=rtol)
     kappa_2, accuracy, staircase, reason = found.kappa_2, found.accuracy, found.staircase, found.reason
     message = result.message + (f"; kappa_2 = {kappa_2:.10g}, estimated relative error {_fmt_accuracy(accuracy)}"
                                 if kappa_2 is not None else "")
@@ -686,10 +697,11 @@ class Kappa2:
     reason: str
 
 
-def locate_kappa_2(params: Parameters, law: ContactLaw | str, kappa_c: float, *, rtol: float = 1e-10,
-                   integrator_rtol: float = 1e-10, samples: int = 24):
+@renamed_tolerances("kappa_rtol")
+def locate_kappa_2(params: Parameters, law: ContactLaw | str, kappa_c: float, *, kappa_rtol: float = KAPPA_2_RTOL,
+                   rtol: float = 1e-10, samples: int = 24):
     """``kappa_2``: the smallest ``kappa`` from which ``N = 2``, by bisection on ``N`` in
-    ``log(kappa/kappa_c - 1)`` to a bracket of relative width ``rtol``, whose ends are then
+    ``log(kappa/kappa_c - 1)`` to a bracket of relative width ``kappa_rtol``, whose ends are then
     confirmed (:func:`.confirm.confirmed_count`); and the staircase of ``N`` sampled from
     ``1.5 (kappa_2/kappa_c - 1)`` down to ``min(1e-5, (kappa_2/kappa_c - 1)/10)``, each count
     confirmed, stopping at the first run the horizon cuts (closer to ``kappa_c`` the escape only
@@ -703,10 +715,11 @@ def locate_kappa_2(params: Parameters, law: ContactLaw | str, kappa_c: float, *,
         ``paper`` or another Filippov law.
     kappa_c : float
         The critical damping (:func:`critical_damping`), N s/m^(1+alpha).
+    kappa_rtol : float, default 1e-10
+        Relative width of the final bracket of ``kappa_2`` (not checked here; ``rtol`` up to 0.2.0).
     rtol : float, default 1e-10
-        Relative width of the final bracket of ``kappa_2`` (not checked here).
-    integrator_rtol : float, default 1e-10
-        Tolerance of every run, within :data:`~phaseimpact.integrate.RTOL_RANGE`.
+        The integrator's tolerance of every run, within :data:`~phaseimpact.integrate.RTOL_RANGE`
+        (``integrator_rtol`` up to 0.2.0).
     samples : int, default 24
         Points of the staircase (0: none).
 
@@ -738,14 +751,14 @@ def locate_kappa_2(params: Parameters, law: ContactLaw | str, kappa_c: float, *,
     def count(eps):
         nonlocal evaluations
         evaluations += 1
-        run = simulate(params.replace(kappa=kappa_c * (1 + eps)), law, None, rtol=integrator_rtol)
-        violation = stick_sequence_violation(run, integrator_rtol) if run.status == "success" else run.message
+        run = simulate(params.replace(kappa=kappa_c * (1 + eps)), law, None, rtol=rtol)
+        violation = stick_sequence_violation(run, rtol) if run.status == "success" else run.message
         return run.n_stick, violation
 
     def confirmed(eps):
         nonlocal evaluations
         evaluations += 2
-        return confirmed_count(params.replace(kappa=kappa_c * (1 + eps)), law, integrator_rtol)
+        return confirmed_count(params.replace(kappa=kappa_c * (1 + eps)), law, rtol)
 
     eps_hi = 1e-3
     while count(eps_hi)[0] != 2:
@@ -757,7 +770,7 @@ def locate_kappa_2(params: Parameters, law: ContactLaw | str, kappa_c: float, *,
         eps_hi, eps_lo = eps_lo, eps_lo / 2
         if eps_lo < 1e-12:
             return Kappa2(None, None, None, [], evaluations, "N = 2 down to kappa_c (1 + 1e-12)")
-    while (eps_hi - eps_lo) / (1 + eps_hi) > rtol:
+    while (eps_hi - eps_lo) / (1 + eps_hi) > kappa_rtol:
         mid = math.sqrt(eps_lo * eps_hi)
         if mid in (eps_lo, eps_hi):
             break
@@ -809,8 +822,9 @@ def locate_kappa_2(params: Parameters, law: ContactLaw | str, kappa_c: float, *,
     return Kappa2(kappa_2, accuracy, n_below, staircase[::-1], evaluations, reason)
 
 
+@renamed_tolerances(None)
 def adding_sliding_exponents(params: Parameters, law: ContactLaw | str, kappa_c: float, *,
-                             eps=(1e-7, 3e-7, 1e-6, 3e-6, 1e-5), integrator_rtol: float = 1e-12) -> dict:
+                             eps=(1e-7, 3e-7, 1e-6, 3e-6, 1e-5), rtol: float = 1e-12) -> dict:
     """Local exponents of the adding-sliding at ``kappa_c``: the first slip's largest speed
     ``~ eps^(3/2)`` and the offset between the first two stick depths ``~ eps^2``
     (``eps = kappa/kappa_c - 1``), fitted on log-log over ``eps``.
@@ -825,8 +839,9 @@ def adding_sliding_exponents(params: Parameters, law: ContactLaw | str, kappa_c:
         The critical damping (:func:`critical_damping`), N s/m^(1+alpha).
     eps : sequence of float, default (1e-7, 3e-7, 1e-6, 3e-6, 1e-5)
         Relative offsets above ``kappa_c`` (> 0).
-    integrator_rtol : float, default 1e-12
-        Tolerance of the runs, within :data:`~phaseimpact.integrate.RTOL_RANGE`.
+    rtol : float, default 1e-12
+        The integrator's tolerance of the runs, within :data:`~phaseimpact.integrate.RTOL_RANGE`
+        (``integrator_rtol`` up to 0.2.0).
 
     Returns
     -------
@@ -849,7 +864,7 @@ def adding_sliding_exponents(params: Parameters, law: ContactLaw | str, kappa_c:
     speeds, offsets = [], []
     for e in eps:
         p = params.replace(kappa=kappa_c * (1 + e))
-        first = simulate(p, law, None, rtol=integrator_rtol, stop_on=("stick", 2))
+        first = simulate(p, law, None, rtol=rtol, stop_on=("stick", 2))
         sticks = first.events_of("stick")
         slips = first.events_of("slip")
         if len(sticks) < 2 or not slips:
@@ -858,7 +873,7 @@ def adding_sliding_exponents(params: Parameters, law: ContactLaw | str, kappa_c:
             continue
         t0, t1 = slips[0].t, next(ev.t for ev in first.events if ev.t > slips[0].t and ev.kind in ("stick", "reversal"))
         grid = np.linspace(t0, t1, 401)[1:-1]
-        fine = simulate(p, law, t1, rtol=integrator_rtol, save=grid)
+        fine = simulate(p, law, t1, rtol=rtol, save=grid)
         speeds.append(float(np.max(np.abs(fine.deltadot))))
         offsets.append(abs(sticks[1].delta - sticks[0].delta))
     eps = np.asarray(eps)
@@ -1037,15 +1052,16 @@ class Transition:
         return asdict(self)
 
 
+@renamed_tolerances("kappa_rtol")
 def grazing_transitions(params: Parameters, law: ContactLaw | str, kappa_min: float, kappa_max: float, *,
-                        num: int = 96, rtol: float = 1e-9, integrator_rtol: float = 1e-10,
+                        num: int = 96, kappa_rtol: float = 1e-9, rtol: float = 1e-10,
                         progress: bool = False) -> list[Transition]:
     """Every grazing value of a unilateral law in ``[kappa_min, kappa_max]``, in order.
 
     The extrema of ``delta`` are sampled on a log grid of ``num`` values of ``kappa`` (at least
     :data:`MIN_SAMPLES_PER_DECADE` per decade); wherever the ``j``-th changes sign between
     neighbours, or comes close to zero at a local extreme in ``kappa`` without crossing on the grid
-    (a window narrower than the grid), its root is located by Brent's method to ``rtol``
+    (a window narrower than the grid), its root is located by Brent's method to ``kappa_rtol``
     (relative): :func:`delta_extremum` is the smooth defining function. A :class:`SamplingWarning`
     says when the grid is coarser than what it can resolve; :class:`RunFailed` (naming the kappa)
     when a run fails or the defining function does not bracket a root the samples showed.
@@ -1062,10 +1078,12 @@ def grazing_transitions(params: Parameters, law: ContactLaw | str, kappa_min: fl
     num : int, default 96
         Samples of the log grid of kappa: 8 to 10000, at least 4 per decade (16 per decade or
         more give no warning).
-    rtol : float, default 1e-9
-        Relative tolerance of each grazing value, ``1e-14 <= rtol <= 1e-2``.
-    integrator_rtol : float, default 1e-10
-        Tolerance of every run, within :data:`~phaseimpact.integrate.RTOL_RANGE`.
+    kappa_rtol : float, default 1e-9
+        Relative tolerance of each grazing value, ``1e-14 <= kappa_rtol <= 1e-2`` (``rtol`` up to
+        0.2.0).
+    rtol : float, default 1e-10
+        The integrator's tolerance of every run, within :data:`~phaseimpact.integrate.RTOL_RANGE`
+        (``integrator_rtol`` up to 0.2.0).
     progress : bool, default False
         Draw a progress bar on stderr while sampling.
 
@@ -1080,8 +1098,8 @@ def grazing_transitions(params: Parameters, law: ContactLaw | str, kappa_min: fl
     TypeError
         If ``params`` is not :class:`~phaseimpact.Parameters`.
     ValueError
-        For ``paper`` in its printed reading (no flight phase), or the range, ``num`` or ``rtol``
-        out of range.
+        For ``paper`` in its printed reading (no flight phase), or the range, ``num``,
+        ``kappa_rtol`` or ``rtol`` out of range.
     RunFailed
         When a run fails numerically, or a root the samples showed cannot be bracketed.
 
@@ -1111,7 +1129,8 @@ def grazing_transitions(params: Parameters, law: ContactLaw | str, kappa_min: fl
                          "contact='unilateral')")
     kappa_min, kappa_max = check_kappa_range(kappa_min, kappa_max)
     num = check_samples(num, kappa_min, kappa_max)
-    check_rtol_of_kappa(rtol)
+    check_rtol_of_kappa(kappa_rtol)
+    rtol = check_rtol(rtol)
     density = num / (math.log10(kappa_max) - math.log10(kappa_min))
     if density < WARN_SAMPLES_PER_DECADE:
         warnings.warn(f"{num} samples over kappa {kappa_min:g}..{kappa_max:g} are {density:.2g} per decade: a window "
@@ -1119,7 +1138,7 @@ def grazing_transitions(params: Parameters, law: ContactLaw | str, kappa_min: fl
                       f"missed ({WARN_SAMPLES_PER_DECADE} per decade resolve a factor "
                       f"{10 ** (1 / WARN_SAMPLES_PER_DECADE):.3g})", SamplingWarning, stacklevel=2)
     logk = np.linspace(math.log(kappa_min), math.log(kappa_max), num)
-    samples = [extrema(params.replace(kappa=math.exp(x)), law, rtol=integrator_rtol)
+    samples = [extrema(params.replace(kappa=math.exp(x)), law, rtol=rtol)
                for x in tqdm(logk, desc=f"grazing {law.name}", unit="kappa", disable=not progress)]
     deepest = max(len(e) for e in samples)
     if deepest > MAX_EXTREMA:
@@ -1133,10 +1152,10 @@ def grazing_transitions(params: Parameters, law: ContactLaw | str, kappa_min: fl
     scale = params.hertz_indentation
 
     def g(x, j):
-        return delta_extremum(params.replace(kappa=math.exp(x)), law, j, rtol=integrator_rtol)
+        return delta_extremum(params.replace(kappa=math.exp(x)), law, j, rtol=rtol)
 
     def root(lo, hi, j):
-        return _grazing_root(g, lo, hi, j, rtol)
+        return _grazing_root(g, lo, hi, j, kappa_rtol)
 
     found = []
     for j in range(1, depth + 1):
@@ -1172,7 +1191,7 @@ def grazing_transitions(params: Parameters, law: ContactLaw | str, kappa_min: fl
                     found.append((root(lo, hi, j), j))
     found.sort()
     step = logk[1] - logk[0]
-    close = [(a, b) for (a, _), (b, _) in zip(found, found[1:], strict=False) if 10 * rtol * b < b - a
+    close = [(a, b) for (a, _), (b, _) in zip(found, found[1:], strict=False) if 10 * kappa_rtol * b < b - a
              and math.log(b / a) < step]
     if close:
         a, b = close[0]
@@ -1181,15 +1200,15 @@ def grazing_transitions(params: Parameters, law: ContactLaw | str, kappa_min: fl
                       stacklevel=2)
     transitions = []
     for kappa, j in found:
-        if transitions and abs(kappa - transitions[-1].kappa) <= 10 * rtol * kappa:
+        if transitions and abs(kappa - transitions[-1].kappa) <= 10 * kappa_rtol * kappa:
             continue  # the same grazing seen by two extrema (a pair created or removed at it)
-        below = contact_count(params.replace(kappa=kappa * (1 - 1e-6)), law, rtol=integrator_rtol)
-        above = contact_count(params.replace(kappa=kappa * (1 + 1e-6)), law, rtol=integrator_rtol)
+        below = contact_count(params.replace(kappa=kappa * (1 - 1e-6)), law, rtol=rtol)
+        above = contact_count(params.replace(kappa=kappa * (1 + 1e-6)), law, rtol=rtol)
         transitions.append(Transition("grazing", kappa, below, above, j))
     return transitions
 
 
-def _grazing_root(g, lo: float, hi: float, j: int, rtol: float) -> float:
+def _grazing_root(g, lo: float, hi: float, j: int, kappa_rtol: float) -> float:
     """The root of ``g(., j)`` in ``[lo, hi]`` (log kappa), ``kappa`` to ``rtol``; :class:`RunFailed`
     naming the bracket when the defining function does not change sign there."""
     from scipy.optimize import brentq  # imported where used: 0.5 s at start-up
@@ -1199,11 +1218,12 @@ def _grazing_root(g, lo: float, hi: float, j: int, rtol: float) -> float:
         raise RunFailed(f"kappa = {math.exp(lo):.6g} to {math.exp(hi):.6g}: extremum {j} of delta changes sign between "
                         f"the samples but not in single runs (delta = {g_lo:.3g} and {g_hi:.3g} m at the ends): no "
                         "grazing can be located there")
-    return math.exp(brentq(g, lo, hi, args=(j,), xtol=rtol / 4, rtol=4 * np.finfo(float).eps))
+    return math.exp(brentq(g, lo, hi, args=(j,), xtol=kappa_rtol / 4, rtol=4 * np.finfo(float).eps))
 
 
+@renamed_tolerances("kappa_rtol")
 def transitions(params: Parameters, law: ContactLaw | str, kappa_min: float, kappa_max: float, *,
-                rtol: float = 1e-9, integrator_rtol: float = 1e-10, num: int = 96,
+                kappa_rtol: float = 1e-9, rtol: float = 1e-10, num: int = 96,
                 progress: bool = False) -> list[Transition]:
     """Every transition of the long-time count in ``[kappa_min, kappa_max]``, in order.
 
@@ -1220,10 +1240,12 @@ def transitions(params: Parameters, law: ContactLaw | str, kappa_min: float, kap
         A law that reads ``kappa``.
     kappa_min, kappa_max : float
         The range, N s/m^(1+alpha), ``0 < kappa_min < kappa_max <= 1e18``.
-    rtol : float, default 1e-9
-        Relative tolerance of each located value, ``1e-14 <= rtol <= 1e-2``.
-    integrator_rtol : float, default 1e-10
-        Tolerance of every run, within :data:`~phaseimpact.integrate.RTOL_RANGE`.
+    kappa_rtol : float, default 1e-9
+        Relative tolerance of each located value, ``1e-14 <= kappa_rtol <= 1e-2`` (``rtol`` up to
+        0.2.0).
+    rtol : float, default 1e-10
+        The integrator's tolerance of every run, within :data:`~phaseimpact.integrate.RTOL_RANGE`
+        (``integrator_rtol`` up to 0.2.0; ``rtol=`` alone is refused for one release).
     num : int, default 96
         Samples of a grazing search (unilateral laws; see :func:`grazing_transitions`).
     progress : bool, default False
@@ -1261,10 +1283,10 @@ def transitions(params: Parameters, law: ContactLaw | str, kappa_min: float, kap
                          "that reads kappa (paper, hunt-crossley) without restitution")
     kappa_min, kappa_max = check_kappa_range(kappa_min, kappa_max)
     if not law.is_filippov:
-        return grazing_transitions(params, law, kappa_min, kappa_max, num=num, rtol=rtol,
-                                   integrator_rtol=integrator_rtol, progress=progress)
-    critical = critical_damping(params, law, kappa_min=kappa_min, kappa_max=kappa_max, rtol=rtol,
-                                integrator_rtol=integrator_rtol, with_kappa_2=True)
+        return grazing_transitions(params, law, kappa_min, kappa_max, num=num, kappa_rtol=kappa_rtol,
+                                   rtol=rtol, progress=progress)
+    critical = critical_damping(params, law, kappa_min=kappa_min, kappa_max=kappa_max, kappa_rtol=kappa_rtol,
+                                rtol=rtol, with_kappa_2=True)
     if critical.status == "failed":
         raise RunFailed(critical.message)
     out = []
