@@ -147,8 +147,8 @@ and object headers (attributes included) are checksummed; root attribute ``text_
 SHA-256 of the text attributes (HDF5 keeps them in its global heap, without a checksum); the chunk
 index (a v1 B-tree, without one) is checked on load. Fletcher-32 passes a chunk whose data and checksum
 were both zeroed or filled with 0xFF: root attribute ``data_sha256`` is the SHA-256 of each dataset's
-contents (:func:`_dataset_digest`), checked by :func:`load`; a file written before it, or killed while a
-checkpoint wrote in place, loads unverified by it. :func:`load` and :func:`describe` also check the
+contents (:func:`_dataset_digest`), checked by :func:`load`; a file written before it, killed while a
+checkpoint wrote in place, or copied by another netCDF writer (xarray), loads unverified by it. :func:`load` and :func:`describe` also check the
 content (codes within their tables, finite axes, scalar attributes; :func:`load`: a finite
 ``max_force`` where a run succeeded, counts >= -1 at computed points) and refuse a damaged file with a
 :class:`DamagedArchiveError` (a ``ValueError``) that names it and the damage; what a checkpoint
@@ -966,13 +966,15 @@ def stick_phases(ds_or_path):
 
 
 def _texts_digest(f) -> str:
-    """SHA-256 of the text attributes :func:`load` reads: the root's (but the digest's own) and those of
+    """SHA-256 of the text attributes :func:`load` reads: the root's (but the digests') and those of
     ``/extras`` (object path, name, value)."""
     h = hashlib.sha256()
 
     def add(name, node):
-        for key in sorted(node.attrs):  # not netCDF's reserved attributes (_NCProperties): the library's
-            value = node.attrs[key] if key != _TEXT_DIGEST and not key.startswith("_") else None
+        # not netCDF's reserved attributes (_NCProperties): the library's; not the data digests, which a
+        # checkpoint rewrites in place (they protect themselves: a changed one matches no data)
+        for key in sorted(node.attrs):
+            value = node.attrs[key] if key not in (_TEXT_DIGEST, _DATA_DIGEST) and not key.startswith("_") else None
             if isinstance(value, bytes):  # netCDF4 (xarray's re-save) writes texts as fixed-length bytes
                 value = value.decode("utf-8", "replace")
             if isinstance(value, str):
@@ -990,13 +992,20 @@ def _piece_digests(data: np.ndarray) -> list:
     flat = np.ascontiguousarray(data).reshape(-1)
     if flat.dtype.kind not in "biufc":  # text: its characters, not the addresses of Python objects
         flat = np.array([_json(x.decode() if isinstance(x, bytes) else x) for x in flat.tolist()], dtype=str)
+    else:  # the values, whatever the byte order a writer chose (xarray's copy may store big-endian)
+        flat = flat.astype(flat.dtype.newbyteorder("<"), copy=False)
     return [hashlib.sha256(flat[i:i + _DIGEST_PIECE].tobytes()).digest()
             for i in range(0, max(flat.size, 1), _DIGEST_PIECE)]
 
 
+def _little_endian(dtype) -> np.dtype:
+    dtype = np.dtype(dtype)
+    return dtype.newbyteorder("<") if dtype.kind in "biufc" else dtype
+
+
 def _dataset_digest(dtype, shape, pieces) -> str:
     """A dataset's digest: of its type, shape and the digests of its pieces; whatever its chunks or filters."""
-    h = hashlib.sha256(_json([np.dtype(dtype).str, list(shape)]).encode())
+    h = hashlib.sha256(_json([_little_endian(dtype).str, list(shape)]).encode())
     for piece in pieces:
         h.update(piece)
     return h.hexdigest()
@@ -1038,9 +1047,11 @@ def _stored_digests(f) -> dict | None:
 
 
 def _check_data_digests(f) -> None:
-    """Every dataset's contents against :data:`_DATA_DIGEST`, where the file has it."""
+    """Every dataset's contents against :data:`_DATA_DIGEST`, where the file has it. Not in a copy that
+    another netCDF writer made (xarray's ``to_netcdf``): it carries the attribute over, but a subset or a
+    re-encoding is not the data it was computed from; such a copy is checked by its content alone."""
     stored = _stored_digests(f)
-    if stored is None:
+    if stored is None or _netcdf_writer(f) is not None:
         return
     pieces = _file_pieces(f)
     for name in sorted(set(stored) | set(pieces)):

@@ -121,7 +121,7 @@ def test_a_subset_that_is_no_archive_is_refused_as_xarrays_copy(change, reason, 
 
 def test_extras_left_out_by_xarray_are_named(results, tmp_path):
     grid = results["atlas"]
-    found = refine_boundaries(grid, "kappa", rtol=1e-4)
+    found = refine_boundaries(grid, "kappa", refine_rtol=1e-4)
     refined = grid.__class__(grid.grid, grid.t_end, grid.settings, status=grid.status, outcome=grid.outcome,
                              stop_reason=grid.stop_reason, stick_point=grid.stick_point, stick_t=grid.stick_t,
                              stick_delta=grid.stick_delta, stick_dwell=grid.stick_dwell,
