@@ -2530,7 +2530,7 @@ def _read_curve_v1(f) -> CriticalCurve:
 def describe(path) -> dict:
     """The identity of the work an archive holds, read from its header and axes only.
 
-    Returns ``{"kind", "law", "parameters", "axes", "t_end", "rtol", "schema_version"}``
+    Returns ``{"kind", "law", "law_source", "parameters", "axes", "t_end", "rtol", "schema_version"}``
     (``axes``: ``{name: values}``, names as given, e.g. ``plate.E``). Raises ``ValueError`` if
     ``path`` is not a phaseimpact archive, or its header or axes are damaged.
 
@@ -2542,7 +2542,8 @@ def describe(path) -> dict:
     Returns
     -------
     dict
-        ``kind`` (one of :data:`KINDS`), ``law`` (the law as a dict), ``parameters`` (the base's
+        ``kind`` (one of :data:`KINDS`), ``law`` (the law as a dict), ``law_source`` (a user law's
+        source digest, :attr:`~phaseimpact.model.ContactLaw.source`; None for a shipped law), ``parameters`` (the base's
         :class:`~phaseimpact.Parameters` as a dict, SI), ``axes``, ``t_end`` (s; NaN: each run
         until its outcome settles), ``rtol`` and ``schema_version``.
 
@@ -2642,8 +2643,8 @@ def same_work(held: dict, kind: str, law: ContactLaw, params: Parameters, axes: 
     Returns
     -------
     list of str
-        One phrase per difference (kind, law, parameters, axes, ``t_end``, ``rtol``), each with
-        both values.
+        One phrase per difference (kind, law, a user law's source, parameters, axes, ``t_end``,
+        ``rtol``), each with both values.
 
     Examples
     --------
@@ -2726,6 +2727,9 @@ def check_overwrite(path, kind: str, law: ContactLaw, params: Parameters, axes: 
         return
     try:
         held = describe(path)
+    except _Refusal as error:  # an archive of a user law not defined here: not comparable, not damaged
+        raise ValueError(f"{name} = {path!r} exists and cannot be compared ({error}); refusing to overwrite it "
+                         "(choose another path, or add --force to replace it)") from None
     except DamagedArchiveError as error:
         raise ValueError(f"{name} = {path!r} exists and is a damaged phaseimpact archive ({error.reason}); refusing "
                          "to overwrite it (choose another path, or add --force to replace it)") from None
