@@ -1998,14 +1998,16 @@ def _load_law_files(argv) -> tuple[list, dict]:
 
 
 def _law_of_files(args, files: dict) -> None:
-    """``--law-file`` without ``--law``: the file's one law (unless the case names one of its laws);
-    the case's law, paper by default, would silently ignore the file."""
+    """``--law-file`` without ``--law``: the file's one law (unless the case names a user law); a
+    shipped law of the case, paper by default, would silently ignore the file."""
+    from .model import LAWS
+
     if not files or not hasattr(args, "law") or args.command == "check-law" or args.law is not None \
             or "law" in _setting_names(args):
         return
     defined = [name for names in files.values() for name in names]
     case = getattr(args, "case", None)
-    if case is not None and case.impact["law"] in defined:
+    if case is not None and case.impact["law"] not in LAWS:
         return
     from .model.userlaw import single_law
 
