@@ -49,7 +49,7 @@ SLOW = textwrap.dedent('''\
 
     def force(delta, deltadot, K, kappa, alpha):
         s = 0.0
-        for i in range(200000):  # milliseconds per call: thousands of calls between two looks of the engine
+        for i in range(2000000):  # ~20 ms a call: the engine looks for signals every 4096 steps (minutes)
             s += math.sin(i * delta)
         return K * delta ** alpha * (1.0 + 1e-30 * s)
 
