@@ -8,7 +8,8 @@ Layout (``schema_version`` 5). Every variable of the result is in the root group
     / attrs       Conventions "CF-1.11", title, history, source, references (CF's), schema_version 5,
                   package_version, kind ("sweep": one axis, "atlas": two or more, "critical-curve"; or
                   one of TRAIN_KINDS: "impact-train", "orbit-diagram", "map-branch", "basins"), law
-                  (JSON), contact (its reading of |delta|^alpha), base ("parameters" or "case"), case (JSON:
+                  (JSON), contact (its reading of |delta|^alpha), law_source (a user law's only: the digest
+                  of its functions and law file), base ("parameters" or "case"), case (JSON:
                   the Case, or the Parameters), parameters (JSON, SI: the base's Parameters), engine, rtol,
                   t_end (s; NaN: each run until its outcome settles), created (ISO 8601 UTC; from
                   SOURCE_DATE_EPOCH when set), settings (JSON)
@@ -148,7 +149,8 @@ SHA-256 of the text attributes (HDF5 keeps them in its global heap, without a ch
 index (a v1 B-tree, without one) is checked on load. Fletcher-32 passes a chunk whose data and checksum
 were both zeroed or filled with 0xFF: root attribute ``data_sha256`` is the SHA-256 of each dataset's
 contents (:func:`_dataset_digest`), checked by :func:`load`; a file written before it, killed while a
-checkpoint wrote in place, or copied by another netCDF writer (xarray), loads unverified by it. :func:`load` and :func:`describe` also check the
+checkpoint wrote in place, or copied by another netCDF writer (xarray), loads unverified by it.
+:func:`load` and :func:`describe` also check the
 content (codes within their tables, finite axes, scalar attributes; :func:`load`: a finite
 ``max_force`` where a run succeeded, counts >= -1 at computed points) and refuse a damaged file with a
 :class:`DamagedArchiveError` (a ``ValueError``) that names it and the damage; what a checkpoint
@@ -271,6 +273,9 @@ _DATA_DIGEST = "data_sha256"
 _IN_PROGRESS = '{"checkpoint": "in progress"}'
 #: Elements (C order) per piece of a dataset's digest: a checkpoint hashes again only the pieces it wrote.
 _DIGEST_PIECE = 8192
+#: Root attribute of an archive of a user law: the law's source digest (:attr:`ContactLaw.source`; its
+#: functions and law file). ``--resume`` and overwrites compare it: an edited law is other work.
+_LAW_SOURCE = "law_source"
 
 
 # ------------------------------------------------------------------------------------------------
@@ -1083,6 +1088,8 @@ def _header(f, kind: str, law: ContactLaw | None, base, t_end, rtol, engine: str
     if law is not None:
         f.attrs["law"] = _json(law.as_dict())
         f.attrs["contact"] = str(law.contact)
+        if law.source is not None:  # a user law: its source is part of the work's identity
+            f.attrs[_LAW_SOURCE] = law.source
     for key, value in (_base_attrs(base) if base is not None else {}).items():
         f.attrs[key] = value
     f.attrs["engine"] = str(engine) or _ENGINE  # curves, transitions and trains run on the sweeps' engine
@@ -2077,7 +2084,7 @@ def _same_grid(f, r: SweepResult) -> bool:
     try:
         if _attr_str(f, "kind") != kind_of(r) or json.loads(_attr_str(f, "axes")) != list(grid.names):
             return False
-        if json.loads(_attr_str(f, "law")) != json.loads(_json(r.law.as_dict())):
+        if json.loads(_attr_str(f, "law")) != json.loads(_json(r.law.as_dict())) or _law_source(f) != r.law.source:
             return False
         base = _base_attrs(grid.base)
         if any(_attr_str(f, key) != value for key, value in base.items()):
@@ -2373,6 +2380,36 @@ def _law(f) -> ContactLaw:
     return ContactLaw(**_json_attr(f, "law", dict))
 
 
+def _law_source(f) -> str | None:
+    """The source digest of the archive's user law (:attr:`ContactLaw.source`); None for a shipped law's."""
+    return _attr_str(f, _LAW_SOURCE) if _LAW_SOURCE in f.attrs else None
+
+
+def _check_law_defined(f, path: str) -> None:
+    """Refuse, as what it is, an archive of a user law not defined in this process (not damage):
+    its results need the law's entry (name, units). A case that records its law file defines it
+    (the file is run, as :func:`_base` would)."""
+    from .model import LAWS, REGISTRY
+
+    name = _json_attr(f, "law", dict).get("name")
+    if not isinstance(name, str) or name in REGISTRY or name in LAWS:
+        return  # a shipped law's, a defined one's, or damage that the readers name
+    impact = _json_attr(f, "case", dict).get("impact") if "case" in f.attrs else None
+    law_file = impact.get("law_file") if isinstance(impact, dict) else None
+    if isinstance(law_file, str) and os.path.isfile(law_file):
+        from .model.userlaw import load_law_file
+
+        try:
+            load_law_file(law_file)
+        except ValueError as error:
+            raise _Refusal(f"{path!r} holds work of law {name!r}, a user law of the case's law file, which fails: "
+                           f"{error}") from None
+        if name in REGISTRY:
+            return
+    raise _Refusal(f"{path!r} holds work of law {name!r}, a user law: define it first (--law-file FILE, or "
+                   "phaseimpact.define_law in Python)")
+
+
 def _base(f):
     from .case import case_from_dict
 
@@ -2439,6 +2476,7 @@ def load(path):
 def _load(path: str):
     with _reading(path) as f:
         version = _checked_header(f, path)
+        _check_law_defined(f, path)
         kind = _attr_str(f, "kind")
         if kind in TRAIN_KINDS:  # schema 5 on
             result = _READERS[kind](f)
@@ -2744,7 +2782,7 @@ def _read_curve_v1(f) -> CriticalCurve:
 def describe(path) -> dict:
     """The identity of the work an archive holds, read from its header and axes only.
 
-    Returns ``{"kind", "law", "parameters", "axes", "t_end", "rtol", "schema_version"}``
+    Returns ``{"kind", "law", "law_source", "parameters", "axes", "t_end", "rtol", "schema_version"}``
     (``axes``: ``{name: values}``, names as given, e.g. ``plate.E``). Raises ``ValueError`` if
     ``path`` is not a phaseimpact archive, or its header or axes are damaged.
 
@@ -2756,7 +2794,8 @@ def describe(path) -> dict:
     Returns
     -------
     dict
-        ``kind`` (one of :data:`KINDS`), ``law`` (the law as a dict), ``parameters`` (the base's
+        ``kind`` (one of :data:`KINDS`), ``law`` (the law as a dict), ``law_source`` (a user law's
+        source digest, :attr:`~phaseimpact.model.ContactLaw.source`; None for a shipped law), ``parameters`` (the base's
         :class:`~phaseimpact.Parameters` as a dict, SI), ``axes``, ``t_end`` (s; NaN: each run
         until its outcome settles), ``rtol`` and ``schema_version``.
 
@@ -2785,8 +2824,10 @@ def _describe(path: str) -> dict:
 
     with _reading(path) as f:
         version = _checked_header(f, path)
+        _check_law_defined(f, path)
         kind = _attr_str(f, "kind")
         law = _law(f).as_dict()
+        law_source = _law_source(f)
         params = _json_attr(f, "parameters", dict)
         if kind in TRAIN_KINDS:
             axes = {}
@@ -2809,8 +2850,8 @@ def _describe(path: str) -> dict:
             axes = {param: axis(g, param, param)}
         if version >= 3:
             _check_metadata(f, data=False)
-        return {"kind": kind, "law": law, "parameters": params, "axes": axes, "t_end": _real_attr(f, "t_end"),
-                "rtol": _real_attr(f, "rtol"), "schema_version": version}
+        return {"kind": kind, "law": law, "law_source": law_source, "parameters": params, "axes": axes,
+                "t_end": _real_attr(f, "t_end"), "rtol": _real_attr(f, "rtol"), "schema_version": version}
 
 
 def _same_number(a, b) -> bool:
@@ -2866,8 +2907,8 @@ def same_work(held: dict, kind: str, law: ContactLaw, params: Parameters, axes: 
     Returns
     -------
     list of str
-        One phrase per difference (kind, law, parameters, axes, ``t_end``, ``rtol``), each with
-        both values.
+        One phrase per difference (kind, law, a user law's source, parameters, axes, ``t_end``,
+        ``rtol``), each with both values.
 
     Examples
     --------
@@ -2887,6 +2928,10 @@ def same_work(held: dict, kind: str, law: ContactLaw, params: Parameters, axes: 
         differences.append(f"kind {held['kind']!r}, not {kind!r}")
     if held["law"] != law.as_dict():
         differences.append(f"law {held['law']}, not {law.as_dict()}")
+    elif held.get("law_source") != law.source:
+        held_source = held.get("law_source") or "not recorded"
+        differences.append(f"law {law.name!r}: its source changed (the archive's was {held_source}, now "
+                           f"{law.source or 'a shipped law'}): the law file or functions were edited")
     asked = json.loads(_json(params.as_dict()))
     if held["parameters"] != asked:
         changed = sorted(k for k in set(asked) | set(held["parameters"])
@@ -2958,6 +3003,9 @@ def check_overwrite(path, kind: str, law: ContactLaw, params: Parameters, axes: 
             if kind == "critical-curve":
                 curve = load(path)
                 held["axes"] = {curve.param: np.asarray(curve.values)[np.asarray(curve.requested, dtype=bool)]}
+    except _Refusal as error:  # an archive of a user law not defined here: not comparable, not damaged
+        raise ValueError(f"{name} = {path!r} exists and cannot be compared ({error}); refusing to overwrite it "
+                         "(choose another path, or add --force to replace it)") from None
     except DamagedArchiveError as error:
         raise ValueError(f"{name} = {path!r} exists and is a damaged phaseimpact archive ({error.reason}); refusing "
                          "to overwrite it (choose another path, or add --force to replace it)") from None

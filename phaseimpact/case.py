@@ -234,21 +234,20 @@ def _impact_from(table) -> dict:
     return {key: out[key] for key in _IMPACT_KEYS}
 
 
-def _load_law_file(value, origin: str) -> str:
+def _load_law_file(value, origin: str) -> tuple[str, list]:
     """Run ``impact.law_file`` (its laws then pass ``impact.law``'s check); returns its absolute
-    path, so that the case as recorded (archives, JSON) finds it from anywhere."""
+    path, so that the case as recorded (archives, JSON) finds it from anywhere, and the names of
+    the laws it defines."""
     from .model.userlaw import load_law_file
 
-    path = Path(_string("impact.law_file", value, "a path to a .py file"))
+    path = Path(_string("impact.law_file", value, "a path to a Python file"))
     if not path.is_absolute() and origin not in ("<dict>", "") and Path(origin).suffix == ".toml":
         path = Path(origin).resolve().parent / path
-    if path.suffix != ".py":
-        raise ValueError(f"impact.law_file = {value!r} is out of range; allowed: a .py file")
     try:
-        load_law_file(path)
+        names = load_law_file(path)
     except ValueError as exc:
         raise ValueError(f"impact.law_file: {exc}") from None
-    return str(path.resolve())
+    return str(path.resolve()), names
 
 
 def _check_read_by_law(impact: dict) -> None:
@@ -546,7 +545,12 @@ def case_from_dict(data, origin: str = "<dict>") -> Case:
         text = {key: _string(key, data[key]) for key in ("name", "description", "source") if key in data}
         impact_table = data["impact"]
         if isinstance(impact_table, Mapping) and impact_table.get("law_file") is not None:
-            impact_table = {**impact_table, "law_file": _load_law_file(impact_table["law_file"], origin)}
+            path, names = _load_law_file(impact_table["law_file"], origin)
+            impact_table = {**impact_table, "law_file": path}
+            if "law" not in impact_table:  # the file's one law; the default paper would ignore the file
+                from .model.userlaw import single_law
+
+                impact_table["law"] = single_law(names, path, "impact.law")
         impact = _impact_from(impact_table)
         _check_read_by_law(impact)
         return Case(

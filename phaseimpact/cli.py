@@ -2180,11 +2180,11 @@ def _stopped(stop: KeyboardInterrupt) -> str:
     return "terminated (SIGTERM)" if isinstance(stop, _signals.Terminated) else "interrupted"
 
 
-def _load_law_files(argv) -> list:
+def _load_law_files(argv) -> tuple[list, dict]:
     """Run the files of ``--law-file FILE.py`` (they register laws with phaseimpact.define_law);
     return ``argv`` without them, so that every command takes them (``plot`` and ``info`` of an
-    archive of a user law too)."""
-    rest, i = [], 0
+    archive of a user law too), and ``{path: names of the laws it defines}``."""
+    rest, i, files = [], 0, {}
     while i < len(argv):
         arg = argv[i]
         if arg == "--":
@@ -2198,9 +2198,26 @@ def _load_law_files(argv) -> list:
             continue
         from .model.userlaw import load_law_file
 
-        load_law_file(path)
+        files[path] = load_law_file(path)
         i += 1 if arg.startswith("--law-file=") else 2
-    return rest
+    return rest, files
+
+
+def _law_of_files(args, files: dict) -> None:
+    """``--law-file`` without ``--law``: the file's one law (unless the case names a user law); a
+    shipped law of the case, paper by default, would silently ignore the file."""
+    from .model import LAWS
+
+    if not files or not hasattr(args, "law") or args.command == "check-law" or args.law is not None \
+            or "law" in _setting_names(args):
+        return
+    defined = [name for names in files.values() for name in names]
+    case = getattr(args, "case", None)
+    if case is not None and case.impact["law"] not in LAWS:
+        return
+    from .model.userlaw import single_law
+
+    args.law = single_law(defined, " and ".join(files), "--law NAME")
 
 
 _ANSI_ESCAPE = re.compile(r"\x1b\[[0-9;]*[A-Za-z]")
@@ -2241,10 +2258,15 @@ def main(argv=None) -> int:
     previous_term = signal.getsignal(signal.SIGTERM)
     try:
         argv = list(sys.argv[1:] if argv is None else argv)
-        parsed = _load_law_files(argv)  # before the parser: its --law choices include the file's laws
+        if any(arg == "--law-file" or arg.startswith("--law-file=") for arg in argv):
+            from . import _signals  # a law file compiles (seconds): Ctrl-C and SIGTERM end it with one line
+
+            _signals.install_command_line()
+        parsed, law_files = _load_law_files(argv)  # before the parser: its --law choices include the file's laws
         parser = build_parser()
         args = parser.parse_args(parsed)
         args.argv = argv
+        _law_of_files(args, law_files)
         if args.command not in _INTEGRATE_NOTHING:  # _signals imports numba (0.2 s): only where runs are stopped
             from . import _signals
 

@@ -381,25 +381,38 @@ def simulate(params: Parameters, law: ContactLaw | str = "paper", t_end: float |
                              f"max_steps = {max_steps}")
     if not _signals.installed:
         _signals.install()
+    native = law.entry.native
     while True:
+        if native is not None:
+            native.reset()
         if rk4_step:
             out = d.run_rk4(law.code, c, y0, horizon, save_kind, times, int(max_steps), rk4_step, int(every))
         else:
             out = d.run(law.code, c, y0, horizon, rtol, default_atol if atol is None else _atol(params, rtol, atol),
                         s.max_step, settle, stop_kind, stop_count, save_kind, times, int(max_steps), MAX_EVENTS,
                         stiff_after)
-        woken = out[0][d.S_STATUS] == d.INTERRUPTED
+        woken = _woken(out[0][d.S_STATUS], native)
         if not (woken or _signals.deferred):
             break
         _signals.check(woken)  # raises for Ctrl-C or SIGTERM; after an old wake-up, runs again
     summary, event_log, samples, y_final = out
+    law_fault = ""
+    if native is not None and native.faulted and summary[d.S_STATUS] != d.SUCCESS:
+        summary[d.S_STATUS] = d.NON_FINITE  # the law's NaN failed the run, whatever the steps made of it
+        law_fault = native.fault(law.name)
     status = d.STATUSES[int(summary[d.S_STATUS])]
     reason = d.STOP_REASONS[int(summary[d.S_REASON])]
     outcome = d.OUTCOMES[int(summary[d.S_OUTCOME])]
     return Trajectory(
         samples=samples, event_log=event_log, params=params, law=law, initial_state=y0, final_state=y_final,
         t_end=horizon, status=status, stop_reason=reason, outcome=outcome, summary=summary,
-        integrator=_integrator_name(rk4_step, rtol, stiff_after > 0))
+        integrator=_integrator_name(rk4_step, rtol, stiff_after > 0), law_fault=law_fault)
+
+
+def _woken(status, native) -> bool:
+    """Whether a signal stopped the run: the driver saw it (status ``interrupted``), or a user law
+    did (it then returns NaN, and the run fails at once: :mod:`phaseimpact.model.userlaw`)."""
+    return status == d.INTERRUPTED or (native is not None and native.stopped)
 
 
 @functools.lru_cache(maxsize=64)
@@ -481,30 +494,28 @@ def run_batch(batch: Batch, *, rtol: float, settle: bool = True, stop_on=None, n
     threads = max(1, min(int(n_threads), n))
     if not _signals.installed:
         _signals.install()
+    native = batch.law.entry.native
     while True:
+        if native is not None:
+            native.reset()
         if threads == 1:
             d.run_block(*args, 0, n, 1, *outputs)
         else:  # thread k runs k, k + threads, ...: equal loads (run_block); the driver releases the GIL
             with ThreadPoolExecutor(threads) as pool:
                 list(pool.map(lambda start: d.run_block(*args, start, n, threads, *outputs), range(threads)))
-        woken = bool(np.any(summary[:, d.S_STATUS] == d.INTERRUPTED))
+        woken = bool(np.any(summary[:, d.S_STATUS] == d.INTERRUPTED)) or _woken(d.SUCCESS, native)
         if not (woken or _signals.deferred):
             break
         _signals.check(woken)  # raises for Ctrl-C or SIGTERM; after an old wake-up, runs again
+    if native is not None and native.faulted:
+        _mark_law_faults(batch, summary, native, rtol, settle, stop_kind, stop_count, stiff_after)
     # the stick points of every run in run order: each run's first min(count, capacity) from the
     # buffers (one masked gather: a Python loop over the runs was the serial part of a threaded sweep)
     kept = np.arange(capacity) < np.minimum(count, capacity)[:, None]
     points = [st[j][kept] for j in range(3)]
     for i in np.flatnonzero(count > capacity)[::-1]:  # from the last, so earlier offsets stay valid
         # more stick phases than the buffer holds (near kappa_c): rerun this one for all of them
-        while True:
-            out = d.run(batch.law.code, batch.C[i], batch.Y0[i], batch.t_end[i], rtol, batch.atol[i],
-                        batch.max_step[i], settle, stop_kind, stop_count, d.SAVE_SUMMARY, _NO_TIMES, MAX_STEPS,
-                        MAX_EVENTS, stiff_after)
-            woken = out[0][d.S_STATUS] == d.INTERRUPTED
-            if not (woken or _signals.deferred):
-                break
-            _signals.check(woken)
+        out = _run_one(batch, i, rtol, settle, stop_kind, stop_count, stiff_after, native)
         k = int(count[i])
         full = np.empty((3, k))
         s = out[0]
@@ -512,6 +523,33 @@ def run_batch(batch: Batch, *, rtol: float, settle: bool = True, stop_on=None, n
         offset = int(np.minimum(count[:i], capacity).sum())
         points = [np.concatenate([p[:offset], full[j], p[offset + capacity:]]) for j, p in enumerate(points)]
     return Columns.from_summary(summary, count, *points)
+
+
+def _run_one(batch: Batch, i: int, rtol, settle, stop_kind, stop_count, stiff_after, native):
+    """Run ``i`` of ``batch`` alone, summary and stick points (again after an old wake-up)."""
+    while True:
+        if native is not None:
+            native.reset()
+        out = d.run(batch.law.code, batch.C[i], batch.Y0[i], batch.t_end[i], rtol, batch.atol[i],
+                    batch.max_step[i], settle, stop_kind, stop_count, d.SAVE_SUMMARY, _NO_TIMES, MAX_STEPS,
+                    MAX_EVENTS, stiff_after)
+        woken = _woken(out[0][d.S_STATUS], native)
+        if not (woken or _signals.deferred):
+            return out
+        _signals.check(woken)
+
+
+def _mark_law_faults(batch: Batch, summary, native, rtol, settle, stop_kind, stop_count, stiff_after) -> None:
+    """Give the status ``non-finite`` to the failed runs whose user law raised or gave NaN or inf.
+
+    The law's fault record is one for the whole batch (its runs share the compiled function, in
+    several threads): each failed run is run again alone (the same numbers: runs are independent)
+    to see whether its law faulted. Only failed runs can be the law's: a run whose law faulted on
+    a rejected trial step and then went on is a success."""
+    for i in np.flatnonzero(summary[:, d.S_STATUS] != d.SUCCESS):
+        _run_one(batch, i, rtol, settle, stop_kind, stop_count, stiff_after, native)
+        if native.faulted:
+            summary[i, d.S_STATUS] = d.NON_FINITE
 
 
 def simulate_many(params_seq, law: ContactLaw | str = "paper", t_end: float | None = None, *,

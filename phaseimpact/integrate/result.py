@@ -160,6 +160,9 @@ class Trajectory:
         The summary vector (see :mod:`.driver`, ``S_*``); read it through the properties.
     integrator : str
         The integrator and its settings, e.g. ``exact[DOP853+Radau5, rtol=1e-10]``.
+    law_fault : str
+        Of a run that a user law ended (status ``non-finite``): what its function raised or
+        returned, and at which ``delta`` (the :attr:`message`); else empty.
 
     Examples
     --------
@@ -183,6 +186,7 @@ class Trajectory:
     outcome: str
     summary: np.ndarray = field(repr=False)
     integrator: str = "exact"
+    law_fault: str = ""
 
     @property
     def t(self) -> np.ndarray:
@@ -232,6 +236,8 @@ class Trajectory:
     @property
     def message(self) -> str:
         """A sentence on how the run ended."""
+        if self.law_fault:
+            return f"{self.law_fault}: the run stopped at t = {self.t_stop:.6g} s"
         return run_message(self.status, self.stop_reason, self.t_stop, self.outcome)
 
     @property

@@ -703,7 +703,26 @@ class ContactLaw:
     def __getstate__(self):
         state = dict(self.__dict__)
         state.pop("_code", None)  # holds the entry (functions, a user law's compiled code): not pickled
+        entry = REGISTRY.get(self.name)
+        if entry is not None and entry.native is not None:  # a worker process defines the user law again
+            state["_recipe"] = entry.native.recipe(self.name)
         return state
+
+    def __setstate__(self, state):
+        state = dict(state)
+        recipe = state.pop("_recipe", None)
+        if recipe is not None:
+            from .userlaw import ensure_defined
+
+            ensure_defined(recipe)
+        self.__dict__.update(state)
+
+    @property
+    def source(self) -> str | None:
+        """A user law's source digest (its functions and law file; recorded in its archives), None
+        for a shipped law."""
+        native = self.entry.native
+        return None if native is None else native.identity
 
     @property
     def is_filippov(self) -> bool:

@@ -17,7 +17,7 @@ from llvmlite import ir
 from numba import njit, types
 from numba.extending import intrinsic
 
-__all__ = ["call_native", "call_native_compiled", "SIGNATURE", "CTYPES_SIGNATURE"]
+__all__ = ["call_native", "call_native_compiled", "SIGNATURE", "CTYPES_SIGNATURE", "slot_load", "slot_store"]
 
 #: The C signature of a user law's compiled function.
 SIGNATURE = types.float64(types.int64, types.float64, types.float64, types.int64, types.float64, types.float64,
@@ -51,3 +51,25 @@ def call_native_compiled(address, which, delta, deltadot, mode, K, damping, alph
     """:func:`call_native` in compiled code: an indirect call through ``address``."""
     return _call(np.int64(address), np.int64(which), np.float64(delta), np.float64(deltadot), np.int64(mode),
                  np.float64(K), np.float64(damping), np.float64(alpha))
+
+
+@intrinsic
+def slot_load(typingctx, address, index):
+    """Compiled code only: the float64 at ``address`` + ``index`` (a user law's fault record,
+    :class:`phaseimpact.model.userlaw.NativeLaw`)."""
+    def codegen(context, builder, sig, args):
+        pointer = builder.inttoptr(args[0], ir.DoubleType().as_pointer())
+        return builder.load(builder.gep(pointer, [args[1]]))
+
+    return types.float64(types.int64, types.int64), codegen
+
+
+@intrinsic
+def slot_store(typingctx, address, index, value):
+    """Compiled code only: store ``value`` as the float64 at ``address`` + ``index``."""
+    def codegen(context, builder, sig, args):
+        pointer = builder.inttoptr(args[0], ir.DoubleType().as_pointer())
+        builder.store(args[2], builder.gep(pointer, [args[1]]))
+        return context.get_dummy_value()
+
+    return types.void(types.int64, types.int64, types.float64), codegen

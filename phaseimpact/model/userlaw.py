@@ -36,19 +36,49 @@ the bodies together stays within ``|g(delta, 0)|``. ``paper`` itself, as a user 
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import inspect
 import math
 import os
+import re
+import stat
 import sys
-from dataclasses import dataclass
+import types
+from dataclasses import dataclass, field
 
-from .laws import GUARD_ENERGY_FACTOR, LAWS, NATIVE, PLAIN, REGISTRY, RUNAWAY_ENERGY_FACTOR, LawEntry, register
+from .laws import (
+    D_DELTA,
+    D_RATE,
+    FORCE,
+    GUARD_ENERGY_FACTOR,
+    LAWS,
+    NATIVE,
+    PLAIN,
+    POTENTIAL,
+    REGISTRY,
+    RUNAWAY_ENERGY_FACTOR,
+    LawEntry,
+    register,
+)
 
 __all__ = ["define_law", "load_law_file", "UserLawError"]
 
 _ARGUMENTS = {"force": 5, "partials": 5, "potential": 3}
 _SAMPLES = ((1e-6, 0.5), (1e-5, -0.3), (2e-5, 1.0), (1e-7, 0.0))  # (delta, deltadot), seed-like scales
+
+# A user law's fault record (NativeLaw.record), written by its compiled function: the first call
+# that raised or gave a non-finite value (its kind and arguments), whether a signal stopped the
+# law, and a count of calls between two looks for a signal.
+(REC_FAULT, REC_WHICH, REC_DELTA, REC_DELTADOT, REC_MODE, REC_K, REC_DAMPING, REC_ALPHA, REC_STOP,
+ REC_CALLS) = range(10)
+N_RECORD = 10
+NO_FAULT, RAISED, NOT_A_NUMBER, INFINITE = 0, 1, 2, 3
+#: Calls of a user law between two looks for Ctrl-C or SIGTERM (a ``poll``, about 0.3 us): a law
+#: whose every call is slow still stops within a fraction of a second.
+POLL_CALLS = 64
+_FUNCTION_NAMES = {FORCE: "force", D_DELTA: "partials", D_RATE: "partials", POTENTIAL: "potential"}
+_ANSI = re.compile(r"\x1b\[[0-9;]*[A-Za-z]")
 
 
 class UserLawError(ValueError):
@@ -73,19 +103,71 @@ class UserLawError(ValueError):
 
 @dataclass(frozen=True)
 class NativeLaw:
-    """A user law's compiled function (kept alive here: the engine calls its address)."""
+    """A user law's compiled function (kept alive here: the engine calls its address).
+
+    ``identity``: a digest of its source (the functions', the values of the globals they read, and
+    the bytes of the law file that defined it), recorded in every archive of its work.
+    ``path``: that law file, or None. ``definition``: the arguments of :func:`define_law`, for a
+    worker process that has to define the law again. ``record``: the fault record its compiled
+    function writes (``REC_*``).
+    """
 
     address: int
     cfunc: object
-    digest: str
+    identity: str
     functions: dict
+    record: object = field(repr=False)
+    path: str | None = None
+    definition: dict = field(default_factory=dict, repr=False)
+
+    def reset(self) -> None:
+        """Clear the record before a run."""
+        self.record[:] = 0.0
+
+    @property
+    def stopped(self) -> bool:
+        """A signal (Ctrl-C, SIGTERM) arrived while the law ran: it returned NaN from then on."""
+        return self.record[REC_STOP] != 0.0
+
+    @property
+    def faulted(self) -> bool:
+        """A call raised or gave a non-finite value since the last :meth:`reset`."""
+        return self.record[REC_FAULT] != NO_FAULT
+
+    def fault(self, name: str) -> str:
+        """One line on the recorded fault: the law, the function, what it did and where."""
+        r = self.record
+        which = int(r[REC_WHICH])
+        delta, deltadot, K, damping, alpha = (float(r[i]) for i in (REC_DELTA, REC_DELTADOT, REC_K, REC_DAMPING,
+                                                                     REC_ALPHA))
+        label = _FUNCTION_NAMES.get(which, "force")
+        kind = int(r[REC_FAULT])
+        if kind == RAISED:
+            what = "raised an exception"
+            function = self.functions.get(label) or self.functions["force"]
+            args = (delta, K, alpha) if label == "potential" else (delta, deltadot, K, damping, alpha)
+            try:  # the same call in Python names the exception (numba's except clause cannot)
+                function(*args)
+            except Exception as exc:  # noqa: BLE001 (the user's code: report whatever it raised)
+                what = f"raised {type(exc).__name__}" + (f" ({exc})" if str(exc) else "")
+        else:
+            what = "returned nan" if kind == NOT_A_NUMBER else "returned an infinity"
+        return f"law {name!r}: its {label} {what} at delta = {delta:.6g} m (deltadot = {deltadot:.6g} m/s)"
+
+    def recipe(self, name: str) -> tuple:
+        """What a worker process needs to define the law again (:func:`ensure_defined`)."""
+        if self.path is not None:
+            return ("file", name, self.path, self.identity)
+        return ("python", name, self.definition, self.identity)
 
 
 def _check_signature(name: str, function) -> None:
     if function is None:
         return
-    if not callable(function):
-        raise UserLawError(f"{name} = {function!r} is not a function; allowed: a Python function of "
+    if not (inspect.isfunction(function) or inspect.isfunction(getattr(function, "py_func", None))):
+        # numba compiles functions only: a class, a callable object or a builtin would fail in numba
+        kind = "a callable object" if callable(function) else "not a function"
+        raise UserLawError(f"{name} = {function!r} is {kind}; allowed: a Python function (def or lambda) of "
                            f"{_ARGUMENTS[name]} numbers")
     try:
         parameters = inspect.signature(function).parameters.values()
@@ -140,25 +222,55 @@ def _validate(name, force, partials, potential, unilateral, K, damping, alpha):
                                "acts in tension)")
 
 
-def _source_digest(*functions) -> str:
-    digest = hashlib.sha256()
-    for f in functions:
-        if f is None:
-            digest.update(b"-")
-            continue
+def _source_digest(*functions, file_digest: str = "") -> str:
+    """A digest of what numba compiles: each function's source, the values of the constants it
+    reads from globals or a closure (numba freezes them) and the functions it calls, and the
+    bytes of the law file (``file_digest``) that defined them."""
+    digest = hashlib.sha256(file_digest.encode())
+    seen = set()
+
+    def add(f):
+        f = getattr(f, "py_func", f)  # a numba dispatcher: its Python function
+        if id(f) in seen or not inspect.isfunction(f):
+            return
+        seen.add(id(f))
         try:
             digest.update(inspect.getsource(f).encode())
         except (OSError, TypeError):
-            digest.update(f.__code__.co_code)
+            digest.update(f.__code__.co_code + repr(f.__code__.co_consts).encode())
+        cells = zip(f.__code__.co_freevars, (c.cell_contents for c in f.__closure__ or ()), strict=False)
+        read = [(n, f.__globals__[n]) for n in f.__code__.co_names if n in f.__globals__]
+        for name, value in (*cells, *read):
+            if isinstance(value, (bool, int, float, complex, str, bytes, tuple)):
+                digest.update(f"{name}={value!r};".encode())
+            else:
+                add(value)
+
+    for f in functions:
+        if f is None:
+            digest.update(b"-")
+        else:
+            add(f)
     return digest.hexdigest()[:16]
 
 
-def _compile(force, partials, potential, filippov) -> NativeLaw:
+def _compile(force, partials, potential, filippov, record) -> tuple:
     """One C-callable function ``(which, delta, deltadot, mode, K, damping, alpha)`` for the law
-    (a Filippov law's: with the sign factor of ``mode``, as ``paper``'s kernel)."""
+    (a Filippov law's: with the sign factor of ``mode``, as ``paper``'s kernel); returns it and
+    its address.
+
+    The user's code runs inside a ``try``: an exception, or a NaN or an infinity, is written to
+    ``record`` (the first one) and the call returns NaN, which fails the run (the engine cannot
+    step over it); the caller names the fault (:meth:`NativeLaw.fault`). Without it numba printed
+    a traceback for every call and the run went on with a force of 0. Every :data:`POLL_CALLS`
+    calls the function looks for Ctrl-C or SIGTERM (a slow law's calls fill seconds between two
+    looks of the engine); once one arrived, it returns NaN without calling the user's code, so
+    that the run ends at once and Python raises the signal's ``KeyboardInterrupt``.
+    """
     import numba
 
-    from .native import SIGNATURE
+    from .._signals import interrupted
+    from .native import SIGNATURE, slot_load, slot_store
 
     try:
         f = numba.njit(force)
@@ -183,9 +295,36 @@ def _compile(force, partials, potential, filippov) -> NativeLaw:
             return (f(delta, deltadot + h, K, damping, alpha) - f(delta, deltadot - h, K, damping, alpha)) / (2 * h)
 
         plain = PLAIN
+        at = record.ctypes.data  # the record's address: kept alive by the NativeLaw
 
         def law(which, delta, deltadot, mode, K, damping, alpha):
-            value = unsigned(which, delta, deltadot, K, damping, alpha)
+            calls = slot_load(at, REC_CALLS) + 1.0
+            if calls >= POLL_CALLS:
+                calls = 0.0
+                if interrupted():
+                    slot_store(at, REC_STOP, 1.0)
+            slot_store(at, REC_CALLS, calls)
+            if slot_load(at, REC_STOP) != 0.0:
+                return math.nan
+            fault = NO_FAULT
+            try:
+                value = float(unsigned(which, delta, deltadot, K, damping, alpha))
+            except Exception:  # noqa: BLE001 (the user's code: whatever it raised ends the run)
+                value = math.nan
+                fault = RAISED
+            if fault == NO_FAULT and not math.isfinite(value):
+                fault = NOT_A_NUMBER if math.isnan(value) else INFINITE
+            if fault != NO_FAULT:
+                if slot_load(at, REC_FAULT) == NO_FAULT:
+                    slot_store(at, REC_WHICH, float(which))
+                    slot_store(at, REC_DELTA, delta)
+                    slot_store(at, REC_DELTADOT, deltadot)
+                    slot_store(at, REC_MODE, float(mode))
+                    slot_store(at, REC_K, K)
+                    slot_store(at, REC_DAMPING, damping)
+                    slot_store(at, REC_ALPHA, alpha)
+                    slot_store(at, REC_FAULT, float(fault))
+                return math.nan
             if not filippov or which == 3:
                 return value
             if mode == plain:  # the sign read literally (fixed-step methods)
@@ -198,13 +337,12 @@ def _compile(force, partials, potential, filippov) -> NativeLaw:
             pot = f
         compiled = numba.cfunc(SIGNATURE)(law)
     except numba.core.errors.NumbaError as exc:
-        first = str(exc).strip().splitlines()
+        first = _ANSI.sub("", str(exc)).strip().splitlines()
         detail = next((line for line in first if "rror" in line or "Untyped" in line or "Unknown" in line),
                       first[0] if first else "")
         raise UserLawError("numba cannot compile the law's functions (plain arithmetic and the math module "
                            f"compile; Python objects do not): {detail.strip()}") from None
-    return NativeLaw(compiled.address, compiled, _source_digest(force, partials, potential),
-                     {"force": force, "partials": partials, "potential": potential})
+    return compiled, compiled.address
 
 
 def define_law(name: str, force, *, partials=None, potential=None, unilateral: bool = True,
@@ -282,25 +420,51 @@ def define_law(name: str, force, *, partials=None, potential=None, unilateral: b
         ...
     phaseimpact.model.userlaw.UserLawError: name = 'paper' is a shipped law's; allowed: a new name
     """
+    definition = {"force": force, "partials": partials, "potential": potential, "unilateral": unilateral,
+                  "filippov": filippov, "damping": damping, "damping_power": damping_power,
+                  "clamp_option": clamp_option, "description": description}
+    return _define(name, definition)
+
+
+# The law file being run (load_law_file): (path, digest of its bytes), read by define_law.
+_LOADING: list[tuple[str, str]] = []
+
+
+def _define(name: str, definition: dict, identity: str | None = None) -> LawEntry:
+    """:func:`define_law` with its arguments as a dict; ``identity``: the source digest a worker
+    process is told (it may not see the functions' source), else computed here."""
+    force, partials, potential = definition["force"], definition["partials"], definition["potential"]
+    unilateral, filippov, damping = definition["unilateral"], definition["filippov"], definition["damping"]
+    damping_power, description = definition["damping_power"], definition["description"]
     if not isinstance(name, str) or not name or any(ch.isspace() for ch in name):
         raise UserLawError(f"name = {name!r} is out of range; allowed: a non-empty name without spaces")
     if name in LAWS:
         raise UserLawError(f"name = {name!r} is a shipped law's; allowed: a new name")
-    if clamp_option:
+    if definition["clamp_option"]:
         raise UserLawError("clamp_option = True is not available for user laws: write max(P, 0) in the force")
     if not (isinstance(damping, tuple) and len(damping) == 2 and isinstance(damping[0], str)):
         raise UserLawError(f"damping = {damping!r} is out of range; allowed: (symbol, unit or None)")
     if damping_power is not None and not (isinstance(damping_power, (int, float)) and math.isfinite(damping_power)):
         raise UserLawError(f"damping_power = {damping_power!r} is out of range; allowed: a finite number or None")
-    if not isinstance(filippov, bool):
-        raise UserLawError(f"filippov = {filippov!r} is out of range; allowed: True or False")
+    for label, flag in (("unilateral", unilateral), ("filippov", filippov)):
+        if not isinstance(flag, bool):
+            raise UserLawError(f"{label} = {flag!r} is out of range; allowed: True or False")
+    if not isinstance(description, str) or "\n" in description or "\r" in description:
+        raise UserLawError(f"description = {description!r} is out of range; allowed: one line of text")
     if filippov and potential is not None:
         raise UserLawError("potential is not allowed with filippov = True: the elastic term of a Filippov law "
                            "acts like friction (docs/physics.md §4), it has no potential")
     _validate(name, force, partials, potential, unilateral, 1e9, 1e5, 1.5)
-    native = _compile(force, partials, potential, filippov)
+    import numpy as np
+
+    path, file_digest = _LOADING[-1] if _LOADING else (None, "")
+    record = np.zeros(N_RECORD)
+    compiled, address = _compile(force, partials, potential, filippov, record)
+    native = NativeLaw(address, compiled,
+                       identity or _source_digest(force, partials, potential, file_digest=file_digest),
+                       {"force": force, "partials": partials, "potential": potential}, record, path, definition)
     power = (lambda alpha: 1.0 + alpha) if damping_power is None else (lambda alpha, p=float(damping_power): p)
-    entry = LawEntry(name, NATIVE, "kappa", filippov, bool(unilateral), potential is not None,
+    entry = LawEntry(name, NATIVE, "kappa", filippov, unilateral, potential is not None,
                      description=description or f"user law ({getattr(force, '__module__', '')}."
                                                 f"{getattr(force, '__name__', 'force')})",
                      damping_name=damping[0], damping_power=power, native=native,
@@ -347,23 +511,90 @@ def load_law_file(path) -> list[str]:
         ...
     phaseimpact.model.userlaw.UserLawError: law file '.../missing.py' does not exist
     """
+    if not isinstance(path, (str, os.PathLike)):
+        raise UserLawError(f"law file {path!r} is out of range; allowed: a path (str or os.PathLike)")
     path = os.fspath(path)
-    before = {n: e for n, e in REGISTRY.items()}
-    if not os.path.isfile(path):
-        raise UserLawError(f"law file {path!r} does not exist")
-    import importlib.util
-
-    module_name = "phaseimpact_user_law_" + hashlib.sha1(os.path.abspath(path).encode()).hexdigest()[:12]
-    spec = importlib.util.spec_from_file_location(module_name, path)
-    module = importlib.util.module_from_spec(spec)
-    sys.modules[module_name] = module
     try:
-        spec.loader.exec_module(module)
+        mode = os.stat(path).st_mode
+    except FileNotFoundError:
+        raise UserLawError(f"law file {path!r} does not exist") from None
+    except OSError as exc:
+        raise UserLawError(f"law file {path!r} cannot be read: {exc.strerror or exc}") from None
+    if stat.S_ISDIR(mode):
+        raise UserLawError(f"law file {path!r} is a folder; allowed: a Python file")
+    if not stat.S_ISREG(mode):
+        raise UserLawError(f"law file {path!r} is not a regular file (a FIFO, socket or device); allowed: a Python "
+                           "file")
+    try:
+        with open(path, "rb") as f:
+            source = f.read()
+    except OSError as exc:
+        raise UserLawError(f"law file {path!r} cannot be read: {exc.strerror or exc}") from None
+    absolute = os.path.abspath(path)
+    file_digest = hashlib.sha256(source).hexdigest()
+    loaded = _LOADED.get(absolute)
+    if loaded is not None and loaded[0] == file_digest and all(REGISTRY.get(n) is e for n, e in loaded[1].items()):
+        return list(loaded[1])  # the same bytes, already run: the laws as they are (no second compile)
+    before = dict(REGISTRY)
+    module_name = "phaseimpact_user_law_" + hashlib.sha1(absolute.encode()).hexdigest()[:12]
+    module = types.ModuleType(module_name)  # any file name: the bytes read above run as a module
+    module.__file__ = absolute
+    sys.modules[module_name] = module
+    _LOADING.append((absolute, file_digest))
+    try:
+        # what the file prints goes to stderr: stdout holds the command's output (--json)
+        with contextlib.redirect_stdout(sys.stderr):
+            exec(compile(source, absolute, "exec"), module.__dict__)  # noqa: S102 (the user's own law file)
     except UserLawError:
         raise
+    except SystemExit as exc:
+        raise UserLawError(f"law file {path!r} called sys.exit({exc.code!r}) while it was run; allowed: a file that "
+                           "defines laws (remove the exit)") from None
     except Exception as exc:  # noqa: BLE001 (the user's file)
         raise UserLawError(f"law file {path!r} failed: {type(exc).__name__}: {exc}") from None
+    finally:
+        _LOADING.pop()
     added = [n for n, e in REGISTRY.items() if before.get(n) is not e]
     if not added:
         raise UserLawError(f"law file {path!r} defines no law; it should call phaseimpact.define_law(...)")
+    _LOADED[absolute] = (file_digest, {n: REGISTRY[n] for n in added})
     return added
+
+
+#: Law files run in this process: ``{absolute path: (digest of its bytes, {name: entry})}``.
+_LOADED: dict = {}
+
+
+def ensure_defined(recipe: tuple) -> None:
+    """Define a user law in this process as :meth:`NativeLaw.recipe` describes it, unless a law of
+    the same identity is already registered (a worker process unpickling a :class:`ContactLaw`).
+
+    Raises
+    ------
+    UserLawError
+        If the law file no longer holds the law that was run (edited, or gone).
+    """
+    def defined(name, identity):
+        entry = REGISTRY.get(name)
+        return entry is not None and entry.native is not None and entry.native.identity == identity
+
+    if recipe[0] == "file":
+        _, name, path, identity = recipe
+        if not defined(name, identity):
+            load_law_file(path)
+            if not defined(name, identity):
+                raise UserLawError(f"law {name!r}: law file {path!r} changed since the work began (its source "
+                                   "differs); run the work again")
+        return
+    _, name, definition, identity = recipe
+    if not defined(name, identity):
+        _define(name, definition, identity)
+
+
+def single_law(names: list, path, option: str) -> str:
+    """The law of a law file that defines exactly one (chosen when no law is named); else refuse,
+    naming the laws it defines."""
+    if len(names) == 1:
+        return names[0]
+    raise UserLawError(f"law file {os.fspath(path)!r} defines {len(names)} laws ({', '.join(names)}); allowed: one of "
+                       f"them named with {option}")
