@@ -224,8 +224,8 @@ def test_a_law_file_of_any_name_runs(tmp_path):
 
 
 @pytest.mark.parametrize("body, message", [
-    ("import sys\nsys.exit(0)\n", "called sys.exit(0) while it was run"),
-    ("import sys\nsys.exit(3)\n", "called sys.exit(3) while it was run"),
+    ("import sys\nsys.exit(0)\n", "exited (status 0) while it was run"),
+    ("import sys\nsys.exit(3)\n", "exited (status 3) while it was run"),
 ])
 def test_sys_exit_in_a_law_file_is_a_usage_error(tmp_path, capsys, body, message):
     path = tmp_path / "exit.py"
@@ -242,7 +242,7 @@ def test_a_folder_or_fifo_is_named_as_such(tmp_path):
         load_law_file(folder)
     fifo = tmp_path / "fifo.py"
     os.mkfifo(fifo)
-    with pytest.raises(UserLawError, match="is not a regular file"):
+    with pytest.raises(UserLawError, match="is a FIFO"):
         load_law_file(fifo)
 
 

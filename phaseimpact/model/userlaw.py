@@ -523,8 +523,8 @@ def load_law_file(path) -> list[str]:
     if stat.S_ISDIR(mode):
         raise UserLawError(f"law file {path!r} is a folder; allowed: a Python file")
     if not stat.S_ISREG(mode):
-        raise UserLawError(f"law file {path!r} is not a regular file (a FIFO, socket or device); allowed: a Python "
-                           "file")
+        kind = "a FIFO (named pipe)" if stat.S_ISFIFO(mode) else "not a regular file (a socket or device)"
+        raise UserLawError(f"law file {path!r} is {kind}; allowed: a Python file")
     try:
         with open(path, "rb") as f:
             source = f.read()
@@ -541,6 +541,10 @@ def load_law_file(path) -> list[str]:
     module.__file__ = absolute
     sys.modules[module_name] = module
     _LOADING.append((absolute, file_digest))
+    def refuse_exit(status=0):  # os._exit would end the process with its status before any message
+        raise SystemExit(status)
+
+    exit_now, os._exit = os._exit, refuse_exit
     try:
         # what the file prints goes to stderr: stdout holds the command's output (--json)
         with contextlib.redirect_stdout(sys.stderr):
@@ -548,11 +552,12 @@ def load_law_file(path) -> list[str]:
     except UserLawError:
         raise
     except SystemExit as exc:
-        raise UserLawError(f"law file {path!r} called sys.exit({exc.code!r}) while it was run; allowed: a file that "
-                           "defines laws (remove the exit)") from None
+        raise UserLawError(f"law file {path!r} exited (status {exc.code!r}) while it was run (sys.exit or "
+                           "os._exit); allowed: a file that only defines laws (remove the exit)") from None
     except Exception as exc:  # noqa: BLE001 (the user's file)
         raise UserLawError(f"law file {path!r} failed: {type(exc).__name__}: {exc}") from None
     finally:
+        os._exit = exit_now
         _LOADING.pop()
     added = [n for n, e in REGISTRY.items() if before.get(n) is not e]
     if not added:
