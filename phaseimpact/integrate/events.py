@@ -30,10 +30,10 @@ import math
 from .._jit import kernel
 from ..model.laws import (
     GUARD_ENERGY_FACTOR,  # noqa: F401 (re-exported)
-    MEMORY_,
     RUNAWAY_ENERGY_FACTOR,  # noqa: F401 (re-exported)
     STUCK,
     contact_gap,
+    dent_depth,
     has_memory,
     is_filippov,
     is_unilateral,
@@ -195,7 +195,7 @@ def transition(code, c, column, y, mode, settle):
     action = GO_ON
     if column == DELTA:
         # the event is a zero gap: remove the root finder's residue
-        y[X1] = y[X2] + c[MEMORY_ + 2] if has_memory(code) else y[X2]
+        y[X1] = y[X2] + dent_depth(code, c) if has_memory(code) else y[X2]
         deltadot = y[V1] - y[V2]
         kind = CONTACT if deltadot > 0 else SEPARATION
         if (is_filippov(code) or has_memory(code)) and mode != STUCK and deltadot != 0:

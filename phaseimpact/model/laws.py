@@ -71,7 +71,7 @@ from ..parameters import Parameters, is_number, require, require_choice
 __all__ = [
     "LawEntry", "REGISTRY", "LAWS", "CONTACT_READINGS", "ContactLaw", "as_law", "law_variants", "register",
     "contact_force", "force_partials", "contact_potential", "stick_bound", "hertz_power", "is_filippov",
-    "is_unilateral", "has_memory", "contact_gap", "remember", "force_of", "partials_of", "potential_of",
+    "is_unilateral", "has_memory", "contact_gap", "dent_depth", "remember", "force_of", "partials_of", "potential_of",
     "STUCK", "PLAIN", "RUNAWAY_ENERGY_FACTOR", "GUARD_ENERGY_FACTOR",
 ]
 
@@ -277,6 +277,13 @@ def contact_gap(code, c, delta):
     if has_memory(code):
         return delta - c[MEMORY_ + 2]
     return delta
+
+
+@kernel(python=True, inline="always")
+def dent_depth(code, c):
+    """The residual indentation ``delta_p`` of a law with memory, m (0 for other laws, and before the
+    first yield): where :func:`contact_gap` is zero."""
+    return c[MEMORY_ + 2] if has_memory(code) else 0.0
 
 
 @kernel
