@@ -36,7 +36,7 @@ def test_the_yield_velocity_is_where_the_hertz_pressure_reaches_p_y():
 @pytest.mark.parametrize("r", [0.9, 0.5, 0.2, 0.1, 0.02])
 def test_restitution_is_thorntons_closed_form(r):
     """Exact for the law (REFERENCE.md §7): to 1e-9 at rtol 1e-12, 1e-7 at the default 1e-10 (the
-    unloading's end at the residual indentation is stepped over, not regularised as Hertz's onset)."""
+    unloading's end at the residual indentation is located, not regularised as Hertz's onset)."""
     p = RIGID.replace(v=RIGID.yield_velocity / r)
     tight = simulate(p, "thornton", rtol=1e-12)
     assert tight.status == "success" and tight.outcome == "rebound"
