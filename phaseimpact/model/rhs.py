@@ -132,7 +132,8 @@ PLAIN_PHASE, FLIGHT = 0, 2
 def contact_side(code, c, y, mode):
     """How the driver integrates the phase that starts at ``y`` in ``mode``.
 
-    ``+1`` or ``-1`` (the sign of ``delta``, or of ``deltadot`` at ``delta = 0``) while a Hertz
+    ``+1`` or ``-1`` (the sign of ``delta``, or of ``deltadot`` at ``delta = 0``; past a law's dent, of
+    :func:`~phaseimpact.model.laws.contact_gap`) while a Hertz
     power law (``alpha = 3/2``) acts: a regularised contact, where the driver integrates
     ``u = (w, x2, x1dot, x2dot, W, t)`` with ``delta = side w^2`` in the time ``s`` with
     ``dt = w ds`` (:func:`rhs_integration`): the ``delta^(3/2)`` singularity at the contact's onset
