@@ -32,7 +32,7 @@ __all__ = ["ImpactTrain", "MapFixedPoint", "OrbitDiagram", "impact_map", "impact
            "map_jacobian", "orbit_diagram", "lyapunov_exponent", "TRAIN_PARAMETERS", "MapBifurcation", "MapBranch",
            "BifurcationCurve", "Attractor", "Basins", "continue_map_orbit", "continue_map_bifurcation", "basins",
            "BIFURCATION_KINDS", "NOT_CONVERGED", "NO_MAP", "ATTRACTOR_MATCH", "period_range",
-           "MAX_PERIOD_SWINGS"]
+           "MAX_PERIOD_SWINGS", "attracting_orbit", "ATTRACTION_RADIUS", "LYAPUNOV_SETTLE", "MAX_LYAPUNOV_TRANSIENTS"]
 
 #: Parameters an orbit diagram runs over (the period ``T``, s; the damping ``kappa``; the speed ``v``, m/s).
 TRAIN_PARAMETERS = ("T", "kappa", "v")
@@ -449,6 +449,84 @@ def map_fixed_point(params: Parameters, law, period: float, *, k: int = 1, guess
                          "" if converged else f"no periodic orbit found from the guess ({sol.message})")
 
 
+#: How far (in the state's scales) the last sample may lie from a stable orbit found from it and still
+#: count as on its way there (the samples' distances to it must shrink as well).
+ATTRACTION_RADIUS = 1e-2
+
+
+def attracting_orbit(params: Parameters, law, period: float, samples, *, max_period: int = 8,
+                     rtol: float = 1e-10) -> MapFixedPoint | None:
+    """The stable periodic orbit that consecutive plate states ``samples`` converge to, found by
+    converging to it: :func:`map_fixed_point` from the last sample for ``k = 1, 2, ... max_period``;
+    the first stable orbit (every multiplier inside the unit circle) counts when the samples approach
+    it (their distance to its nearest point shrinks over the samples and ends within
+    :data:`ATTRACTION_RADIUS` of the state's scales). A count of distinct samples alone calls an
+    orbit with a multiplier near -1 (still converging) irregular.
+
+    Parameters
+    ----------
+    params : Parameters
+    law : ContactLaw or str
+    period : float
+        Time between arrivals, s.
+    samples : array, shape (n, 2)
+        Consecutive ``(x2, x2dot)`` (m, m/s) of the map, n >= 2.
+    max_period : int, default 8
+        Longest period tried (1 to 64).
+    rtol : float, default 1e-10
+        The integrator's relative tolerance.
+
+    Returns
+    -------
+    MapFixedPoint or None
+        None when no stable orbit of period up to ``max_period`` is found that the samples approach
+        (an irregular attractor, a longer period, or a transient not yet near its orbit).
+
+    Raises
+    ------
+    ValueError
+        Samples that are not finite plate states of shape (n, 2) with n >= 2, a period or
+        ``max_period`` out of range.
+
+    Examples
+    --------
+    Just above half a plate period the period-1 orbit converges slowly (a multiplier near -0.96):
+    after 200 impacts its 40 samples are still distinct, yet they approach the stable orbit:
+
+    >>> from phaseimpact import seed_parameters
+    >>> from phaseimpact.integrate import scales
+    >>> p = seed_parameters(v=1.0, kappa=3e9)
+    >>> T = 0.504 * scales(p).plate_period
+    >>> train = impact_train(p, "hunt-crossley", T, 240)
+    >>> orbit = attracting_orbit(p, "hunt-crossley", T, train.plate[200:])
+    >>> orbit.period_k, f"{min(orbit.multipliers.real):.3f}"
+    (1, '-0.963')
+    """
+    samples = np.asarray(samples, dtype=float)
+    if samples.ndim != 2 or samples.shape[1] != 2 or len(samples) < 2 or not np.all(np.isfinite(samples)):
+        raise ValueError(f"samples of shape {samples.shape} are out of range; allowed: finite plate states "
+                         "(x2, x2dot), shape (n, 2) with n >= 2")
+    period = _check_period(period, params)
+    if not (isinstance(max_period, (int, np.integer)) and not isinstance(max_period, bool)
+            and 1 <= max_period <= 64):
+        raise ValueError(f"max_period = {max_period!r} is out of range; allowed: an integer, 1 <= max_period <= 64")
+    law = as_law(law)
+    scale = _state_scale(params)
+    for k in range(1, max_period + 1):
+        fp = map_fixed_point(params, law, period, k=k, guess=samples[-1], rtol=rtol)
+        if not (fp.converged and fp.stable):
+            continue
+        points = [fp.plate]
+        for _ in range(k - 1):
+            points.append(impact_map(params, law, period, points[-1], rtol=rtol)[0])
+        points = np.array(points) / scale
+        distance = np.min(np.linalg.norm(samples[:, None, :] / scale - points[None, :, :], axis=2), axis=1)
+        # on it (to the orbit diagram's 1e-6) or still approaching it
+        if distance[-1] <= ATTRACTION_RADIUS and (distance[-1] <= distance[0] or distance.max() < 1e-6):
+            return fp
+    return None
+
+
 @dataclass(frozen=True)
 class OrbitDiagram:
     """The map's attractor over a parameter: ``samples`` plate states after ``transients`` impacts.
@@ -558,12 +636,41 @@ def orbit_diagram(params: Parameters, law, param: str, values, *, period: float 
     return OrbitDiagram(param, values, plate, force, distinct)
 
 
+#: What the start's distance to a stable orbit, and the tangent vector's distance to its direction, have
+#: shrunk to when :func:`lyapunov_exponent` starts averaging (its transients chosen from the multiplier).
+LYAPUNOV_SETTLE = 1e-8
+#: Most transient impacts :func:`lyapunov_exponent` chooses (a multiplier within 2e-4 of the unit circle).
+MAX_LYAPUNOV_TRANSIENTS = 100_000
+
+
+def _lyapunov_transients(params, law, period, z, rtol):
+    """Impacts to discard before averaging: until the slowest multiplier ``mu`` (per impact) of the
+    stable orbit the start approaches has shrunk its distance to :data:`LYAPUNOV_SETTLE`,
+    ``log(LYAPUNOV_SETTLE) / log |mu|``, a whole number of the orbit's periods; 0 when no such orbit is
+    found (an irregular attractor: nothing to wait for). Also the period ``k`` (1 when none)."""
+    samples = impact_train(params, law, period, 16, plate=z, rtol=rtol).plate
+    orbit = attracting_orbit(params, law, period, samples, rtol=rtol)
+    if orbit is None:
+        return 0, 1
+    k = orbit.period_k
+    slowest = float(np.max(np.abs(orbit.multipliers))) ** (1.0 / k)
+    if slowest == 0.0:
+        return 0, k
+    n = math.ceil(math.log(LYAPUNOV_SETTLE) / math.log(slowest) / k) * k
+    return min(n, MAX_LYAPUNOV_TRANSIENTS), k
+
+
 def lyapunov_exponent(params: Parameters, law, period: float, *, plate=None, iterations: int = 200,
-                      rtol: float = 1e-10) -> float:
+                      transients: int | None = None, rtol: float = 1e-10) -> float:
     """The largest Lyapunov exponent of the impact map (per impact): the mean of ``log |J_n w_n|``
     along the orbit from ``plate`` (default: after 100 impacts from rest), ``w`` renormalised each
     impact; ``J_n`` the map's Jacobian by central differences (:func:`map_jacobian`). Negative on a
     stable periodic orbit (the log of its largest multiplier's modulus), positive when chaotic.
+
+    The mean starts after ``transients`` impacts (``w`` carried along): by default as many as the
+    slowest multiplier of the stable orbit the start approaches (:func:`attracting_orbit`) needs to
+    bring both the orbit and ``w`` within :data:`LYAPUNOV_SETTLE` (a fixed count is percents off
+    near a multiplier of -0.96: the start's approach and ``w``'s first turns weigh in the mean).
 
     Parameters
     ----------
@@ -575,7 +682,10 @@ def lyapunov_exponent(params: Parameters, law, period: float, *, plate=None, ite
     plate : 2 numbers, optional
         ``(x2, x2dot)`` (m, m/s) to start from; default the state after 100 impacts from rest.
     iterations : int, default 200
-        Impacts averaged over.
+        Impacts averaged over (rounded up to a whole number of the orbit's periods).
+    transients : int, optional
+        Impacts before the mean (0 to 100000); default chosen from the multiplier as above (0 when no
+        stable orbit of period up to 8 is found).
     rtol : float, default 1e-10
         The integrator's relative tolerance.
 
@@ -587,29 +697,40 @@ def lyapunov_exponent(params: Parameters, law, period: float, *, plate=None, ite
     Raises
     ------
     ValueError
-        A period out of range.
+        A period, iterations or transients out of range.
 
     Examples
     --------
-    On the stable period-1 orbit at 0.4 ms it approaches ``log 0.450 = -0.799``:
+    On the stable period-1 orbit at 0.4 ms it approaches ``log 0.450 = -0.799`` (a complex pair of
+    multipliers: ``w`` turns each impact, and the mean converges as ``1 / iterations``):
 
     >>> from phaseimpact import seed_parameters
     >>> p = seed_parameters(kappa=3e9)
     >>> fp = map_fixed_point(p, "hunt-crossley", 0.4e-3)
     >>> f"{lyapunov_exponent(p, 'hunt-crossley', 0.4e-3, plate=fp.plate, iterations=50):.2f}"
-    '-0.80'
+    '-0.78'
     """
     law = as_law(law)
     period = _check_period(period, params)
+    for name, n, low in (("iterations", iterations, 1), ("transients", transients, 0)):
+        if name == "transients" and n is None:
+            continue
+        if not (isinstance(n, (int, np.integer)) and not isinstance(n, bool) and low <= n <= 100_000):
+            raise ValueError(f"{name} = {n!r} is out of range; allowed: an integer, {low} <= {name} <= 100000")
     scale = _state_scale(params)
     z = impact_train(params, law, period, 100, rtol=rtol).plate[-1] if plate is None else np.asarray(plate, float)
+    k = 1
+    if transients is None:
+        transients, k = _lyapunov_transients(params, law, period, z, rtol)
+    iterations = math.ceil(iterations / k) * k
     w = np.array([1.0, 1.0]) / math.sqrt(2)
     total = 0.0
-    for _ in range(iterations):
+    for n in range(transients + iterations):
         J, _ = map_jacobian(params, law, period, z, rtol=rtol)
         w = (J * scale[None, :] / scale[:, None]) @ w  # in the state's scales
         growth = float(np.linalg.norm(w))
-        total += math.log(growth)
+        if n >= transients:
+            total += math.log(growth)
         w /= growth
         z, _ = impact_map(params, law, period, z, rtol=rtol)
     return total / iterations

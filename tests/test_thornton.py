@@ -36,7 +36,7 @@ def test_the_yield_velocity_is_where_the_hertz_pressure_reaches_p_y():
 @pytest.mark.parametrize("r", [0.9, 0.5, 0.2, 0.1, 0.02])
 def test_restitution_is_thorntons_closed_form(r):
     """Exact for the law (REFERENCE.md §7): to 1e-9 at rtol 1e-12, 1e-7 at the default 1e-10 (the
-    unloading's end at the residual indentation is stepped over, not regularised as Hertz's onset)."""
+    unloading's end at the residual indentation is located, not regularised as Hertz's onset)."""
     p = RIGID.replace(v=RIGID.yield_velocity / r)
     tight = simulate(p, "thornton", rtol=1e-12)
     assert tight.status == "success" and tight.outcome == "rebound"
@@ -75,6 +75,113 @@ def test_the_memory_is_each_runs_own():
     many = simulate_many([p, p, p.replace(v=2.0)], "thornton")
     assert np.all(many.values["max_force"][:2] == first.max_force)
     assert many.values["max_force"][2] == simulate(p.replace(v=2.0), "thornton").max_force
+
+
+def force_contacts(p, t_end, rigid=False):
+    """An independent solve of Thornton's law (scipy's DOP853 at rtol 1e-12, its own events): the
+    intervals where the force is positive, from ``x1 = x2 = 0``, ``x1dot = v``. Shares only the physics
+    (Thornton 1997, eq. 4-13): Hertz loading to ``delta_y``, then linear at ``p_y``; at each maximum of
+    ``delta`` beyond the last, the unloading curve ``K_p (delta - delta_p)^1.5``; the force ends at
+    ``delta_p`` (a flight inside the dent follows) and starts again there."""
+    from scipy.integrate import solve_ivp
+
+    K, R, p_y = p.K, p.R, p.limiting_pressure
+    e_star = 0.75 * K / math.sqrt(R)
+    d_y = R * (0.5 * math.pi * p_y / e_star) ** 2
+    f_y = K * d_y**1.5
+    memory = {"max": 0.0, "k_p": K, "d_p": 0.0}
+
+    def loading(d):
+        return K * d**1.5 if d <= d_y else f_y + math.pi * p_y * R * (d - d_y)
+
+    def unloading(d):
+        return memory["k_p"] * (d - memory["d_p"]) ** 1.5 if d > memory["d_p"] else 0.0
+
+    def remember(d):
+        memory["max"] = d
+        if d > d_y:
+            f_max = loading(d)
+            a_p = math.sqrt((2 * f_max + f_y) / (2 * math.pi * p_y))
+            memory["k_p"] = 4 / 3 * e_star * math.sqrt(4 * e_star * a_p**3 / (3 * f_max))
+            memory["d_p"] = d - (f_max / memory["k_p"]) ** (2 / 3)
+
+    def equations(force):
+        def rhs(t, y):
+            P = force(y[0] - y[1])
+            return [y[2], y[3], -P / p.M1, 0.0 if rigid else (P - p.Kb * y[1] - p.Km * y[1] ** 3) / p.M2]
+        return rhs
+
+    def event(g, direction):
+        g.terminal, g.direction = True, direction
+        return g
+
+    def gap(t, y):
+        return y[0] - y[1] - memory["d_p"]
+
+    # each event its own function: solve_ivp reads the direction from the function's attributes
+    phases = {"loading": (loading, [event(lambda t, y: y[2] - y[3], -1)]),
+              "unloading": (unloading, [event(lambda t, y: gap(t, y), -1),
+                                        event(lambda t, y: y[0] - y[1] - memory["max"], 1)]),
+              "flight": (lambda d: 0.0, [event(lambda t, y: gap(t, y), 1)])}
+    atol = [1e-18, 1e-18, 1e-14 * p.v, 1e-14 * p.v]
+    y, t, phase, start, contacts = np.array([0.0, 0.0, p.v, 0.0]), 0.0, "loading", 0.0, []
+    for _ in range(1000):  # phases (a bound, so that a solve that stalls fails rather than hangs)
+        if t >= t_end:
+            break
+        force, events = phases[phase]
+        sol = solve_ivp(equations(force), (t, t_end), y, events=events, rtol=1e-12, atol=atol, method="DOP853")
+        t, y = sol.t[-1], sol.y[:, -1].copy()
+        if sol.status != 1:
+            break
+        first = next(i for i, times in enumerate(sol.t_events) if len(times))
+        if phase == "loading":  # a new largest indentation
+            remember(y[0] - y[1])
+            phase = "unloading"
+        elif phase == "unloading" and first == 0:  # the force ends
+            contacts.append((start, t))
+            phase = "flight"
+            if rigid:
+                break
+        elif phase == "unloading":  # loaded again past the largest indentation
+            phase = "loading"
+        else:
+            start, phase = t, "unloading"
+    return contacts
+
+
+def engine_contacts(tr):
+    starts, ends = (np.array([e.t for e in tr.events_of(kind)]) for kind in ("contact", "separation"))
+    return list(zip(starts, ends, strict=False))
+
+
+@pytest.mark.parametrize("ratio, duration", [(10.0, 7.1264e-7), (100.0, 5.7031e-7)])
+def test_a_contact_ends_where_the_force_does_not_where_the_dent_is_left(ratio, duration):
+    """sand-gelcoat on a rigid wall at 10 and 100 v_y: the contact time is the time the force is
+    positive (an audit's independent values, issue 42), not the flight out of the plastic dent that
+    follows (27 % and 98 % longer), and it agrees with the independent solve."""
+    p = load_case("sand-gelcoat").parameters(target="rigid")
+    p = p.replace(v=ratio * p.yield_velocity)
+    tr = simulate(p, "thornton", rtol=1e-12)
+    assert tr.status == "success" and tr.n_contacts == 1
+    assert tr.contact_duration == pytest.approx(duration, rel=1e-4)
+    (start, end), = force_contacts(p, 1e-5, rigid=True)
+    assert tr.contact_duration == pytest.approx(end - start, rel=1e-8)
+    assert tr.restitution == pytest.approx(thornton_restitution(1 / ratio), rel=1e-9)  # unchanged
+
+
+@pytest.mark.parametrize("ratio, contacts", [(10.0, 2), (100.0, 3)])
+def test_contacts_on_the_plate_are_counted_by_force(ratio, contacts):
+    """The seed's plate at 10 and 100 v_y: each interval of positive force is a contact (at 100 v_y
+    the projectile leaves the force three times before it leaves its dent: one contact by
+    indentation), each start and end where the independent solve has it."""
+    p = seed_parameters(v=1.0, limiting_pressure=P_Y)
+    p = p.replace(v=ratio * p.yield_velocity)
+    tr = simulate(p, "thornton", rtol=1e-12)
+    assert tr.status == "success" and tr.n_contacts == contacts
+    independent = force_contacts(p, tr.t_stop)
+    assert len(independent) == contacts
+    np.testing.assert_allclose(np.array(engine_contacts(tr)), np.array(independent), rtol=1e-8,
+                               atol=1e-12 * tr.t_stop)
 
 
 def test_the_law_passes_the_conformance_suite():

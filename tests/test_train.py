@@ -11,6 +11,7 @@ from _cli import run
 from phaseimpact import seed_parameters
 from phaseimpact.integrate import scales
 from phaseimpact.train import (
+    attracting_orbit,
     basins,
     continue_map_bifurcation,
     continue_map_orbit,
@@ -84,6 +85,54 @@ def test_the_lyapunov_exponent_of_a_stable_orbit_is_its_largest_multiplier():
     # of (log of J's non-normality) / n
     lam = lyapunov_exponent(p, "hunt-crossley", 3e-3, plate=fp.plate, iterations=400)
     assert lam == pytest.approx(math.log(max(abs(fp.multipliers))), abs=0.02)
+
+
+#: studies/train.py's value of T just above half a plate period: a stable period-1 orbit whose slowest
+#: multiplier is about -0.96 (the study's 200 dropped impacts leave its 40 samples distinct).
+NEAR_HALF = 0.5040100250626567
+
+
+def test_a_slowly_converging_period_1_orbit_is_found_by_converging_to_it():
+    """The count of distinct samples calls the orbit irregular (all 40 distinct); the orbit Newton's
+    method finds from the last sample is period 1 and stable, and a long iteration (an independent
+    route: 1000 impacts, |mu|^800 ~ 1e-13) ends on it."""
+    p = SEED.replace(kappa=3e9)
+    T = NEAR_HALF * scales(p).plate_period
+    diagram = orbit_diagram(p, "hunt-crossley", "T", [T], transients=200, samples=40)
+    assert diagram.distinct[0] == 40  # what the count alone says
+    orbit = attracting_orbit(p, "hunt-crossley", T, diagram.plate[0])
+    assert orbit is not None and orbit.period_k == 1 and orbit.stable
+    assert -0.99 < min(orbit.multipliers.real) < -0.9 and max(abs(orbit.multipliers)) < 1
+    long = impact_train(p, "hunt-crossley", T, 1000)
+    scale = np.array([p.hertz_indentation, p.v])
+    assert np.max(np.abs(long.plate[-1] - orbit.plate) / scale) < 1e-6
+
+
+def test_a_period_2_attractor_is_period_2_and_a_far_transient_is_none():
+    """At one plate period the train from rest settles on a period-2 orbit (studies/train.py);
+    samples from the first impacts from rest, still far from any orbit, are no orbit."""
+    p = SEED.replace(kappa=3e9)
+    T = PLATE_PERIOD
+    train = impact_train(p, "hunt-crossley", T, 240)
+    orbit = attracting_orbit(p, "hunt-crossley", T, train.plate[200:])
+    assert orbit is not None and orbit.period_k == 2 and orbit.stable
+    assert attracting_orbit(p, "hunt-crossley", T, train.plate[:6], max_period=2) is None
+    with pytest.raises(ValueError, match="max_period = 0"):
+        attracting_orbit(p, "hunt-crossley", T, train.plate[:6], max_period=0)
+
+
+def test_the_default_lyapunov_exponent_waits_for_the_slowest_multiplier():
+    """Near half a plate period (multiplier -0.963) a fixed 200 impacts from the default start are 3 %
+    off log |mu|; the default transients, chosen from the multiplier, bring it within 1e-6."""
+    p = SEED.replace(kappa=3e9)
+    T = NEAR_HALF * scales(p).plate_period
+    fp = map_fixed_point(p, "hunt-crossley", T, guess=impact_train(p, "hunt-crossley", T, 240).plate[-1])
+    expected = math.log(max(abs(fp.multipliers)))
+    assert lyapunov_exponent(p, "hunt-crossley", T) == pytest.approx(expected, rel=1e-6)
+    fixed = lyapunov_exponent(p, "hunt-crossley", T, transients=0)
+    assert abs(fixed / expected - 1) > 0.01  # what a fixed count gives
+    with pytest.raises(ValueError, match="transients = -1"):
+        lyapunov_exponent(p, "hunt-crossley", T, transients=-1)
 
 
 def test_the_orbit_diagram_does_not_depend_on_the_threads():

@@ -26,7 +26,7 @@ import numpy as np
 
 from .._jit import allocating, kernel
 from .._signals import interrupted
-from ..model.laws import PLAIN, STUCK
+from ..model.laws import PLAIN, STUCK, dent_depth
 from ..model.rhs import (
     FLIGHT,
     M2_,
@@ -268,7 +268,7 @@ def _phase_tolerances(code, mode, side, atol, out):
 def _events(code, c, mode, side, energy_limit, u, y, f, force, g):
     """Event values at ``u`` (physical ``y``, ``f``, ``force``) into ``g``."""
     event_values(code, c, y, f, force, mode, energy_limit, g)
-    if _regularised(side):
+    if _regularised(side) and dent_depth(code, c) == 0.0:  # past a dent the gap is not w: its value from y
         g[DELTA] = side * u[0]  # delta = side w^2 keeps its sign through its root; w changes sign there
     if relative_slip(code, mode, side):
         g[DELTADOT] = u[V1]  # as integrated: x1dot - x2dot of the physical state has lost its digits
@@ -284,7 +284,7 @@ def _event_at(code, c, mode, side, energy_limit, target, column, F, u0, s0, h, s
     _dense(c, side, F, u0, s0, h, s, us)
     if column == TIME_COLUMN:
         return us[TIME] - target
-    if column == DELTA and _regularised(side):
+    if column == DELTA and _regularised(side) and dent_depth(code, c) == 0.0:
         return side * us[0]  # delta = side w^2 keeps its sign through its root; w changes sign there
     if column == DELTADOT and relative_slip(code, mode, side):
         return us[V1]

@@ -7,7 +7,8 @@ applies an event located at a state.
 ==================  =========  =========  ===================================================
 column              direction  action     meaning
 ==================  =========  =========  ===================================================
-``DELTA``           both       restart    ``delta``: contact onset (up), separation (down)
+``DELTA``           both       restart    the contact gap, ``delta`` (minus a law's dent, where
+                                          its force ends): contact onset (up), separation (down)
 ``DELTADOT``        both       restart*   ``deltadot``: extreme indentation; ``paper``
                                           slipping: stick, or a reversal of the slip
 ``FORCE_RATE``      down       record     ``dP/dt``: a maximum of the contact force
@@ -31,6 +32,8 @@ from ..model.laws import (
     GUARD_ENERGY_FACTOR,  # noqa: F401 (re-exported)
     RUNAWAY_ENERGY_FACTOR,  # noqa: F401 (re-exported)
     STUCK,
+    contact_gap,
+    dent_depth,
     has_memory,
     is_filippov,
     is_unilateral,
@@ -82,7 +85,7 @@ def event_value(code, c, y, f, force, mode, energy_limit, column):
     side). Inactive events are held at +-1 so that they never fire."""
     stuck = mode == STUCK
     if column == DELTA:
-        return y[X1] - y[X2]
+        return contact_gap(code, c, y[X1] - y[X2])
     if column == ENERGY:
         return energy_limit - energy(code, c, y)
     if column == PAIR_CENTRE:
@@ -102,7 +105,8 @@ def event_value(code, c, y, f, force, mode, energy_limit, column):
         p_delta, p_rate = partials_of(code, c, y[X1] - y[X2], deltadot, mode)
         return p_delta * deltadot + p_rate * (f[V1] - f[V2])
     # REACH
-    if not stuck and is_unilateral(code) and c[SPRINGS_] > 0 and y[X1] - y[X2] < 0 and y[V1] < 0:
+    if not stuck and is_unilateral(code) and c[SPRINGS_] > 0 and contact_gap(code, c, y[X1] - y[X2]) < 0 \
+            and y[V1] < 0:
         return -(y[X1] + target_reach(c, y))
     return -1.0
 
@@ -190,7 +194,8 @@ def transition(code, c, column, y, mode, settle):
     """
     action = GO_ON
     if column == DELTA:
-        y[X1] = y[X2]  # the event is delta = 0: remove the root finder's residue
+        # the event is a zero gap: remove the root finder's residue
+        y[X1] = y[X2] + dent_depth(code, c) if has_memory(code) else y[X2]
         deltadot = y[V1] - y[V2]
         kind = CONTACT if deltadot > 0 else SEPARATION
         if (is_filippov(code) or has_memory(code)) and mode != STUCK and deltadot != 0:

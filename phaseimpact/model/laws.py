@@ -71,7 +71,7 @@ from ..parameters import Parameters, is_number, require, require_choice
 __all__ = [
     "LawEntry", "REGISTRY", "LAWS", "CONTACT_READINGS", "ContactLaw", "as_law", "law_variants", "register",
     "contact_force", "force_partials", "contact_potential", "stick_bound", "hertz_power", "is_filippov",
-    "is_unilateral", "has_memory", "remember", "force_of", "partials_of", "potential_of",
+    "is_unilateral", "has_memory", "contact_gap", "dent_depth", "remember", "force_of", "partials_of", "potential_of",
     "STUCK", "PLAIN", "RUNAWAY_ENERGY_FACTOR", "GUARD_ENERGY_FACTOR",
 ]
 
@@ -266,6 +266,24 @@ def contact_potential(code, delta, K, alpha):
 def has_memory(code):
     """Whether the law keeps state over a run (:attr:`LawEntry.memory`; Thornton's form)."""
     return (code >> FORM_SHIFT) & FORM_MASK == THORNTON
+
+
+@kernel(python=True, inline="always")
+def contact_gap(code, c, delta):
+    """How far the bodies are from touching at the indentation ``delta`` (m): ``delta`` itself, or for
+    a law with memory ``delta - delta_p``, past the residual indentation ``delta_p`` of its dent: a
+    projectile inside its plastic dent feels no force (the dent is state, not contact), so its
+    contact starts and ends where the force does (0 before the first yield)."""
+    if has_memory(code):
+        return delta - c[MEMORY_ + 2]
+    return delta
+
+
+@kernel(python=True, inline="always")
+def dent_depth(code, c):
+    """The residual indentation ``delta_p`` of a law with memory, m (0 for other laws, and before the
+    first yield): where :func:`contact_gap` is zero."""
+    return c[MEMORY_ + 2] if has_memory(code) else 0.0
 
 
 @kernel

@@ -41,6 +41,7 @@ from .laws import (  # noqa: F401 (the packed layout, re-exported: the engine's 
     STUCK,
     ContactLaw,
     as_law,
+    contact_gap,
     force_of,
     is_filippov,
     partials_of,
@@ -131,7 +132,8 @@ PLAIN_PHASE, FLIGHT = 0, 2
 def contact_side(code, c, y, mode):
     """How the driver integrates the phase that starts at ``y`` in ``mode``.
 
-    ``+1`` or ``-1`` (the sign of ``delta``, or of ``deltadot`` at ``delta = 0``) while a Hertz
+    ``+1`` or ``-1`` (the sign of ``delta``, or of ``deltadot`` at ``delta = 0``; past a law's dent, of
+    :func:`~phaseimpact.model.laws.contact_gap`) while a Hertz
     power law (``alpha = 3/2``) acts: a regularised contact, where the driver integrates
     ``u = (w, x2, x1dot, x2dot, W, t)`` with ``delta = side w^2`` in the time ``s`` with
     ``dt = w ds`` (:func:`rhs_integration`): the ``delta^(3/2)`` singularity at the contact's onset
@@ -142,7 +144,7 @@ def contact_side(code, c, y, mode):
     """
     if mode == STUCK or mode == PLAIN:
         return PLAIN_PHASE
-    delta = y[X1] - y[X2]
+    delta = contact_gap(code, c, y[X1] - y[X2])  # a law with memory flies inside its dent
     deltadot = y[V1] - y[V2]
     side = 1 if delta > 0 else (-1 if delta < 0 else (1 if deltadot > 0 else (-1 if deltadot < 0 else 0)))
     if side < 0 and force_of(code, c, -1.0, 0.0, mode) == 0.0:
