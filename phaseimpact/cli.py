@@ -80,12 +80,12 @@ _NEGATIVE_NUMBER = re.compile(r"^-(\d+\.?\d*|\.\d+)(e[-+]?\d+)?$|^-(inf|infinity
 def _check_environment() -> None:
     """The environment this process runs in, checked before any work (``ValueError`` names it)."""
     from ._environment import source_date_epoch
-    from ._jit import processes
+    from ._jit import linked_only_requested
 
     if sys.stdout is None:  # started with stdout closed (cmd >&-): nothing could be reported
         raise ValueError("stdout is closed; allowed: an open standard output (redirect it to a file or /dev/null)")
     source_date_epoch()
-    processes()  # PHASEIMPACT_COMPILE_PROCESSES: read only by a first-ever compile, checked every time
+    linked_only_requested()  # PHASEIMPACT_LINKED_ONLY: read only by a first compile, checked every time
 
 
 class _Parser(argparse.ArgumentParser):
@@ -558,8 +558,8 @@ def cmd_warmup(args) -> int:
         print(f"compiled in {out['seconds']:.1f} s for this process only: nothing is cached ({out['reason']})")
     else:
         done = "compiled" if out["compiled"] else "already compiled; loaded"
-        print(f"{done} in {out['seconds']:.1f} s; cache: {out['cache']} ({out['source']}"
-              f"{'' if out['writable'] else ', read-only'}; {out['files']} files, {out['bytes'] / 1e6:.1f} MB)")
+        print(f"{done} in {out['seconds']:.1f} s; cache: {out['cache']} ({out['source']}; {out['files']} files, "
+              f"{out['bytes'] / 1e6:.1f} MB)")
     return EXIT_OK
 
 

@@ -409,10 +409,10 @@ def test_bad_source_date_epoch_refused_before_numpy_reads_it(epoch, tmp_path):
     assert not (tmp_path / "s.h5").exists()
 
 
-def test_bad_compile_processes_refused(monkeypatch, no_work):
-    monkeypatch.setenv("PHASEIMPACT_COMPILE_PROCESSES", "abc")
+def test_bad_linked_only_switch_refused(monkeypatch, no_work):
+    monkeypatch.setenv("PHASEIMPACT_LINKED_ONLY", "abc")
     code, _, err = run(["simulate"])
-    assert code == 2 and "PHASEIMPACT_COMPILE_PROCESSES = 'abc'" in err
+    assert code == 2 and "PHASEIMPACT_LINKED_ONLY = 'abc' is out of range; allowed: 0 or 1" in err
 
 
 def test_closed_stdout_is_an_error(tmp_path):
