@@ -1481,9 +1481,10 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser("warmup", help="compile the engine ahead, and say where its cache is",
                        description="Compile every entry of the engine into its cache now (the first command that "
-                                   "integrates would otherwise do it, about 20 s on 2 cores), and say where the "
-                                   "cache is: for shared installs (run it as the install's owner: other users read "
-                                   "that cache), containers and cluster workers. On a warm cache it only loads.")
+                                   "integrates would otherwise do it, about 30 s on 2 cores), and say where the "
+                                   "cache is: for containers, cluster workers and a fresh install (each user who "
+                                   "cannot write the install compiles once into ~/.cache/phaseimpact). On a warm "
+                                   "cache it only loads.")
     json_option(p)
     p.set_defaults(func=cmd_warmup)
 

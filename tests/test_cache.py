@@ -235,7 +235,9 @@ print(json.dumps(out))
 
 
 def _linked(tmp_path, step, hooks="present", **env):
-    (tmp_path / "linked.py").write_text(LINKED)
+    module = tmp_path / "linked.py"
+    if not module.exists():  # rewritten, its new time would make numba's cache of it stale
+        module.write_text(LINKED)
     env = {"NUMBA_CACHE_DIR": str(tmp_path / "cache"), "PYTHONPATH": os.pathsep.join((str(tmp_path), str(ROOT))),
            **env}
     out = subprocess.run([sys.executable, "-c", LINKED_RUN, step, hooks], cwd=tmp_path, capture_output=True,
