@@ -6,7 +6,7 @@ STAMP := $(VENV)/.installed
 QUICK ?=
 JOBS ?= 2
 
-.PHONY: test docs reproduce lint benchmarks stress peers clean
+.PHONY: test test-numba-range docs reproduce lint benchmarks stress peers clean
 
 $(BIN)/python:
 	$(PYTHON) -m venv $(VENV)
@@ -35,6 +35,30 @@ docs: $(STAMP)
 reproduce: $(STAMP)
 	$(BIN)/python studies/run_all.py $(if $(QUICK),--quick) --jobs $(JOBS)
 
+# The engine's tests on the oldest and the newest numba pyproject.toml allows (numba>=0.59,<0.69),
+# each in a throwaway .venv-numba-<end> (git-ignored; `make clean` removes them) with the NumPy that
+# numba supports, and its own NUMBA_CACHE_DIR (a first compile in each, and one more for the cold
+# session of test_precompile.py, which checks the hooks bit for bit; the slow test that compiles
+# an edited copy twice is left to `make test`). Raise the cap in
+# pyproject.toml only after this passes with the new numba as the newest end.
+NUMBA_OLDEST := "numba==0.59.0" "numpy<1.27"
+NUMBA_NEWEST := "numba<0.69"
+NUMBA_RANGE_TESTS ?= tests/test_integrate.py tests/test_laws.py tests/test_cache.py tests/test_precompile.py \
+	tests/test_imports.py
+
+.venv-numba-%/.installed: pyproject.toml
+	$(PYTHON) -m venv .venv-numba-$*
+	.venv-numba-$*/bin/python -m pip install --quiet --upgrade pip
+	.venv-numba-$*/bin/python -m pip install --quiet $(NUMBA_$(shell echo $* | tr a-z A-Z)) -e . pytest hypothesis
+	touch $@
+
+test-numba-range: .venv-numba-oldest/.installed .venv-numba-newest/.installed
+	@for end in oldest newest; do \
+		echo "== numba $$(.venv-numba-$$end/bin/python -c 'import numba, numpy; print(numba.__version__, "with numpy", numpy.__version__)') ($$end allowed)"; \
+		NUMBA_CACHE_DIR=$$PWD/.venv-numba-$$end/numba-cache .venv-numba-$$end/bin/python -m pytest -q \
+			-o cache_dir=.venv-numba-$$end/pytest-cache -m "not slow" $(NUMBA_RANGE_TESTS) || exit 1; \
+	done
+
 lint: $(STAMP)
 	$(BIN)/ruff check .
 
@@ -48,4 +72,4 @@ peers: $(STAMP)  # heyoka comparison, in its own .venv-peers (downloads ~100 MB)
 	$(BIN)/python benchmarks/peers.py
 
 clean:
-	rm -rf $(VENV) .pytest_cache build *.egg-info
+	rm -rf $(VENV) .venv-numba-oldest .venv-numba-newest .pytest_cache build *.egg-info

@@ -5,9 +5,6 @@ import sys
 
 
 def main() -> int:
-    from . import _jit
-
-    _jit.ONE_COMMAND = True
     try:
         from .cli import main as command_line
     except KeyboardInterrupt:

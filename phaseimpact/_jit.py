@@ -41,17 +41,22 @@ the digest is the SHA-256 of every file whose code is compiled (:data:`ENGINE_SO
 itself checks only the cached function's own file, while a cached function holds the machine
 code of every function it calls: after an edit of ``model/rhs.py`` the driver ran the old
 right-hand side. A new digest is a new, empty directory, so any edit recompiles everything.
-The directory lies in the first of these roots that can hold it:
+The directory is handed to numba through its public setting, ``numba.config.CACHE_DIR``
+(what ``NUMBA_CACHE_DIR`` sets), for the engine's functions only: it is set while each is
+declared to numba and restored at once, so other numba code in the process caches as it would.
+The directory lies in the first of these roots that this user can write:
 
 1. ``$NUMBA_CACHE_DIR`` when set;
-2. ``__pycache__/`` of the installed package (written by whoever can write the install, e.g.
-   ``phaseimpact warmup`` run by the owner of a shared install; read by everyone once it is
-   complete, even where they cannot write it);
+2. ``__pycache__/`` of the installed package (``phaseimpact warmup`` run by whoever installed it
+   fills it for that user);
 3. ``$XDG_CACHE_HOME/phaseimpact`` (default ``~/.cache/phaseimpact``), per user;
 4. none: every process compiles for itself, and says so on stderr when it does.
 
 Of the directories this module created in a root, the :data:`KEEP` most recently used stay (a few
-checkouts or versions side by side); older ones are removed when a new one is made.
+checkouts or versions side by side); older ones are removed when a new one is made. A cache made
+with the kernels compiled as whole libraries (``PHASEIMPACT_LINKED_ONLY=0``, or a numba without
+the hooks below) gets its own directory, ``...-whole``: the other kind's files cannot be read back
+without the hooks.
 """
 
 from __future__ import annotations
@@ -62,11 +67,12 @@ import os
 import shutil
 import sys
 import tempfile
-import time
+import warnings
 from dataclasses import dataclass
 from pathlib import Path
 
-__all__ = ["kernel", "allocating", "cache_info", "CacheInfo", "ENGINE_SOURCES", "processes", "PROCESSES_VARIABLE"]
+__all__ = ["kernel", "allocating", "cache_info", "CacheInfo", "ENGINE_SOURCES", "linked_only",
+           "LINKED_ONLY_VARIABLE", "announce"]
 
 #: The package's root directory.
 PACKAGE = Path(__file__).resolve().parent
@@ -76,27 +82,21 @@ ENGINE_SOURCES = ("model", "integrate", "_jit.py", "_signals.py")
 KEEP = 4
 #: Marks a cache directory this module made (only those are ever removed).
 _MARKER = "phaseimpact-cache"
-#: Written by ``phaseimpact warmup`` once every entry is compiled: a cache others may read only.
-COMPLETE = "complete"
 
-#: Environment variable: the number of processes of a first-ever compile (1 or 2).
-PROCESSES_VARIABLE = "PHASEIMPACT_COMPILE_PROCESSES"
-#: True in the console script's process (``phaseimpact ...``), which runs one command and ends: what
-#: a first compile leaves for the garbage collector is frozen there, not collected
-#: (:class:`phaseimpact.integrate.precompile._FirstCompile`).
-ONE_COMMAND = False
+#: Environment variable: ``0`` compiles every kernel as a whole library (numba's own way, no hooks).
+LINKED_ONLY_VARIABLE = "PHASEIMPACT_LINKED_ONLY"
+#: The first compile of an entry on a cold cache, on two cores (``benchmarks/startup.py``): the
+#: announcement quotes it.
+FIRST_COMPILE = "about 35 s"
 
 
-def processes() -> int:
-    """How many processes a first-ever compile uses: ``PHASEIMPACT_COMPILE_PROCESSES`` (1 or 2),
-    by default 2 when this process may run on two cores."""
-    value = os.environ.get(PROCESSES_VARIABLE, "")
-    if value:
-        if value not in ("1", "2"):
-            raise ValueError(f"{PROCESSES_VARIABLE} = {value!r} is out of range; allowed: 1 or 2")
-        return int(value)
-    cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1
-    return 2 if cores >= 2 else 1
+def linked_only_requested() -> bool:
+    """``PHASEIMPACT_LINKED_ONLY``: ``1`` or unset (the default) hooks the kernels' libraries into
+    numba where it can; ``0`` leaves numba as it is."""
+    value = os.environ.get(LINKED_ONLY_VARIABLE, "")
+    if value not in ("", "0", "1"):
+        raise ValueError(f"{LINKED_ONLY_VARIABLE} = {value!r} is out of range; allowed: 0 or 1")
+    return value != "0"
 
 
 # ------------------------------------------------------------------------------------------------
@@ -122,15 +122,19 @@ def engine_digest(package: Path = PACKAGE) -> str:
     return digest.hexdigest()[:16]
 
 
+def cache_name() -> str:
+    """The cache directory's name: the engine's version and digest, and how kernels are compiled."""
+    return f"phaseimpact-{_version()}-{engine_digest()}{'' if linked_only() else '-whole'}"
+
+
 @dataclass(frozen=True)
 class CacheInfo:
     """Where this process keeps the compiled engine.
 
-    ``path`` is None when nothing is cached (``reason`` says why); ``writable`` is False for a
-    complete cache this user may only read; ``tried`` lists the roots tried, in order."""
+    ``path`` is None when nothing is cached (``reason`` says why); ``tried`` lists the roots tried,
+    in order."""
 
     path: Path | None
-    writable: bool
     source: str
     reason: str
     tried: tuple[str, ...]
@@ -138,7 +142,7 @@ class CacheInfo:
     def describe(self) -> str:
         if self.path is None:
             return f"no cache ({self.reason})"
-        return f"{self.path} ({self.source}{'' if self.writable else ', read-only'})"
+        return f"{self.path} ({self.source})"
 
 
 def _user_root() -> Path | None:
@@ -160,6 +164,7 @@ def _roots() -> list[tuple[Path, str]]:
 
 
 def _writable(path: Path) -> bool:
+    # what numba's own locator checks before it uses a directory
     try:
         path.mkdir(parents=True, exist_ok=True)
         tempfile.TemporaryFile(dir=path).close()
@@ -180,80 +185,69 @@ def _prune(root: Path, keep: Path) -> None:
 
 
 def _choose() -> CacheInfo:
-    name = f"phaseimpact-{_version()}-{engine_digest()}"
+    name = cache_name()
     tried = []
     for root, source in _roots():
         path = root / name
         tried.append(str(path))
         fresh = not path.exists()
         if _writable(path):
-            marker = path / _MARKER
             try:
-                marker.touch()  # its time is this directory's last use (pruning keeps the recent ones)
+                (path / _MARKER).touch()  # its time is this directory's last use (pruning keeps the recent ones)
             except OSError:
                 pass
             if fresh:
                 _prune(root, path)
-            return CacheInfo(path, True, source, "", tuple(tried))
-        if (path / COMPLETE).is_file():  # filled by someone else (a shared install's owner): read it
-            return CacheInfo(path, False, source, "", tuple(tried))
-    return CacheInfo(None, False, "", "none of " + ", ".join(tried) + " is writable", tuple(tried))
+            return CacheInfo(path, source, "", tuple(tried))
+    return CacheInfo(None, "", "none of " + ", ".join(tried) + " is writable", tuple(tried))
 
 
 @functools.cache
 def cache_info() -> CacheInfo:
     """Where this process keeps the compiled engine (chosen once, on first need)."""
     if os.environ.get("NUMBA_DISABLE_JIT", "0") not in ("", "0"):
-        return CacheInfo(None, False, "", "NUMBA_DISABLE_JIT is set", ())
+        return CacheInfo(None, "", "NUMBA_DISABLE_JIT is set", ())
     return _choose()
 
 
-def _cache_subdir(py_file: str) -> Path:
+# ------------------------------------------------------------------------------------------------
+# The first compile says so
+# ------------------------------------------------------------------------------------------------
+
+def announce() -> str:
+    """The line a first compile writes on stderr (it depends on where the cache is)."""
     info = cache_info()
-    source = Path(py_file).resolve()
-    try:
-        return info.path / source.parent.relative_to(PACKAGE)
-    except ValueError:  # a function from outside the package: numba's own stamp guards its file
-        parent = source.parent
-        return info.path / "external" / f"{parent.name}_{hashlib.sha1(str(parent).encode()).hexdigest()[:12]}"
+    if info.path is None:
+        return (f"phaseimpact: compiling the engine for this process, {FIRST_COMPILE} on 2 cores (nothing is "
+                f"cached: {info.reason}; set NUMBA_CACHE_DIR to a writable directory to compile once)")
+    return f"phaseimpact: compiling the engine once for this machine, {FIRST_COMPILE} on 2 cores (cache: {info.path})"
+
+
+#: The module of the run loops called from Python, whose compile is the engine's (a kernel called
+#: from Python, as the tests do, compiles in a second).
+_ENTRIES_MODULE = "phaseimpact.integrate.driver"
 
 
 @functools.cache
-def _cache_class():
-    """numba's function cache, located in :func:`cache_info`'s directory; a save that cannot be
-    written (a read-only cache) leaves the compiled function to this process alone."""
-    from numba.core import caching
+def _listen_for_first_compile() -> None:
+    """Print :func:`announce` once per process, when numba compiles an entry (a cache miss: numba's
+    ``numba:compile`` event fires on nothing else)."""
+    from numba.core import event
 
-    class Locator(caching._SourceFileBackedLocatorMixin, caching._CacheLocator):
-        def __init__(self, py_func, py_file):
-            self._py_file = py_file
-            self._lineno = py_func.__code__.co_firstlineno
-            self._cache_path = str(_cache_subdir(py_file))
+    class FirstCompile(event.Listener):
+        announced = False
 
-        def get_cache_path(self):
-            return self._cache_path
+        def on_start(self, ev):
+            dispatcher = ev.data["dispatcher"]
+            if (not self.announced and getattr(dispatcher.py_func, "__module__", "") == _ENTRIES_MODULE
+                    and not dispatcher.targetoptions.get("no_cpython_wrapper", False)):
+                self.announced = True
+                print(announce(), file=sys.stderr, flush=True)
 
-        def ensure_cache_path(self):
-            if cache_info().writable:
-                super().ensure_cache_path()
+        def on_end(self, ev):
+            pass
 
-        @classmethod
-        def from_function(cls, py_func, py_file):
-            return cls(py_func, py_file)
-
-    class Impl(caching.CompileResultCacheImpl):
-        _locator_classes = [Locator]
-
-    class Cache(caching.FunctionCache):
-        _impl_class = Impl
-
-        def save_overload(self, sig, data):
-            try:
-                super().save_overload(sig, data)
-            except OSError:
-                pass
-
-    return Cache
+    event.register("numba:compile", FirstCompile())
 
 
 # ------------------------------------------------------------------------------------------------
@@ -267,19 +261,28 @@ def _cache_class():
 # first compile went into machine code that nothing would run. A kernel's library here keeps its
 # function-level optimisation and its IR for linking, and stops there; the entry that links it
 # optimises the whole and makes the only machine code, as before. The machine code of the
-# entries, and every result, is bit-identical; a cold session on one process took 38.9 s before
-# and 29.9 s after (``benchmarks/startup.py``).
+# entries, and every result, is bit-identical (``tests/test_precompile.py``); the first compile's
+# time with and without is in ``benchmarks/results/startup.md``.
 #
 # numba has no public switch for this: the library class below overrides three of its library's
 # internal steps, and :func:`_linked_only_installed` hooks three more (where a function's library
-# is made, where a cached one is read back, and where a function's environment is set). Each is
-# checked first: with a numba that lacks them nothing is changed, and the compile takes its old
-# time (``tests/test_cache.py`` says so).
+# is made, where a cached one is read back, and where a function's environment is set). Every
+# name is checked first (:data:`_HOOKED`): with a numba that lacks one nothing is changed, the
+# compile takes numba's own time, and one warning says so. ``PHASEIMPACT_LINKED_ONLY=0`` turns it
+# off.
 
 #: The Python functions compiled as kernels without a Python wrapper (see above).
 _LINKED_ONLY: set = set()
 #: The kind under which a kernel's library is cached (numba's own are "object" and "bitcode").
 _LINKED_ONLY_KIND = "phaseimpact-linked-only"
+#: numba's internals the linked-only kernels use or replace: (module, class, names).
+_HOOKED = (
+    ("numba.core.codegen", "JITCodeLibrary", ("_optimize_final_module", "_finalize_final_module",
+                                              "_finalize_dynamic_globals", "_verify_declare_only_symbols",
+                                              "_get_module_for_linking", "serialize_using_object_code")),
+    ("numba.core.codegen", "JITCPUCodegen", ("unserialize_library", "set_env")),
+    ("numba.core.typed_passes", "BaseNativeLowering", ("run_pass",)),
+)
 
 
 @functools.cache
@@ -312,18 +315,38 @@ def _linked_only_library():
     return LinkedOnlyLibrary
 
 
+def _missing_hooks() -> list[str]:
+    import importlib
+
+    missing = []
+    for module, owner, names in _HOOKED:
+        cls = getattr(importlib.import_module(module), owner, None)
+        missing.extend(f"{module}.{owner}.{name}" for name in names if not hasattr(cls, name))
+    return missing
+
+
 @functools.cache
-def _linked_only_installed() -> bool:
-    """Hook the kernels' libraries into numba (once); False if this numba lacks what they need."""
+def linked_only() -> bool:
+    """Whether kernels are compiled for linking only in this process: asked for
+    (``PHASEIMPACT_LINKED_ONLY``) and this numba has every hooked name (else one warning says which
+    it lacks). Hooks numba on the first call."""
+    if not linked_only_requested():
+        return False
+    missing = _missing_hooks()
+    if missing:
+        import numba
+
+        warnings.warn(f"phaseimpact: numba {numba.__version__} lacks {', '.join(missing)}; kernels are "
+                      f"compiled as whole libraries, and a first compile takes longer (set "
+                      f"{LINKED_ONLY_VARIABLE}=0 to choose this without the warning)", RuntimeWarning, stacklevel=2)
+        return False
+    _install_linked_only()
+    return True
+
+
+def _install_linked_only() -> None:
     from numba.core import codegen, typed_passes
 
-    needed = ((codegen.JITCodeLibrary, ("_optimize_final_module", "_finalize_final_module",
-                                         "_finalize_dynamic_globals", "_verify_declare_only_symbols",
-                                         "_get_module_for_linking", "serialize_using_object_code")),
-              (codegen.JITCPUCodegen, ("unserialize_library", "set_env")),
-              (typed_passes.BaseNativeLowering, ("run_pass",)))
-    if not all(hasattr(owner, name) for owner, names in needed for name in names):
-        return False
     library_class = _linked_only_library()
     lower, unserialize, set_env = (typed_passes.BaseNativeLowering.run_pass,
                                    codegen.JITCPUCodegen.unserialize_library, codegen.JITCPUCodegen.set_env)
@@ -348,7 +371,6 @@ def _linked_only_installed() -> bool:
     typed_passes.BaseNativeLowering.run_pass = run_pass
     codegen.JITCPUCodegen.unserialize_library = unserialize_library
     codegen.JITCPUCodegen.set_env = set_env_where_defined
-    return True
 
 
 # ------------------------------------------------------------------------------------------------
@@ -361,13 +383,19 @@ _pending: list[_Deferred] = []
 def _compile(function, options):
     import numba
 
-    if options["no_cpython_wrapper"] and _linked_only_installed():
+    _listen_for_first_compile()
+    if options["no_cpython_wrapper"] and linked_only():
         _LINKED_ONLY.add(function)
-    cache = cache_info().path is not None
-    dispatcher = numba.njit(cache=False, **options)(function)
-    if cache:
-        dispatcher._cache = _cache_class()(function)  # what numba's cache=True does, with our locator
-    return dispatcher
+    path = cache_info().path
+    if path is None:
+        return numba.njit(cache=False, **options)(function)
+    # numba's locator reads the setting when the function is declared (``cache=True``), and keeps it
+    previous = numba.config.CACHE_DIR
+    numba.config.CACHE_DIR = str(path)
+    try:
+        return numba.njit(cache=True, **options)(function)
+    finally:
+        numba.config.CACHE_DIR = previous
 
 
 class _Deferred:
@@ -437,9 +465,3 @@ kernel = _compiler(reference_counted=False)
 #: ``@allocating``, ``@allocating(python=True, nogil=True)``: a compiled function that creates arrays.
 allocating = _compiler(reference_counted=True)
 
-
-def mark_complete() -> None:
-    """Say that the cache holds every entry (``phaseimpact warmup``): other users may read it."""
-    info = cache_info()
-    if info.path is not None and info.writable:
-        (info.path / COMPLETE).write_text(time.strftime("%Y-%m-%dT%H:%M:%S%z\n"))

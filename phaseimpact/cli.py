@@ -84,13 +84,13 @@ _NEGATIVE_NUMBER = re.compile(r"^-(\d+\.?\d*|\.\d+)(e[-+]?\d+)?$|^-(inf|infinity
 def _check_environment() -> None:
     """The environment this process runs in, checked before any work (``ValueError`` names it)."""
     from ._environment import numba_num_threads, source_date_epoch
-    from ._jit import processes
+    from ._jit import linked_only_requested
 
     if sys.stdout is None:  # started with stdout closed (cmd >&-): nothing could be reported
         raise ValueError("stdout is closed; allowed: an open standard output (redirect it to a file or /dev/null)")
     source_date_epoch()
     numba_num_threads()
-    processes()  # PHASEIMPACT_COMPILE_PROCESSES: read only by a first-ever compile, checked every time
+    linked_only_requested()  # PHASEIMPACT_LINKED_ONLY: read only by a first compile, checked every time
 
 
 class _Parser(argparse.ArgumentParser):
@@ -632,8 +632,8 @@ def cmd_warmup(args) -> int:
         print(f"compiled in {out['seconds']:.1f} s for this process only: nothing is cached ({out['reason']})")
     else:
         done = "compiled" if out["compiled"] else "already compiled; loaded"
-        print(f"{done} in {out['seconds']:.1f} s; cache: {out['cache']} ({out['source']}"
-              f"{'' if out['writable'] else ', read-only'}; {out['files']} files, {out['bytes'] / 1e6:.1f} MB)")
+        print(f"{done} in {out['seconds']:.1f} s; cache: {out['cache']} ({out['source']}; {out['files']} files, "
+              f"{out['bytes'] / 1e6:.1f} MB)")
     return EXIT_OK
 
 
@@ -1542,9 +1542,10 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser("warmup", help="compile the engine ahead, and say where its cache is",
                        description="Compile every entry of the engine into its cache now (the first command that "
-                                   "integrates would otherwise do it, about 20 s on 2 cores), and say where the "
-                                   "cache is: for shared installs (run it as the install's owner: other users read "
-                                   "that cache), containers and cluster workers. On a warm cache it only loads.")
+                                   "integrates would otherwise do it, about 35 s on 2 cores), and say where the "
+                                   "cache is: for containers, cluster workers and a fresh install (each user who "
+                                   "cannot write the install compiles once into ~/.cache/phaseimpact). On a warm "
+                                   "cache it only loads.")
     json_option(p)
     p.set_defaults(func=cmd_warmup)
 

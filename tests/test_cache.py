@@ -60,20 +60,21 @@ def test_the_digest_covers_every_engine_file_and_only_those(tmp_path):
 @pytest.mark.slow
 def test_editing_a_kernel_in_a_copy_changes_the_next_run(tmp_path):
     """Copy the package, run, double the Hertz power in model/laws.py (a kernel the driver inlines),
-    run again in a fresh process on the same cache root: the new force, not the cached one."""
+    run again in a fresh process on the same cache root: the new force, not the cached one. (Two
+    first compiles: numba keys its files on each source folder's absolute path, so the copy cannot
+    start from the checkout's cache.)"""
     import numpy as np
 
     from phaseimpact import seed_parameters, simulate
 
-    expected = simulate(seed_parameters(v=1.0, kappa=3e9), "hunt-crossley", 2e-3).max_force  # warms the cache
+    expected = simulate(seed_parameters(v=1.0, kappa=3e9), "hunt-crossley", 2e-3).max_force
     package = _copy_package(tmp_path / "copy")
     root = tmp_path / "cache"
-    # the copy's sources are the checkout's: start from the checkout's warm cache (only the edit compiles)
-    shutil.copytree(_jit.cache_info().path, root / _jit.cache_info().path.name)
     first = _run(RUN, package.parent, NUMBA_CACHE_DIR=str(root))
     assert first.returncode == 0, first.stderr[-3000:]
     first = json.loads(first.stdout.strip().splitlines()[-1])
     assert first["file"] == str(package / "__init__.py")
+    assert first["cache"] == str(root / _jit.cache_name())
     assert first["max_force"] == expected
 
     laws = package / "model" / "laws.py"
@@ -106,14 +107,14 @@ def test_the_first_writable_root_holds_the_cache_and_old_directories_are_pruned(
         os.utime(old / _jit._MARKER, (1e9 + i, 1e9 + i))
     (root / "someone-elses").mkdir()
     info = _info(monkeypatch, [(root, "test")])
-    assert info.writable and info.path.parent == root
-    assert info.path.name == f"phaseimpact-{_jit._version()}-{_jit.engine_digest()}"
+    assert info.path.parent == root
+    assert info.path.name == _jit.cache_name()
     left = sorted(p.name for p in root.iterdir())
     kept = [f"phaseimpact-0.1-{i:016d}" for i in range(2, _jit.KEEP + 2)]  # the KEEP most recent
     assert left == sorted([*kept, "someone-elses", info.path.name])
 
 
-def test_an_unwritable_root_falls_back_then_reads_a_complete_cache_then_caches_nothing(tmp_path, monkeypatch):
+def test_an_unwritable_root_falls_back_then_caches_nothing(tmp_path, monkeypatch):
     if os.geteuid() == 0:
         pytest.skip("root writes anywhere: the unwritable case is run in test_a_read_only_install_...")
     locked = tmp_path / "locked"
@@ -122,7 +123,7 @@ def test_an_unwritable_root_falls_back_then_reads_a_complete_cache_then_caches_n
     locked.chmod(0o555)
     try:
         info = _info(monkeypatch, [(locked, "install"), (user, "per user")])
-        assert info.writable and info.source == "per user"
+        assert info.path.parent == user and info.source == "per user"
         info = _info(monkeypatch, [(locked, "install")])
         assert info.path is None and "is writable" in info.reason
     finally:
@@ -175,16 +176,6 @@ def test_a_read_only_install_with_no_home_never_crashes(tmp_path):
         shutil.rmtree(base)
 
 
-def test_a_complete_cache_is_read_where_it_cannot_be_written(tmp_path, monkeypatch):
-    locked = tmp_path / "locked"
-    name = f"phaseimpact-{_jit._version()}-{_jit.engine_digest()}"
-    (locked / name).mkdir(parents=True)
-    (locked / name / _jit.COMPLETE).touch()
-    monkeypatch.setattr(_jit, "_writable", lambda path: False)
-    info = _info(monkeypatch, [(locked, "install"), (tmp_path / "user", "per user")])
-    assert info.path == locked / name and not info.writable
-
-
 @pytest.mark.parametrize("argv", [["cases"], ["params"], ["--version"], ["--help"], ["cases", "--json"],
                                   ["completion", "bash"]])
 def test_commands_that_integrate_nothing_import_no_numba(argv):
@@ -211,40 +202,92 @@ def twice(x):
 def entry(x):
     return twice(x) + 1.0
 """
-# First process: the kernel alone (as the compile helper does); second: the entry, which reads the
-# kernel from the cache and links it.
+# First process: the kernel alone; second: the entry, which reads the kernel from the cache and
+# links it. ``hooks`` (the first argument) "lacking" pretends this numba lacks one hooked name.
 LINKED_RUN = r"""
-import json, sys
-from numba import float64
+import json, os, sys, warnings
+warnings.simplefilter("always")
+from numba import config, float64
 from phaseimpact import _jit
-import linked
-if sys.argv[1] == "kernel":
-    linked.twice.compile((float64,))
-    library = linked.twice.overloads[(float64,)].library
-    print(json.dumps({"linked_only": isinstance(library, _jit._linked_only_library()),
-                      "kind": library.serialize_using_object_code()[1],
-                      "machine_code": any(library.codegen._engine.is_symbol_defined(f.name)
-                                          for f in library.get_defined_functions())}))
-else:
-    value = linked.entry(3.0)
-    kernel, entry = linked.twice.overloads[(float64,)].library, linked.entry.overloads[(float64,)].library
-    print(json.dumps({"value": value, "kernel_from_cache": linked.twice.stats.cache_hits[(float64,)],
-                      "linked_only": isinstance(kernel, _jit._linked_only_library()),
-                      "entry_linked_only": isinstance(entry, _jit._linked_only_library())}))
+if sys.argv[2] == "lacking":
+    _jit._HOOKED += (("numba.core.codegen", "JITCodeLibrary", ("_a_step_this_numba_lacks",)),)
+with warnings.catch_warnings(record=True) as caught:
+    import linked
+    out = {"cache_dir_restored": config.CACHE_DIR == os.environ["NUMBA_CACHE_DIR"],
+           "cache": _jit.cache_info().path.name}
+    if sys.argv[1] == "kernel":
+        linked.twice.compile((float64,))
+        library = linked.twice.overloads[(float64,)].library
+        out.update(linked_only=isinstance(library, _jit._linked_only_library()),
+                   kind=library.serialize_using_object_code()[1],
+                   machine_code=any(library.codegen._engine.is_symbol_defined(f.name)
+                                    for f in library.get_defined_functions()))
+    else:
+        kernel = linked.twice.overloads  # filled by the entry's compile or from the cache
+        out.update(value=linked.entry(3.0) + linked.entry(4.0),
+                   kernel_from_cache=linked.twice.stats.cache_hits.get((float64,), 0),
+                   linked_only=isinstance(kernel[(float64,)].library, _jit._linked_only_library()),
+                   entry_linked_only=isinstance(linked.entry.overloads[(float64,)].library,
+                                                _jit._linked_only_library()))
+out["warnings"] = [str(w.message) for w in caught if issubclass(w.category, RuntimeWarning)]
+print(json.dumps(out))
 """
+
+
+def _linked(tmp_path, step, hooks="present", **env):
+    module = tmp_path / "linked.py"
+    if not module.exists():  # rewritten, its new time would make numba's cache of it stale
+        module.write_text(LINKED)
+    env = {"NUMBA_CACHE_DIR": str(tmp_path / "cache"), "PYTHONPATH": os.pathsep.join((str(tmp_path), str(ROOT))),
+           **env}
+    out = subprocess.run([sys.executable, "-c", LINKED_RUN, step, hooks], cwd=tmp_path, capture_output=True,
+                         text=True, timeout=600, env={**{k: v for k, v in os.environ.items()
+                                                         if k not in ("NUMBA_DISABLE_JIT", LINKED_SWITCH)}, **env})
+    assert out.returncode == 0, out.stderr[-3000:]
+    return json.loads(out.stdout.strip().splitlines()[-1])
+
+
+LINKED_SWITCH = "PHASEIMPACT_LINKED_ONLY"
 
 
 def test_a_kernel_is_compiled_for_linking_only_and_read_back_from_the_cache_by_its_callers(tmp_path):
     """A kernel's library keeps its IR for the entries that link it and makes no machine code of
     its own (the compile-time saving of phaseimpact/_jit.py); cached, it is read back as such and
-    an entry compiled in another process links it and computes the right value."""
-    assert _jit._linked_only_installed(), "this numba lacks the hooks: kernels compile as whole libraries"
-    (tmp_path / "linked.py").write_text(LINKED)
-    env = {"NUMBA_CACHE_DIR": str(tmp_path / "cache"), "PYTHONPATH": os.pathsep.join((str(tmp_path), str(ROOT)))}
-    first = _run(LINKED_RUN.replace("sys.argv[1]", "'kernel'"), tmp_path, **env)
-    assert first.returncode == 0, first.stderr[-3000:]
-    assert json.loads(first.stdout) == {"linked_only": True, "kind": _jit._LINKED_ONLY_KIND, "machine_code": False}
-    second = _run(LINKED_RUN.replace("sys.argv[1]", "'entry'"), tmp_path, **env)
-    assert second.returncode == 0, second.stderr[-3000:]
-    assert json.loads(second.stdout) == {"value": 7.0, "kernel_from_cache": 1, "linked_only": True,
-                                         "entry_linked_only": False}
+    an entry compiled in another process links it and computes the right value. The cache is
+    numba's own (``numba.config.CACHE_DIR``), set to the digest's directory only while the engine's
+    functions are declared."""
+    name = f"phaseimpact-{_jit._version()}-{_jit.engine_digest()}"
+    assert _linked(tmp_path, "kernel") == {"cache_dir_restored": True, "cache": name, "linked_only": True,
+                                           "kind": _jit._LINKED_ONLY_KIND, "machine_code": False, "warnings": []}
+    assert list((tmp_path / "cache" / name).rglob("linked.twice-*.nbi")), "numba cached nothing in the digest's dir"
+    assert _linked(tmp_path, "entry") == {"cache_dir_restored": True, "cache": name, "value": 16.0,
+                                          "kernel_from_cache": 1, "linked_only": True, "entry_linked_only": False,
+                                          "warnings": []}
+
+
+def test_the_switch_off_compiles_whole_libraries_in_their_own_cache(tmp_path):
+    """``PHASEIMPACT_LINKED_ONLY=0``: numba's own libraries (machine code for each kernel), cached
+    apart (a linked-only cache cannot be read without the hooks)."""
+    name = f"phaseimpact-{_jit._version()}-{_jit.engine_digest()}-whole"
+    kernel = _linked(tmp_path, "kernel", **{LINKED_SWITCH: "0"})
+    assert kernel["cache"] == name and kernel["linked_only"] is False and kernel["machine_code"] is True
+    assert kernel["kind"] != _jit._LINKED_ONLY_KIND and kernel["warnings"] == []
+    entry = _linked(tmp_path, "entry", **{LINKED_SWITCH: "0"})
+    assert entry["value"] == 16.0 and entry["kernel_from_cache"] == 1 and entry["linked_only"] is False
+
+
+def test_a_numba_lacking_a_hooked_name_warns_once_and_still_computes(tmp_path):
+    """A numba without one of the names the hooks need: one warning naming it, nothing hooked,
+    kernels compiled numba's own way (however many compile), the right value."""
+    out = _linked(tmp_path, "entry", hooks="lacking")
+    assert len(out["warnings"]) == 1, out["warnings"]
+    assert "lacks numba.core.codegen.JITCodeLibrary._a_step_this_numba_lacks" in out["warnings"][0]
+    assert out["value"] == 16.0 and out["linked_only"] is False
+    assert out["cache"].endswith("-whole")
+
+
+@pytest.mark.parametrize("value", ["2", "yes", "off"])
+def test_the_switch_refuses_other_values(monkeypatch, value):
+    monkeypatch.setenv(LINKED_SWITCH, value)
+    with pytest.raises(ValueError, match=f"{LINKED_SWITCH} = '{value}' is out of range; allowed: 0 or 1"):
+        _jit.linked_only_requested()

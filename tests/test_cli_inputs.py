@@ -445,10 +445,10 @@ def test_bad_numba_num_threads_named(threads, tmp_path):
         f"phaseimpact: error: NUMBA_NUM_THREADS = {threads!r} is out of range; allowed: an integer >= 1"), lines
 
 
-def test_bad_compile_processes_refused(monkeypatch, no_work):
-    monkeypatch.setenv("PHASEIMPACT_COMPILE_PROCESSES", "abc")
+def test_bad_linked_only_switch_refused(monkeypatch, no_work):
+    monkeypatch.setenv("PHASEIMPACT_LINKED_ONLY", "abc")
     code, _, err = run(["simulate"])
-    assert code == 2 and "PHASEIMPACT_COMPILE_PROCESSES = 'abc'" in err
+    assert code == 2 and "PHASEIMPACT_LINKED_ONLY = 'abc' is out of range; allowed: 0 or 1" in err
 
 
 def test_closed_stdout_is_an_error(tmp_path):

@@ -312,9 +312,7 @@ def test_atlas_stops_with_the_resume_command_and_no_lock(tmp_path, warm, signum,
 def test_ctrl_c_while_the_command_line_is_imported_ends_in_one_line(monkeypatch, capsys):
     """The console script's first moments: a KeyboardInterrupt raised by the import of the command
     line (made to happen here by a finder) gives one line and 130, no traceback."""
-    from phaseimpact import _entry, _jit
-
-    monkeypatch.setattr(_jit, "ONE_COMMAND", False)  # the console script sets it; restored after the test
+    from phaseimpact import _entry
 
     class Interrupting:
         def find_spec(self, name, path=None, target=None):

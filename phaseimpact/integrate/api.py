@@ -17,10 +17,7 @@ from ..model.laws import ContactLaw, as_law
 from ..model.rhs import N_COEF, initial_state, pack
 from ..parameters import Parameters, is_number
 from . import driver as d
-from . import (
-    precompile,  # noqa: F401  (registers the two-process first compile)
-    radau5,
-)
+from . import radau5
 from .events import EVENT_KINDS
 from .result import Columns, Trajectory
 

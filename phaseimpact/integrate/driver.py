@@ -903,7 +903,7 @@ def run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count,
     (:func:`_restart`). The seed's RK4 is :func:`run_rk4`.
 
     The loop is :func:`_run`, which :func:`run_block` calls too: a first compile makes the two
-    entries from it side by side, one in each process (:mod:`.precompile`).
+    entries from it (:func:`phaseimpact.integrate.precompile.warmup` compiles both ahead).
     """
     return _run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count, save_kind, times,
                 max_steps, max_events, stiff_after)
