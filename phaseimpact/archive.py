@@ -198,7 +198,7 @@ from .train import (
     OrbitDiagram,
 )
 
-__all__ = ["SCHEMA_VERSION", "KINDS", "TRAIN_KINDS", "TRANSITION_KINDS",
+__all__ = ["SCHEMA_VERSION", "KINDS", "TRAIN_KINDS", "RUN_KINDS", "TRANSITION_KINDS",
            "CHUNK_POINTS", "Checkpoint", "save", "load", "describe", "same_work",
            "check_overwrite", "kind_of", "created_timestamp", "DamagedArchiveError", "to_xarray", "stick_phases",
            "unit_attributes"]
@@ -210,6 +210,9 @@ KINDS = ("sweep", "atlas", "critical-curve")
 #: What an archive of the impact map holds (phaseimpact.train): an ImpactTrain, an OrbitDiagram, a MapBranch
 #: or Basins. Apart from KINDS, whose archives the command line's sweeps complete and resume.
 TRAIN_KINDS = ("impact-train", "orbit-diagram", "map-branch", "basins")
+#: What an archive of one run or of a transition search holds: a Trajectory (``simulate --out``) or the
+#: list of Transition of :func:`~phaseimpact.continuation.transitions` (``transitions --out``).
+RUN_KINDS = ("trajectory", "transitions")
 #: CF 1.9 and later allow int64 variables (the counts and stick rows).
 CONVENTIONS = "CF-1.11"
 #: The global attribute ``references``: where the equations and the outcome classes are defined.
@@ -356,13 +359,14 @@ def kind_of(result) -> str:
 
     Parameters
     ----------
-    result : SweepResult, Grid, CriticalCurve, ImpactTrain, OrbitDiagram, MapBranch or Basins
+    result : SweepResult, Grid, CriticalCurve, Trajectory, list of Transition, ImpactTrain, OrbitDiagram, \
+MapBranch or Basins
         What would be archived.
 
     Returns
     -------
     str
-        One of :data:`KINDS` or :data:`TRAIN_KINDS`.
+        One of :data:`KINDS`, :data:`RUN_KINDS` or :data:`TRAIN_KINDS`.
 
     Raises
     ------
@@ -381,6 +385,10 @@ def kind_of(result) -> str:
     """
     if isinstance(result, CriticalCurve):
         return "critical-curve"
+    if isinstance(result, Trajectory):
+        return "trajectory"
+    if _transitions_of(result):
+        return "transitions"
     if type(result) in _TRAIN_KIND:
         return _TRAIN_KIND[type(result)]
     grid = result.grid if isinstance(result, SweepResult) else result
@@ -671,9 +679,11 @@ def save(result, path, *, force: bool = False, params=None, law=None, settings: 
 
     Parameters
     ----------
-    result : SweepResult, CriticalCurve, ImpactTrain, OrbitDiagram, MapBranch or Basins
-        A sweep, an atlas (complete or partial), a continued curve, or a result of
-        :mod:`phaseimpact.train`.
+    result : SweepResult, CriticalCurve, Trajectory, list of Transition, ImpactTrain, OrbitDiagram, \
+MapBranch or Basins
+        A sweep, an atlas (complete or partial), a continued curve, a run of
+        :func:`~phaseimpact.simulate`, what :func:`~phaseimpact.continuation.transitions` returns, or a
+        result of :mod:`phaseimpact.train`.
     path : str or path-like
         The archive to write (conventionally ``.nc``: netCDF-4).
     force : bool, default False
@@ -681,12 +691,15 @@ def save(result, path, *, force: bool = False, params=None, law=None, settings: 
         is refused (``ValueError``); an existing archive is replaced. (The command line also refuses
         an archive of other work: see :func:`check_overwrite`.)
     params : Parameters or Case, optional
-        A train result's case (it does not carry it; required for one, refused for the others).
+        The case of a result that does not carry it (transitions, a train result: required), or the
+        Case a trajectory was run from (optional; its parameters must be the run's). Refused for
+        a sweep or curve.
     law : ContactLaw or str, optional
-        A train result's law (required for one, refused for the others).
+        The law of transitions or a train result (required for them, refused for the others).
     settings : dict, optional
-        A train result's other arguments, stored as the JSON attribute ``settings``: ``rtol`` (the
-        header's ``rtol``), ``period`` (s: an orbit diagram's or branch's over ``kappa`` or ``v``), ...
+        The call's other arguments (transitions, a train result, a trajectory), stored as the JSON
+        attribute ``settings``: ``rtol`` (the header's ``rtol``), ``period`` (s: an orbit diagram's or
+        branch's over ``kappa`` or ``v``), ``kappa_min``, ``kappa_max`` (transitions), ...
 
     Returns
     -------
@@ -726,9 +739,9 @@ def save(result, path, *, force: bool = False, params=None, law=None, settings: 
     >>> bool((back.peak_force == train.peak_force).all()), back.status
     (True, ['success', 'success', 'success'])
     """
-    if not isinstance(result, _ARCHIVED):
-        raise TypeError(f"cannot archive a {type(result).__name__}; allowed: a SweepResult or a CriticalCurve, or "
-                        "an ImpactTrain, OrbitDiagram, MapBranch or Basins")
+    if not (isinstance(result, _ARCHIVED) or _transitions_of(result)):
+        raise TypeError(f"cannot archive a {type(result).__name__}; allowed: a SweepResult or a CriticalCurve, a "
+                        "Trajectory, a list of Transition, or an ImpactTrain, OrbitDiagram, MapBranch or Basins")
     context = _context(result, params, law, settings, required=True)
     _write_file(result, os.fspath(path), force=force, spare_rows=0, context=context)
     return os.fspath(path)
@@ -828,12 +841,10 @@ _XARRAY_EXTRA = ("install the extra phaseimpact[xarray] (in a checkout: pip inst
 def to_xarray(result, *, params=None, law=None, settings: dict | None = None):
     """``result`` as an in-memory :class:`xarray.Dataset`, no file written.
 
-    For what :func:`save` archives, the Dataset is the one ``xarray.open_dataset`` gives of that
-    archive (it is that archive, built in memory), variables, dimensions, units and attributes
-    alike, so code written for one reads the other. A trajectory and a list of transitions, which
-    have no archive kind, get a Dataset in the same conventions (CF-1.11 attributes, units as
-    :func:`unit_attributes` gives them, codes as integer flags, the header's attributes); the module
-    docstring gives every layout. Needs xarray and h5netcdf (the extra ``phaseimpact[xarray]``).
+    The Dataset is the one ``xarray.open_dataset`` gives of the archive :func:`save` writes (it is
+    that archive, built in memory), variables, dimensions, units and attributes alike, so code
+    written for one reads the other; the module docstring gives every layout. Needs xarray and
+    h5netcdf (the extra ``phaseimpact[xarray]``).
 
     Parameters
     ----------
@@ -845,7 +856,8 @@ MapBranch or Basins
     params : Parameters or Case, optional
         The case of a result that does not carry it (transitions, train results): its header
         attributes (``parameters``, ``case``, ``base``) and the unit of ``kappa`` (its ``alpha``).
-        Left out, so are they. Refused for a result that carries its own.
+        Left out, so are they. A trajectory's Case (its parameters must be the run's); refused for
+        a sweep or curve.
     law : ContactLaw or str, optional
         Its law, likewise (``law``, ``contact``; the unit of ``kappa``).
     settings : dict, optional
@@ -889,7 +901,7 @@ MapBranch or Basins
     >>> dict(train.sizes), train.peak_force.attrs["units"], train.attrs["kind"]
     ({'arrival': 4, 'impact': 3}, 'N', 'impact-train')
     """
-    if not (isinstance(result, _CONVERTED) or _transitions_of(result)):
+    if not (isinstance(result, _ARCHIVED) or _transitions_of(result)):
         raise TypeError(f"cannot convert a {type(result).__name__}; allowed: a SweepResult or a CriticalCurve, a "
                         "Trajectory, a list of Transition, or an ImpactTrain, OrbitDiagram, MapBranch or Basins")
     context = _context(result, params, law, settings, required=False)
@@ -1305,12 +1317,12 @@ def _transitions_of(result) -> bool:
 
 def _context(result, params, law, settings, *, required: bool) -> _Context:
     """The context of a result that does not carry its case (``required``: an archive needs its case and
-    law); a result that carries them (a sweep, a curve, a trajectory) takes none."""
+    law); a result that carries them (a sweep, a curve) takes none, a trajectory its Case and settings only."""
     from .case import Case
     from .model import as_law
 
     given = params is not None or law is not None or settings is not None
-    if isinstance(result, (SweepResult, CriticalCurve, Trajectory)):
+    if isinstance(result, (SweepResult, CriticalCurve)):
         if given:
             raise TypeError(f"a {type(result).__name__} carries its own case, law and settings; params=, law= and "
                             "settings= are for results that do not (transitions, trains of impacts)")
@@ -1319,6 +1331,14 @@ def _context(result, params, law, settings, *, required: bool) -> _Context:
         raise TypeError(f"params has the wrong type ({type(params).__name__}); allowed: Parameters or Case")
     if settings is not None and not isinstance(settings, dict):
         raise TypeError(f"settings has the wrong type ({type(settings).__name__}); allowed: a dict")
+    if isinstance(result, Trajectory):  # it carries its parameters and law; a Case names where they came from
+        if law is not None:
+            raise TypeError("a Trajectory carries its own law; law= is for results that do not (transitions, trains "
+                            "of impacts)")
+        if params is not None and _base_parameters(params) != result.params:
+            raise ValueError("params is not the trajectory's case: its parameters differ from the run's; allowed: "
+                             "the Case the run was made from")
+        return _Context(params, None, None if settings is None else dict(settings))
     if required and (params is None or law is None):
         raise TypeError(f"archiving a {type(result).__name__} needs params= and law= (it does not carry the case "
                         "and law it was computed with)")
@@ -1411,10 +1431,15 @@ _YES_NO = ("no", "yes")
 
 
 def _write_trajectory(f, tr: Trajectory, created: str, context: _Context) -> None:
-    found = re.search(r"rtol=([^,\]]+)", tr.integrator)
-    _header(f, "trajectory", tr.law, tr.params, tr.t_end, float(found.group(1)) if found else None, tr.integrator,
-            created, f"phaseimpact trajectory: {tr.law.name} law, {tr.outcome} ({tr.status})")
+    settings = context.settings or {}
+    found = re.search(r"rtol=([^,\]]+)", tr.integrator)  # the integrator's name rounds it: settings' is exact
+    rtol = settings.get("rtol", float(found.group(1)) if found else None)
+    _header(f, "trajectory", tr.law, tr.params if context.base is None else context.base, tr.t_end, rtol,
+            tr.integrator, created, f"phaseimpact trajectory: {tr.law.name} law, {tr.outcome} ({tr.status})",
+            context.settings)
     f.attrs["message"] = tr.message
+    if tr.law_fault:  # the message of a run a user law ended is made from it
+        f.attrs["law_fault"] = tr.law_fault
     # t, not time: CF's time coordinate (the name time, standard_name time or axis T) needs units "s since
     # <a date>", which xarray decodes to datetime64 (whole nanoseconds; the run's clock starts at 0)
     _coordinate(f, "t", tr.t, "s", "time since the start of the run").attrs["cartesian_axis"] = "T"
@@ -1440,6 +1465,8 @@ def _write_trajectory(f, tr: Trajectory, created: str, context: _Context) -> Non
     for name, index, dtype, units in SUMMARY_COLUMNS:
         value = np.asarray(tr.summary[index]).astype(dtype)
         _variable(f, name, value, long_name=_LONG_NAMES[name], units=units, fill=value.dtype.kind == "f")
+    _variable(f, "first_stick_t", np.float64(tr.summary[_driver.S_FIRST_STICK_T]),
+              long_name="time the first stick phase began", units="s", fill=True)
     _variable(f, "final_mode", np.int64(tr.final_mode), long_name="mode at the end of the run")
     components = {"components": " ".join(name for name, _, _ in _STATE),
                   "component_units": _json([units for _, units, _ in _STATE]),
@@ -1604,10 +1631,9 @@ _WRITERS = {Trajectory: _write_trajectory, ImpactTrain: _write_impact_train, Orb
 #: The archive kind of each train result.
 _TRAIN_KIND = {ImpactTrain: "impact-train", OrbitDiagram: "orbit-diagram", MapBranch: "map-branch",
                Basins: "basins"}
-#: What :func:`save` archives, and what :func:`to_xarray` converts (besides a list of Transition); the
+#: What :func:`save` archives and :func:`to_xarray` converts (besides a list of Transition); the
 #: TypeErrors of both name them.
-_ARCHIVED = (SweepResult, CriticalCurve, *_TRAIN_KIND)
-_CONVERTED = (SweepResult, CriticalCurve, Trajectory, *_TRAIN_KIND)
+_ARCHIVED = (SweepResult, CriticalCurve, Trajectory, *_TRAIN_KIND)
 
 
 # -- reading trains back ----------------------------------------------------------------------------
@@ -1694,8 +1720,59 @@ def _read_basins(f) -> Basins:
                   attractors, _int_attr(f, "not_converged"), _int_attr(f, "no_map"))
 
 
+def _read_trajectory(f) -> Trajectory:
+    t = _data(f, "t", ndim=1, kinds="f")
+    samples = np.empty((len(t), _driver.N_SMP_COLUMNS))
+    samples[:, _driver.SMP_T] = t
+    m = _data(f, "event_time", ndim=1, kinds="f").shape[0]
+    events = np.empty((m, _driver.N_EV_COLUMNS))
+    events[:, _driver.EV_T] = _shaped(f, "event_time", (m,))
+    events[:, _driver.EV_KIND] = _checked_codes(f, "event_kind", EVENT_KINDS, (m,))
+    events[:, _driver.EV_MODE] = _shaped(f, "event_mode", (m,), "i")
+    for i, (name, _, _) in enumerate(_STATE):
+        samples[:, _driver.SMP_Y + i] = _shaped(f, name, t.shape)
+        events[:, _driver.EV_Y + i] = _shaped(f, f"event_{name}", (m,))
+    samples[:, _driver.SMP_FORCE] = _shaped(f, "force", t.shape)
+    samples[:, _driver.SMP_MODE] = _shaped(f, "mode", t.shape, "i")
+    events[:, _driver.EV_FORCE] = _shaped(f, "event_force", (m,))
+    summary = np.empty(_driver.N_SUMMARY)
+    names = {}
+    for name, index, table in (("status", _driver.S_STATUS, STATUSES), ("outcome", _driver.S_OUTCOME, OUTCOMES),
+                               ("stop_reason", _driver.S_REASON, STOP_REASONS)):
+        summary[index] = _checked_codes(f, name, table, ())
+        names[name] = table[int(summary[index])]
+    for name, index, dtype, _ in SUMMARY_COLUMNS:
+        summary[index] = _shaped(f, name, (), "f" if dtype is float else "iu")
+    summary[_driver.S_FIRST_STICK_T] = _shaped(f, "first_stick_t", ())
+    summary[_driver.S_MODE] = _shaped(f, "final_mode", (), "i")
+    tr = Trajectory(samples, events, Parameters(**_json_attr(f, "parameters", dict)), _law(f),
+                    _shaped(f, "initial_state", (len(_STATE),)), _shaped(f, "final_state", (len(_STATE),)),
+                    _real_attr(f, "t_end"), names["status"], names["stop_reason"], names["outcome"], summary,
+                    _attr_str(f, "engine"), _attr_str(f, "law_fault") if "law_fault" in f.attrs else "")
+    if tr.message != _attr_str(f, "message"):
+        raise _Damaged(f"attribute message = {_short(_attr_str(f, 'message'))} is not the run's: "
+                       f"{_short(tr.message)}")
+    return tr
+
+
+def _read_transitions(f) -> list[Transition]:
+    kappa = _data(f, "kappa", ndim=1, kinds="f")
+    n = len(kappa)
+    kinds = _checked_codes(f, "kind", TRANSITION_KINDS, (n,))
+    counts = {name: _shaped(f, name, (n,), "i") for name in ("count_below", "count_above", "extremum")}
+    for name, values in counts.items():
+        _out_of_range(name, values, values < -1, "-1 (not known) or a count >= 0")
+
+    def count(name, i):
+        return None if counts[name][i] == -1 else int(counts[name][i])
+
+    return [Transition(TRANSITION_KINDS[kinds[i]], float(kappa[i]), count("count_below", i), count("count_above", i),
+                       count("extremum", i)) for i in range(n)]
+
+
 _READERS = {"impact-train": _read_impact_train, "orbit-diagram": _read_orbit_diagram,
-            "map-branch": _read_map_branch, "basins": _read_basins}
+            "map-branch": _read_map_branch, "basins": _read_basins, "trajectory": _read_trajectory,
+            "transitions": _read_transitions}
 
 
 # ------------------------------------------------------------------------------------------------
@@ -2371,8 +2448,9 @@ def _checked_header(f, path) -> int:
     if version < 1:
         raise _Damaged(f"attribute schema_version = {version} is out of range; allowed: 1 to {SCHEMA_VERSION}")
     kind = _attr_str(f, "kind")
-    if kind not in KINDS + TRAIN_KINDS:
-        raise _Damaged(f"attribute kind = {kind!r} is out of range; allowed: one of {', '.join(KINDS + TRAIN_KINDS)}")
+    known = KINDS + RUN_KINDS + TRAIN_KINDS
+    if kind not in known:
+        raise _Damaged(f"attribute kind = {kind!r} is out of range; allowed: one of {', '.join(known)}")
     return version
 
 
@@ -2478,7 +2556,7 @@ def _load(path: str):
         version = _checked_header(f, path)
         _check_law_defined(f, path)
         kind = _attr_str(f, "kind")
-        if kind in TRAIN_KINDS:  # schema 5 on
+        if kind in _READERS:  # schema 5 on
             result = _READERS[kind](f)
             _check_metadata(f)
             return result
@@ -2829,7 +2907,7 @@ def _describe(path: str) -> dict:
         law = _law(f).as_dict()
         law_source = _law_source(f)
         params = _json_attr(f, "parameters", dict)
-        if kind in TRAIN_KINDS:
+        if kind in _READERS:
             axes = {}
             if kind == "orbit-diagram":
                 param = _attr_str(f, "param")
