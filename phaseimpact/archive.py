@@ -1478,7 +1478,8 @@ def _write_trajectory(f, tr: Trajectory, created: str, context: _Context) -> Non
 def _write_transitions(f, items, created: str, context: _Context) -> None:
     settings = context.settings or {}
     _header(f, "transitions", context.law, context.base, None, settings.get("rtol"), "", created,
-            f"phaseimpact transitions: {len(items)} changes of the long-time count over kappa{_by(context)}")
+            f"phaseimpact transitions: {len(items)} changes of the long-time count over kappa{_by(context)}",
+            context.settings)
     for key in ("kappa_min", "kappa_max"):
         if key in settings:
             f.attrs[key] = float(settings[key])
