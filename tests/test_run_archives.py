@@ -101,7 +101,8 @@ def test_to_xarray_of_a_trajectory_is_its_archive_in_memory(tmp_path):
     with xr.open_dataset(archive.save(tr, tmp_path / "run.nc")) as ds:
         in_memory = archive.to_xarray(tr)
         assert set(ds.variables) == set(in_memory.variables)
-        assert float(ds.first_stick_t) == tr.summary[driver.S_FIRST_STICK_T] and np.array_equal(ds.force.values, tr.force)
+        assert float(ds.first_stick_t) == tr.summary[driver.S_FIRST_STICK_T]
+        assert np.array_equal(ds.force.values, tr.force)
 
 
 # ------------------------------------------------------------------------------------------------
