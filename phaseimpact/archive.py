@@ -1,13 +1,14 @@
-"""HDF5 archives of sweeps, atlases, continued curves and trains of impacts: netCDF-4 / CF-1.11 files (conventionally
-``.nc``) that xarray, netCDF4, cfdm and other CF readers open as labelled arrays, and that plain h5py
-reads just as well.
+"""HDF5 archives of sweeps, atlases, continued curves, runs, transitions and trains of impacts: netCDF-4 /
+CF-1.11 files (conventionally ``.nc``) that xarray, netCDF4, cfdm and other CF readers open as labelled
+arrays, and that plain h5py reads just as well.
 
 Layout (``schema_version`` 5). Every variable of the result is in the root group, so
 ``xarray.open_dataset(path)`` shows them all, with one dimension per axis::
 
     / attrs       Conventions "CF-1.11", title, history, source, references (CF's), schema_version 5,
-                  package_version, kind ("sweep": one axis, "atlas": two or more, "critical-curve"; or
-                  one of TRAIN_KINDS: "impact-train", "orbit-diagram", "map-branch", "basins"), law
+                  package_version, kind ("sweep": one axis, "atlas": two or more, "critical-curve"; one
+                  of RUN_KINDS: "trajectory", "transitions"; or one of TRAIN_KINDS: "impact-train",
+                  "orbit-diagram", "map-branch", "basins"), law
                   (JSON), contact (its reading of |delta|^alpha), law_source (a user law's only: the digest
                   of its functions and law file), base ("parameters" or "case"), case (JSON:
                   the Case, or the Parameters), parameters (JSON, SI: the base's Parameters), engine, rtol,
@@ -71,16 +72,16 @@ Layout (``schema_version`` 5). Every variable of the result is in the root group
                   attractor_period, attractor_count (attractor) int64; attractor_x2, attractor_x2dot
                   (orbit_point) float64: the attractors' points, attractor_period rows each, in order
 
-    :func:`to_xarray` also gives, in the same conventions but with no archive kind:
-    trajectory    (a Trajectory; kind "trajectory", the header from its case and law, message) t (n,)
+    runs and transitions (RUN_KINDS; the case and law are the run's, or given to save as a train's):
+    trajectory    (a Trajectory; attrs message, law_fault (a run a user law ended), engine: its integrator) t (n,)
                   coordinate (s since the start of the run, cartesian_axis T; empty for a summary run);
                   x1, x2, x1dot, x2dot, contact_work, delta, deltadot, force (t) float64 m, m, m s-1,
                   m s-1, J, m, m s-1, N; mode (t) int64;
                   along event: event_time, event_kind (int8 flags: the event kinds), event_x1 ...
                   event_contact_work, event_force, event_mode; 0-d: status, outcome, stop_reason (int8
-                  flags), every summary column (max_force, n_stick, t_run, ...), final_mode;
+                  flags), every summary column (max_force, n_stick, t_run, ...), first_stick_t, final_mode;
                   initial_state, final_state (component,) float64 (attrs components, component_units)
-    transitions   (a list of Transition; kind "transitions", attrs kappa_min, kappa_max from settings)
+    transitions   (a list of Transition; attrs kappa_min, kappa_max from settings)
                   kappa (n,) float64 coordinate (fractional_units; the transitions in increasing kappa,
                   so ``ds.sel(kappa=..., method="nearest")``); along kappa: kind (int8 flags
                   adding-sliding staircase-end grazing), count_below, count_above, extremum (int64,
@@ -138,9 +139,9 @@ out (or the file is not an archive of the same grid) a checkpoint rewrites the f
 (phaseimpact 0.1), 2 (groups ``/sweep``, ``/curve``), 3 (this layout with ``_FillValue -1`` on the
 code variables, which made xarray decode them as floats) and 4 (CF-1.8 with int64 variables, a root
 attribute ``dimensions`` that CF 1.9 readers take as a domain variable's, units with fractional
-powers, /extras without netCDF dimensions) still load. Train archives are new kinds of schema 5
-(readers of the other kinds are unaffected); :func:`load` gives back a result equal to the one saved,
-every array bit for bit.
+powers, /extras without netCDF dimensions) still load. Train, trajectory and transitions archives are
+new kinds of schema 5 (readers of the other kinds are unaffected); :func:`load` gives back a result
+equal to the one saved, every array bit for bit.
 
 Integrity. Every chunk of every variable carries a Fletcher-32 checksum (HDF5's filter, which
 netCDF-4, h5netcdf and h5py verify on every read); the file format is HDF5 1.8's, whose superblock
@@ -2501,10 +2502,12 @@ def _base(f):
 
 
 def load(path):
-    """Read an archive back: a :class:`SweepResult` (with its :class:`Grid`), a :class:`CriticalCurve`, or
-    a train result (:class:`~phaseimpact.train.ImpactTrain`, :class:`~phaseimpact.train.OrbitDiagram`,
-    :class:`~phaseimpact.train.MapBranch`, :class:`~phaseimpact.train.Basins`; its case and law are in
-    :func:`describe`).
+    """Read an archive back: a :class:`SweepResult` (with its :class:`Grid`), a :class:`CriticalCurve`, a
+    :class:`~phaseimpact.integrate.result.Trajectory`, a list of
+    :class:`~phaseimpact.continuation.Transition`, or a train result
+    (:class:`~phaseimpact.train.ImpactTrain`, :class:`~phaseimpact.train.OrbitDiagram`,
+    :class:`~phaseimpact.train.MapBranch`, :class:`~phaseimpact.train.Basins`); the case and law of
+    transitions and train results are in :func:`describe`.
 
     Points of an archive in progress that are not committed (status -1) come back as not computed,
     whatever else a killed checkpoint left of them. Every chunk's checksum and the content are
@@ -2521,10 +2524,10 @@ def load(path):
 
     Returns
     -------
-    SweepResult, CriticalCurve, ImpactTrain, OrbitDiagram, MapBranch or Basins
+    SweepResult, CriticalCurve, Trajectory, list of Transition, ImpactTrain, OrbitDiagram, MapBranch or Basins
         A sweep or curve with its base case, law, axes, ``t_end`` and settings, ready to be
-        completed (``previous=``) or plotted; a train result equal to the one saved, every array
-        bit for bit.
+        completed (``previous=``) or plotted; a trajectory, the transitions (in increasing kappa) or a
+        train result equal to the one saved, every array bit for bit.
 
     Raises
     ------
@@ -2873,9 +2876,10 @@ def describe(path) -> dict:
     Returns
     -------
     dict
-        ``kind`` (one of :data:`KINDS`), ``law`` (the law as a dict), ``law_source`` (a user law's
-        source digest, :attr:`~phaseimpact.model.ContactLaw.source`; None for a shipped law), ``parameters`` (the base's
-        :class:`~phaseimpact.Parameters` as a dict, SI), ``axes``, ``t_end`` (s; NaN: each run
+        ``kind`` (one of :data:`KINDS`, :data:`RUN_KINDS`, :data:`TRAIN_KINDS`), ``law`` (the law as a
+        dict), ``law_source`` (a user law's source digest, :attr:`~phaseimpact.model.ContactLaw.source`;
+        None for a shipped law), ``parameters`` (the base's :class:`~phaseimpact.Parameters` as a
+        dict, SI), ``axes`` (empty for a trajectory or transitions), ``t_end`` (s; NaN: each run
         until its outcome settles), ``rtol`` and ``schema_version``.
 
     Raises
@@ -3035,7 +3039,8 @@ def check_overwrite(path, kind: str, law: ContactLaw, params: Parameters, axes: 
     (kind, law, parameters, axis values, ``t_end``, ``rtol`` and ``settings``), or ``force`` is set.
 
     The one rule of every command that writes an archive (``--out`` of ``sweep``, ``atlas``,
-    ``critical-curve``; ``--archive`` of ``train``, ``orbit-diagram``, ``map-continuation``, ``basins``).
+    ``critical-curve``, ``simulate``, ``transitions``; ``--archive`` of ``train``, ``orbit-diagram``,
+    ``map-continuation``, ``basins``).
 
     Parameters
     ----------
@@ -3049,8 +3054,9 @@ def check_overwrite(path, kind: str, law: ContactLaw, params: Parameters, axes: 
     name : str, default "out"
         How the message names ``path`` (the command line's option).
     settings : dict, optional
-        Compared too where given: a train result's settings as :func:`save` stores them (``period``,
-        ``impacts``, ...), or a critical curve's ``{"what": ...}``.
+        Compared too where given: a train result's, a run's or a transition search's settings as
+        :func:`save` stores them (``period``, ``impacts``, ``rtol``, ``kappa_min``, ...), or a critical
+        curve's ``{"what": ...}``.
 
     Raises
     ------
