@@ -150,6 +150,7 @@ def test_transitions_out_writes_what_it_prints(tmp_path):
 def test_out_refuses_other_work_and_foreign_files_unless_force(argv, other, tmp_path):
     out = tmp_path / "held.nc"
     assert run([*argv, "--out", out])[0] == 0
+    assert run([*argv, "--out", out])[0] == 0  # the same work again: replaced without --force
     before = out.read_bytes()
     code, _, err = run([*other, "--out", out])
     assert code == 2 and "holds other work" in err and "--force" in err
