@@ -54,6 +54,27 @@ def test_a_trajectory_loads_back_bit_for_bit(name, tmp_path):
     assert held["kind"] == "trajectory" and held["t_end"] == tr.t_end and held["axes"] == {}
 
 
+def test_a_damaged_trajectory_archive_is_refused_naming_the_damage(tmp_path):
+    path = archive.save(_run("steps"), tmp_path / "run.nc")
+    with h5py.File(path, "r+") as f:
+        f["event_kind"][0] = 99
+    with pytest.raises(archive.DamagedArchiveError, match="event_kind"):
+        archive.load(path)
+
+
+def test_a_run_a_user_law_ended_loads_back_with_its_message(tmp_path):
+    import math
+
+    from phaseimpact import define_law
+
+    define_law("nan-deep-archived", lambda d, dd, K, k, a: math.nan if d > 3e-5 else K * d ** a)
+    tr = simulate(seed_parameters(kappa=1e4), "nan-deep-archived", save="steps")
+    assert tr.status == "non-finite" and tr.law_fault and tr.message.startswith("law 'nan-deep-archived'")
+    back = archive.load(archive.save(tr, tmp_path / "fault.nc"))
+    _assert_same_trajectory(tr, back)
+    assert back.law_fault == tr.law_fault
+
+
 def test_transitions_load_back_bit_for_bit_in_increasing_kappa(tmp_path):
     path = archive.save(TRANSITIONS, tmp_path / "found.nc", params=seed_parameters(), law="paper",
                         settings={"kappa_min": 1e8, "kappa_max": 1e13, "rtol": 1e-10})
