@@ -1,13 +1,14 @@
-"""HDF5 archives of sweeps, atlases, continued curves and trains of impacts: netCDF-4 / CF-1.11 files (conventionally
-``.nc``) that xarray, netCDF4, cfdm and other CF readers open as labelled arrays, and that plain h5py
-reads just as well.
+"""HDF5 archives of sweeps, atlases, continued curves, runs, transitions and trains of impacts: netCDF-4 /
+CF-1.11 files (conventionally ``.nc``) that xarray, netCDF4, cfdm and other CF readers open as labelled
+arrays, and that plain h5py reads just as well.
 
 Layout (``schema_version`` 5). Every variable of the result is in the root group, so
 ``xarray.open_dataset(path)`` shows them all, with one dimension per axis::
 
     / attrs       Conventions "CF-1.11", title, history, source, references (CF's), schema_version 5,
-                  package_version, kind ("sweep": one axis, "atlas": two or more, "critical-curve"; or
-                  one of TRAIN_KINDS: "impact-train", "orbit-diagram", "map-branch", "basins"), law
+                  package_version, kind ("sweep": one axis, "atlas": two or more, "critical-curve"; one
+                  of RUN_KINDS: "trajectory", "transitions"; or one of TRAIN_KINDS: "impact-train",
+                  "orbit-diagram", "map-branch", "basins"), law
                   (JSON), contact (its reading of |delta|^alpha), law_source (a user law's only: the digest
                   of its functions and law file), base ("parameters" or "case"), case (JSON:
                   the Case, or the Parameters), parameters (JSON, SI: the base's Parameters), engine, rtol,
@@ -71,16 +72,16 @@ Layout (``schema_version`` 5). Every variable of the result is in the root group
                   attractor_period, attractor_count (attractor) int64; attractor_x2, attractor_x2dot
                   (orbit_point) float64: the attractors' points, attractor_period rows each, in order
 
-    :func:`to_xarray` also gives, in the same conventions but with no archive kind:
-    trajectory    (a Trajectory; kind "trajectory", the header from its case and law, message) t (n,)
+    runs and transitions (RUN_KINDS; the case and law are the run's, or given to save as a train's):
+    trajectory    (a Trajectory; attrs message, law_fault (a run a user law ended), engine: its integrator) t (n,)
                   coordinate (s since the start of the run, cartesian_axis T; empty for a summary run);
                   x1, x2, x1dot, x2dot, contact_work, delta, deltadot, force (t) float64 m, m, m s-1,
                   m s-1, J, m, m s-1, N; mode (t) int64;
                   along event: event_time, event_kind (int8 flags: the event kinds), event_x1 ...
                   event_contact_work, event_force, event_mode; 0-d: status, outcome, stop_reason (int8
-                  flags), every summary column (max_force, n_stick, t_run, ...), final_mode;
+                  flags), every summary column (max_force, n_stick, t_run, ...), first_stick_t, final_mode;
                   initial_state, final_state (component,) float64 (attrs components, component_units)
-    transitions   (a list of Transition; kind "transitions", attrs kappa_min, kappa_max from settings)
+    transitions   (a list of Transition; attrs kappa_min, kappa_max from settings)
                   kappa (n,) float64 coordinate (fractional_units; the transitions in increasing kappa,
                   so ``ds.sel(kappa=..., method="nearest")``); along kappa: kind (int8 flags
                   adding-sliding staircase-end grazing), count_below, count_above, extremum (int64,
@@ -138,9 +139,9 @@ out (or the file is not an archive of the same grid) a checkpoint rewrites the f
 (phaseimpact 0.1), 2 (groups ``/sweep``, ``/curve``), 3 (this layout with ``_FillValue -1`` on the
 code variables, which made xarray decode them as floats) and 4 (CF-1.8 with int64 variables, a root
 attribute ``dimensions`` that CF 1.9 readers take as a domain variable's, units with fractional
-powers, /extras without netCDF dimensions) still load. Train archives are new kinds of schema 5
-(readers of the other kinds are unaffected); :func:`load` gives back a result equal to the one saved,
-every array bit for bit.
+powers, /extras without netCDF dimensions) still load. Train, trajectory and transitions archives are
+new kinds of schema 5 (readers of the other kinds are unaffected); :func:`load` gives back a result
+equal to the one saved, every array bit for bit.
 
 Integrity. Every chunk of every variable carries a Fletcher-32 checksum (HDF5's filter, which
 netCDF-4, h5netcdf and h5py verify on every read); the file format is HDF5 1.8's, whose superblock
@@ -198,7 +199,7 @@ from .train import (
     OrbitDiagram,
 )
 
-__all__ = ["SCHEMA_VERSION", "KINDS", "TRAIN_KINDS", "TRANSITION_KINDS",
+__all__ = ["SCHEMA_VERSION", "KINDS", "TRAIN_KINDS", "RUN_KINDS", "TRANSITION_KINDS",
            "CHUNK_POINTS", "Checkpoint", "save", "load", "describe", "same_work",
            "check_overwrite", "kind_of", "created_timestamp", "DamagedArchiveError", "to_xarray", "stick_phases",
            "unit_attributes"]
@@ -210,6 +211,9 @@ KINDS = ("sweep", "atlas", "critical-curve")
 #: What an archive of the impact map holds (phaseimpact.train): an ImpactTrain, an OrbitDiagram, a MapBranch
 #: or Basins. Apart from KINDS, whose archives the command line's sweeps complete and resume.
 TRAIN_KINDS = ("impact-train", "orbit-diagram", "map-branch", "basins")
+#: What an archive of one run or of a transition search holds: a Trajectory (``simulate --out``) or the
+#: list of Transition of :func:`~phaseimpact.continuation.transitions` (``transitions --out``).
+RUN_KINDS = ("trajectory", "transitions")
 #: CF 1.9 and later allow int64 variables (the counts and stick rows).
 CONVENTIONS = "CF-1.11"
 #: The global attribute ``references``: where the equations and the outcome classes are defined.
@@ -356,13 +360,14 @@ def kind_of(result) -> str:
 
     Parameters
     ----------
-    result : SweepResult, Grid, CriticalCurve, ImpactTrain, OrbitDiagram, MapBranch or Basins
+    result : SweepResult, Grid, CriticalCurve, Trajectory, list of Transition, ImpactTrain, OrbitDiagram, \
+MapBranch or Basins
         What would be archived.
 
     Returns
     -------
     str
-        One of :data:`KINDS` or :data:`TRAIN_KINDS`.
+        One of :data:`KINDS`, :data:`RUN_KINDS` or :data:`TRAIN_KINDS`.
 
     Raises
     ------
@@ -381,6 +386,10 @@ def kind_of(result) -> str:
     """
     if isinstance(result, CriticalCurve):
         return "critical-curve"
+    if isinstance(result, Trajectory):
+        return "trajectory"
+    if _transitions_of(result):
+        return "transitions"
     if type(result) in _TRAIN_KIND:
         return _TRAIN_KIND[type(result)]
     grid = result.grid if isinstance(result, SweepResult) else result
@@ -671,9 +680,11 @@ def save(result, path, *, force: bool = False, params=None, law=None, settings: 
 
     Parameters
     ----------
-    result : SweepResult, CriticalCurve, ImpactTrain, OrbitDiagram, MapBranch or Basins
-        A sweep, an atlas (complete or partial), a continued curve, or a result of
-        :mod:`phaseimpact.train`.
+    result : SweepResult, CriticalCurve, Trajectory, list of Transition, ImpactTrain, OrbitDiagram, \
+MapBranch or Basins
+        A sweep, an atlas (complete or partial), a continued curve, a run of
+        :func:`~phaseimpact.simulate`, what :func:`~phaseimpact.continuation.transitions` returns, or a
+        result of :mod:`phaseimpact.train`.
     path : str or path-like
         The archive to write (conventionally ``.nc``: netCDF-4).
     force : bool, default False
@@ -681,12 +692,15 @@ def save(result, path, *, force: bool = False, params=None, law=None, settings: 
         is refused (``ValueError``); an existing archive is replaced. (The command line also refuses
         an archive of other work: see :func:`check_overwrite`.)
     params : Parameters or Case, optional
-        A train result's case (it does not carry it; required for one, refused for the others).
+        The case of a result that does not carry it (transitions, a train result: required), or the
+        Case a trajectory was run from (optional; its parameters must be the run's). Refused for
+        a sweep or curve.
     law : ContactLaw or str, optional
-        A train result's law (required for one, refused for the others).
+        The law of transitions or a train result (required for them, refused for the others).
     settings : dict, optional
-        A train result's other arguments, stored as the JSON attribute ``settings``: ``rtol`` (the
-        header's ``rtol``), ``period`` (s: an orbit diagram's or branch's over ``kappa`` or ``v``), ...
+        The call's other arguments (transitions, a train result, a trajectory), stored as the JSON
+        attribute ``settings``: ``rtol`` (the header's ``rtol``), ``period`` (s: an orbit diagram's or
+        branch's over ``kappa`` or ``v``), ``kappa_min``, ``kappa_max`` (transitions), ...
 
     Returns
     -------
@@ -726,9 +740,9 @@ def save(result, path, *, force: bool = False, params=None, law=None, settings: 
     >>> bool((back.peak_force == train.peak_force).all()), back.status
     (True, ['success', 'success', 'success'])
     """
-    if not isinstance(result, _ARCHIVED):
-        raise TypeError(f"cannot archive a {type(result).__name__}; allowed: a SweepResult or a CriticalCurve, or "
-                        "an ImpactTrain, OrbitDiagram, MapBranch or Basins")
+    if not (isinstance(result, _ARCHIVED) or _transitions_of(result)):
+        raise TypeError(f"cannot archive a {type(result).__name__}; allowed: a SweepResult or a CriticalCurve, a "
+                        "Trajectory, a list of Transition, or an ImpactTrain, OrbitDiagram, MapBranch or Basins")
     context = _context(result, params, law, settings, required=True)
     _write_file(result, os.fspath(path), force=force, spare_rows=0, context=context)
     return os.fspath(path)
@@ -828,12 +842,10 @@ _XARRAY_EXTRA = ("install the extra phaseimpact[xarray] (in a checkout: pip inst
 def to_xarray(result, *, params=None, law=None, settings: dict | None = None):
     """``result`` as an in-memory :class:`xarray.Dataset`, no file written.
 
-    For what :func:`save` archives, the Dataset is the one ``xarray.open_dataset`` gives of that
-    archive (it is that archive, built in memory), variables, dimensions, units and attributes
-    alike, so code written for one reads the other. A trajectory and a list of transitions, which
-    have no archive kind, get a Dataset in the same conventions (CF-1.11 attributes, units as
-    :func:`unit_attributes` gives them, codes as integer flags, the header's attributes); the module
-    docstring gives every layout. Needs xarray and h5netcdf (the extra ``phaseimpact[xarray]``).
+    The Dataset is the one ``xarray.open_dataset`` gives of the archive :func:`save` writes (it is
+    that archive, built in memory), variables, dimensions, units and attributes alike, so code
+    written for one reads the other; the module docstring gives every layout. Needs xarray and
+    h5netcdf (the extra ``phaseimpact[xarray]``).
 
     Parameters
     ----------
@@ -845,7 +857,8 @@ MapBranch or Basins
     params : Parameters or Case, optional
         The case of a result that does not carry it (transitions, train results): its header
         attributes (``parameters``, ``case``, ``base``) and the unit of ``kappa`` (its ``alpha``).
-        Left out, so are they. Refused for a result that carries its own.
+        Left out, so are they. A trajectory's Case (its parameters must be the run's); refused for
+        a sweep or curve.
     law : ContactLaw or str, optional
         Its law, likewise (``law``, ``contact``; the unit of ``kappa``).
     settings : dict, optional
@@ -889,7 +902,7 @@ MapBranch or Basins
     >>> dict(train.sizes), train.peak_force.attrs["units"], train.attrs["kind"]
     ({'arrival': 4, 'impact': 3}, 'N', 'impact-train')
     """
-    if not (isinstance(result, _CONVERTED) or _transitions_of(result)):
+    if not (isinstance(result, _ARCHIVED) or _transitions_of(result)):
         raise TypeError(f"cannot convert a {type(result).__name__}; allowed: a SweepResult or a CriticalCurve, a "
                         "Trajectory, a list of Transition, or an ImpactTrain, OrbitDiagram, MapBranch or Basins")
     context = _context(result, params, law, settings, required=False)
@@ -1305,12 +1318,12 @@ def _transitions_of(result) -> bool:
 
 def _context(result, params, law, settings, *, required: bool) -> _Context:
     """The context of a result that does not carry its case (``required``: an archive needs its case and
-    law); a result that carries them (a sweep, a curve, a trajectory) takes none."""
+    law); a result that carries them (a sweep, a curve) takes none, a trajectory its Case and settings only."""
     from .case import Case
     from .model import as_law
 
     given = params is not None or law is not None or settings is not None
-    if isinstance(result, (SweepResult, CriticalCurve, Trajectory)):
+    if isinstance(result, (SweepResult, CriticalCurve)):
         if given:
             raise TypeError(f"a {type(result).__name__} carries its own case, law and settings; params=, law= and "
                             "settings= are for results that do not (transitions, trains of impacts)")
@@ -1319,6 +1332,14 @@ def _context(result, params, law, settings, *, required: bool) -> _Context:
         raise TypeError(f"params has the wrong type ({type(params).__name__}); allowed: Parameters or Case")
     if settings is not None and not isinstance(settings, dict):
         raise TypeError(f"settings has the wrong type ({type(settings).__name__}); allowed: a dict")
+    if isinstance(result, Trajectory):  # it carries its parameters and law; a Case names where they came from
+        if law is not None:
+            raise TypeError("a Trajectory carries its own law; law= is for results that do not (transitions, trains "
+                            "of impacts)")
+        if params is not None and _base_parameters(params) != result.params:
+            raise ValueError("params is not the trajectory's case: its parameters differ from the run's; allowed: "
+                             "the Case the run was made from")
+        return _Context(params, None, None if settings is None else dict(settings))
     if required and (params is None or law is None):
         raise TypeError(f"archiving a {type(result).__name__} needs params= and law= (it does not carry the case "
                         "and law it was computed with)")
@@ -1411,10 +1432,15 @@ _YES_NO = ("no", "yes")
 
 
 def _write_trajectory(f, tr: Trajectory, created: str, context: _Context) -> None:
-    found = re.search(r"rtol=([^,\]]+)", tr.integrator)
-    _header(f, "trajectory", tr.law, tr.params, tr.t_end, float(found.group(1)) if found else None, tr.integrator,
-            created, f"phaseimpact trajectory: {tr.law.name} law, {tr.outcome} ({tr.status})")
+    settings = context.settings or {}
+    found = re.search(r"rtol=([^,\]]+)", tr.integrator)  # the integrator's name rounds it: settings' is exact
+    rtol = settings.get("rtol", float(found.group(1)) if found else None)
+    _header(f, "trajectory", tr.law, tr.params if context.base is None else context.base, tr.t_end, rtol,
+            tr.integrator, created, f"phaseimpact trajectory: {tr.law.name} law, {tr.outcome} ({tr.status})",
+            context.settings)
     f.attrs["message"] = tr.message
+    if tr.law_fault:  # the message of a run a user law ended is made from it
+        f.attrs["law_fault"] = tr.law_fault
     # t, not time: CF's time coordinate (the name time, standard_name time or axis T) needs units "s since
     # <a date>", which xarray decodes to datetime64 (whole nanoseconds; the run's clock starts at 0)
     _coordinate(f, "t", tr.t, "s", "time since the start of the run").attrs["cartesian_axis"] = "T"
@@ -1440,6 +1466,8 @@ def _write_trajectory(f, tr: Trajectory, created: str, context: _Context) -> Non
     for name, index, dtype, units in SUMMARY_COLUMNS:
         value = np.asarray(tr.summary[index]).astype(dtype)
         _variable(f, name, value, long_name=_LONG_NAMES[name], units=units, fill=value.dtype.kind == "f")
+    _variable(f, "first_stick_t", np.float64(tr.summary[_driver.S_FIRST_STICK_T]),
+              long_name="time the first stick phase began", units="s", fill=True)
     _variable(f, "final_mode", np.int64(tr.final_mode), long_name="mode at the end of the run")
     components = {"components": " ".join(name for name, _, _ in _STATE),
                   "component_units": _json([units for _, units, _ in _STATE]),
@@ -1451,7 +1479,8 @@ def _write_trajectory(f, tr: Trajectory, created: str, context: _Context) -> Non
 def _write_transitions(f, items, created: str, context: _Context) -> None:
     settings = context.settings or {}
     _header(f, "transitions", context.law, context.base, None, settings.get("rtol"), "", created,
-            f"phaseimpact transitions: {len(items)} changes of the long-time count over kappa{_by(context)}")
+            f"phaseimpact transitions: {len(items)} changes of the long-time count over kappa{_by(context)}",
+            context.settings)
     for key in ("kappa_min", "kappa_max"):
         if key in settings:
             f.attrs[key] = float(settings[key])
@@ -1604,10 +1633,9 @@ _WRITERS = {Trajectory: _write_trajectory, ImpactTrain: _write_impact_train, Orb
 #: The archive kind of each train result.
 _TRAIN_KIND = {ImpactTrain: "impact-train", OrbitDiagram: "orbit-diagram", MapBranch: "map-branch",
                Basins: "basins"}
-#: What :func:`save` archives, and what :func:`to_xarray` converts (besides a list of Transition); the
+#: What :func:`save` archives and :func:`to_xarray` converts (besides a list of Transition); the
 #: TypeErrors of both name them.
-_ARCHIVED = (SweepResult, CriticalCurve, *_TRAIN_KIND)
-_CONVERTED = (SweepResult, CriticalCurve, Trajectory, *_TRAIN_KIND)
+_ARCHIVED = (SweepResult, CriticalCurve, Trajectory, *_TRAIN_KIND)
 
 
 # -- reading trains back ----------------------------------------------------------------------------
@@ -1694,8 +1722,59 @@ def _read_basins(f) -> Basins:
                   attractors, _int_attr(f, "not_converged"), _int_attr(f, "no_map"))
 
 
+def _read_trajectory(f) -> Trajectory:
+    t = _data(f, "t", ndim=1, kinds="f")
+    samples = np.empty((len(t), _driver.N_SMP_COLUMNS))
+    samples[:, _driver.SMP_T] = t
+    m = _data(f, "event_time", ndim=1, kinds="f").shape[0]
+    events = np.empty((m, _driver.N_EV_COLUMNS))
+    events[:, _driver.EV_T] = _shaped(f, "event_time", (m,))
+    events[:, _driver.EV_KIND] = _checked_codes(f, "event_kind", EVENT_KINDS, (m,))
+    events[:, _driver.EV_MODE] = _shaped(f, "event_mode", (m,), "i")
+    for i, (name, _, _) in enumerate(_STATE):
+        samples[:, _driver.SMP_Y + i] = _shaped(f, name, t.shape)
+        events[:, _driver.EV_Y + i] = _shaped(f, f"event_{name}", (m,))
+    samples[:, _driver.SMP_FORCE] = _shaped(f, "force", t.shape)
+    samples[:, _driver.SMP_MODE] = _shaped(f, "mode", t.shape, "i")
+    events[:, _driver.EV_FORCE] = _shaped(f, "event_force", (m,))
+    summary = np.empty(_driver.N_SUMMARY)
+    names = {}
+    for name, index, table in (("status", _driver.S_STATUS, STATUSES), ("outcome", _driver.S_OUTCOME, OUTCOMES),
+                               ("stop_reason", _driver.S_REASON, STOP_REASONS)):
+        summary[index] = _checked_codes(f, name, table, ())
+        names[name] = table[int(summary[index])]
+    for name, index, dtype, _ in SUMMARY_COLUMNS:
+        summary[index] = _shaped(f, name, (), "f" if dtype is float else "iu")
+    summary[_driver.S_FIRST_STICK_T] = _shaped(f, "first_stick_t", ())
+    summary[_driver.S_MODE] = _shaped(f, "final_mode", (), "i")
+    tr = Trajectory(samples, events, Parameters(**_json_attr(f, "parameters", dict)), _law(f),
+                    _shaped(f, "initial_state", (len(_STATE),)), _shaped(f, "final_state", (len(_STATE),)),
+                    _real_attr(f, "t_end"), names["status"], names["stop_reason"], names["outcome"], summary,
+                    _attr_str(f, "engine"), _attr_str(f, "law_fault") if "law_fault" in f.attrs else "")
+    if tr.message != _attr_str(f, "message"):
+        raise _Damaged(f"attribute message = {_short(_attr_str(f, 'message'))} is not the run's: "
+                       f"{_short(tr.message)}")
+    return tr
+
+
+def _read_transitions(f) -> list[Transition]:
+    kappa = _data(f, "kappa", ndim=1, kinds="f")
+    n = len(kappa)
+    kinds = _checked_codes(f, "kind", TRANSITION_KINDS, (n,))
+    counts = {name: _shaped(f, name, (n,), "i") for name in ("count_below", "count_above", "extremum")}
+    for name, values in counts.items():
+        _out_of_range(name, values, values < -1, "-1 (not known) or a count >= 0")
+
+    def count(name, i):
+        return None if counts[name][i] == -1 else int(counts[name][i])
+
+    return [Transition(TRANSITION_KINDS[kinds[i]], float(kappa[i]), count("count_below", i), count("count_above", i),
+                       count("extremum", i)) for i in range(n)]
+
+
 _READERS = {"impact-train": _read_impact_train, "orbit-diagram": _read_orbit_diagram,
-            "map-branch": _read_map_branch, "basins": _read_basins}
+            "map-branch": _read_map_branch, "basins": _read_basins, "trajectory": _read_trajectory,
+            "transitions": _read_transitions}
 
 
 # ------------------------------------------------------------------------------------------------
@@ -2371,8 +2450,9 @@ def _checked_header(f, path) -> int:
     if version < 1:
         raise _Damaged(f"attribute schema_version = {version} is out of range; allowed: 1 to {SCHEMA_VERSION}")
     kind = _attr_str(f, "kind")
-    if kind not in KINDS + TRAIN_KINDS:
-        raise _Damaged(f"attribute kind = {kind!r} is out of range; allowed: one of {', '.join(KINDS + TRAIN_KINDS)}")
+    known = KINDS + RUN_KINDS + TRAIN_KINDS
+    if kind not in known:
+        raise _Damaged(f"attribute kind = {kind!r} is out of range; allowed: one of {', '.join(known)}")
     return version
 
 
@@ -2422,10 +2502,12 @@ def _base(f):
 
 
 def load(path):
-    """Read an archive back: a :class:`SweepResult` (with its :class:`Grid`), a :class:`CriticalCurve`, or
-    a train result (:class:`~phaseimpact.train.ImpactTrain`, :class:`~phaseimpact.train.OrbitDiagram`,
-    :class:`~phaseimpact.train.MapBranch`, :class:`~phaseimpact.train.Basins`; its case and law are in
-    :func:`describe`).
+    """Read an archive back: a :class:`SweepResult` (with its :class:`Grid`), a :class:`CriticalCurve`, a
+    :class:`~phaseimpact.integrate.result.Trajectory`, a list of
+    :class:`~phaseimpact.continuation.Transition`, or a train result
+    (:class:`~phaseimpact.train.ImpactTrain`, :class:`~phaseimpact.train.OrbitDiagram`,
+    :class:`~phaseimpact.train.MapBranch`, :class:`~phaseimpact.train.Basins`); the case and law of
+    transitions and train results are in :func:`describe`.
 
     Points of an archive in progress that are not committed (status -1) come back as not computed,
     whatever else a killed checkpoint left of them. Every chunk's checksum and the content are
@@ -2442,10 +2524,10 @@ def load(path):
 
     Returns
     -------
-    SweepResult, CriticalCurve, ImpactTrain, OrbitDiagram, MapBranch or Basins
+    SweepResult, CriticalCurve, Trajectory, list of Transition, ImpactTrain, OrbitDiagram, MapBranch or Basins
         A sweep or curve with its base case, law, axes, ``t_end`` and settings, ready to be
-        completed (``previous=``) or plotted; a train result equal to the one saved, every array
-        bit for bit.
+        completed (``previous=``) or plotted; a trajectory, the transitions (in increasing kappa) or a
+        train result equal to the one saved, every array bit for bit.
 
     Raises
     ------
@@ -2478,7 +2560,7 @@ def _load(path: str):
         version = _checked_header(f, path)
         _check_law_defined(f, path)
         kind = _attr_str(f, "kind")
-        if kind in TRAIN_KINDS:  # schema 5 on
+        if kind in _READERS:  # schema 5 on
             result = _READERS[kind](f)
             _check_metadata(f)
             return result
@@ -2794,9 +2876,10 @@ def describe(path) -> dict:
     Returns
     -------
     dict
-        ``kind`` (one of :data:`KINDS`), ``law`` (the law as a dict), ``law_source`` (a user law's
-        source digest, :attr:`~phaseimpact.model.ContactLaw.source`; None for a shipped law), ``parameters`` (the base's
-        :class:`~phaseimpact.Parameters` as a dict, SI), ``axes``, ``t_end`` (s; NaN: each run
+        ``kind`` (one of :data:`KINDS`, :data:`RUN_KINDS`, :data:`TRAIN_KINDS`), ``law`` (the law as a
+        dict), ``law_source`` (a user law's source digest, :attr:`~phaseimpact.model.ContactLaw.source`;
+        None for a shipped law), ``parameters`` (the base's :class:`~phaseimpact.Parameters` as a
+        dict, SI), ``axes`` (empty for a trajectory or transitions), ``t_end`` (s; NaN: each run
         until its outcome settles), ``rtol`` and ``schema_version``.
 
     Raises
@@ -2829,7 +2912,7 @@ def _describe(path: str) -> dict:
         law = _law(f).as_dict()
         law_source = _law_source(f)
         params = _json_attr(f, "parameters", dict)
-        if kind in TRAIN_KINDS:
+        if kind in _READERS:
             axes = {}
             if kind == "orbit-diagram":
                 param = _attr_str(f, "param")
@@ -2956,7 +3039,8 @@ def check_overwrite(path, kind: str, law: ContactLaw, params: Parameters, axes: 
     (kind, law, parameters, axis values, ``t_end``, ``rtol`` and ``settings``), or ``force`` is set.
 
     The one rule of every command that writes an archive (``--out`` of ``sweep``, ``atlas``,
-    ``critical-curve``; ``--archive`` of ``train``, ``orbit-diagram``, ``map-continuation``, ``basins``).
+    ``critical-curve``, ``simulate``, ``transitions``; ``--archive`` of ``train``, ``orbit-diagram``,
+    ``map-continuation``, ``basins``).
 
     Parameters
     ----------
@@ -2970,8 +3054,9 @@ def check_overwrite(path, kind: str, law: ContactLaw, params: Parameters, axes: 
     name : str, default "out"
         How the message names ``path`` (the command line's option).
     settings : dict, optional
-        Compared too where given: a train result's settings as :func:`save` stores them (``period``,
-        ``impacts``, ...), or a critical curve's ``{"what": ...}``.
+        Compared too where given: a train result's, a run's or a transition search's settings as
+        :func:`save` stores them (``period``, ``impacts``, ``rtol``, ``kappa_min``, ...), or a critical
+        curve's ``{"what": ...}``.
 
     Raises
     ------

@@ -17,6 +17,7 @@ as it was used.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import dataclasses
 import json
 import math
@@ -515,6 +516,28 @@ def _case_fields(setup: Setup) -> dict:
             "target": p.target}
 
 
+@contextlib.contextmanager
+def _out_archive(args, setup: Setup, kind: str, t_end, settings: dict):
+    """``--out`` of simulate and transitions: the overwrite rule of every archive
+    (:func:`phaseimpact.archive.check_overwrite`) before any work, and one writer (the path's lock,
+    held from the check to the write). Yields the function that writes the result; None without ``--out``."""
+    if args.out is None:
+        yield None
+        return
+    from . import archive
+
+    archive.created_timestamp()  # a bad SOURCE_DATE_EPOCH is refused before any work
+    with exclusive(args.out, "out"):
+        archive.check_overwrite(args.out, kind, setup.law, setup.params, {}, t_end, args.rtol, force=args.force,
+                                settings=settings)
+
+        def write(result) -> None:  # a trajectory carries its law
+            archive.save(result, args.out, force=args.force, params=setup.case,
+                         law=None if kind == "trajectory" else setup.law, settings=settings)
+
+        yield write
+
+
 # ------------------------------------------------------------------------------------------------
 # Commands
 # ------------------------------------------------------------------------------------------------
@@ -698,14 +721,20 @@ def _contact_reading(trajectory, setup: Setup) -> dict:
 
 
 def cmd_simulate(args) -> int:
-    from .integrate import simulate
+    from .integrate import scales, simulate
     from .quantities import impact_quantities
 
     setup = _setup(args)
     law, p = setup.law, setup.params
     horizon = "until the outcome settles" if args.t_end is None else f"to t = {args.t_end:g} s"
-    _note(f"integrating {law.label()} at v = {p.v:g} m/s {horizon} (the first run compiles the engine)")
-    trajectory = simulate(p, law, args.t_end, rtol=args.rtol)
+    t_end = scales(p).horizon if args.t_end is None else args.t_end  # what the archive's header holds
+    with _out_archive(args, setup, "trajectory", t_end, {"rtol": args.rtol}) as write:
+        _note(f"integrating {law.label()} at v = {p.v:g} m/s {horizon} (the first run compiles the engine)")
+        # an archive keeps the steps too; the run is the same (it stops where the summary's does)
+        trajectory = simulate(p, law, args.t_end, rtol=args.rtol, save="summary" if write is None else "steps",
+                              stop_when_settled=True)
+        if write is not None:
+            write(trajectory)
     q = impact_quantities(trajectory)
     t_stick, delta_stick, dwell = trajectory.stick_points()
     out = {**_case_fields(setup), "status": trajectory.status, "stop_reason": trajectory.stop_reason,
@@ -720,7 +749,7 @@ def cmd_simulate(args) -> int:
                             for t, d, w in zip(t_stick, delta_stick, dwell, strict=True)],
            "asymptotic_points": [{"delta": d, "deltadot": 0.0, "dwell": w}
                                  for d, w in zip(delta_stick, dwell, strict=True)],
-           "case": setup.case.as_dict()}
+           "case": setup.case.as_dict(), "out": args.out}
     if args.json:
         _print_json(args, out)
     else:
@@ -740,6 +769,8 @@ def cmd_simulate(args) -> int:
         for t, d, w in zip(t_stick, delta_stick, dwell, strict=True):
             lasting = "permanent" if math.isinf(w) else f"{w:.4g} s"
             print(f"  stick at t = {t:.6g} s: delta = {d:.6g} m, dwell {lasting}")
+        if args.out is not None:
+            print(f"wrote {args.out} (the trajectory: {len(trajectory.t)} steps, {len(trajectory.event_t)} events)")
     if not trajectory.ok:
         print(f"phaseimpact: numerical failure: {trajectory.status}: {trajectory.message}", file=sys.stderr)
         return EXIT_FAILURE
@@ -849,23 +880,29 @@ def cmd_transitions(args) -> int:
     _check_kappa_range(args)
     if not law.is_filippov:  # a grazing search samples kappa: enough samples per decade, or refused now
         check_samples(args.samples, args.kappa_min, args.kappa_max, names=("kappa-min", "kappa-max", "samples"))
-    _note(f"locating the transitions of {law.label()} at v = {params.v:g} m/s for kappa in "
-          f"[{args.kappa_min:g}, {args.kappa_max:g}]")
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always", SamplingWarning)
-        try:
-            found = transitions(params, law, args.kappa_min, args.kappa_max, kappa_rtol=args.kappa_rtol,
-                                rtol=args.rtol, num=args.samples, progress=sys.stderr.isatty())
-        except RunFailed as error:  # every input was checked: this is the search's own failure
-            print(f"phaseimpact: the transition search failed: {error}", file=sys.stderr)
-            return EXIT_FAILURE
+    settings = {"rtol": args.rtol, "kappa_min": args.kappa_min, "kappa_max": args.kappa_max,
+                "kappa_rtol": args.kappa_rtol, "samples": args.samples}
+    with _out_archive(args, setup, "transitions", None, settings) as write:
+        _note(f"locating the transitions of {law.label()} at v = {params.v:g} m/s for kappa in "
+              f"[{args.kappa_min:g}, {args.kappa_max:g}]")
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always", SamplingWarning)
+            try:
+                found = transitions(params, law, args.kappa_min, args.kappa_max, kappa_rtol=args.kappa_rtol,
+                                    rtol=args.rtol, num=args.samples, progress=sys.stderr.isatty())
+            except RunFailed as error:  # every input was checked: this is the search's own failure
+                print(f"phaseimpact: the transition search failed: {error}", file=sys.stderr)
+                return EXIT_FAILURE
+        if write is not None:
+            write(found)
     notes = [str(w.message) for w in caught if issubclass(w.category, SamplingWarning)]
     for note in notes:
         print(f"phaseimpact: warning: {note}", file=sys.stderr)
     count = "stick phases" if law.is_filippov else "contacts"
     out = {**_law_fields(setup), "v": params.v, "kappa_min": args.kappa_min, "kappa_max": args.kappa_max,
            "count": count, "transitions": [t.as_dict() for t in found], "kappa_rtol": args.kappa_rtol,
-           "rtol": args.rtol, "samples": args.samples, "warnings": notes, "case": setup.case.as_dict()}
+           "rtol": args.rtol, "samples": args.samples, "warnings": notes, "case": setup.case.as_dict(),
+           "out": args.out}
     if args.json:
         _print_json(args, out)
     else:
@@ -876,6 +913,8 @@ def cmd_transitions(args) -> int:
             print(f"  {t.kind:<15} kappa = {t.kappa:.10g}   {t.count_below} -> {above}")
         if not found:
             print("  none in this range")
+        if args.out is not None:
+            print(f"wrote {args.out} ({len(found)} transitions)")
     return EXIT_OK
 
 
@@ -1236,6 +1275,11 @@ def cmd_plot(args) -> int:
     from .continuation import CriticalCurve
     from .train import Basins, OrbitDiagram
 
+    if archive.kind_of(result) in archive.RUN_KINDS:
+        portrait = "; its phase portrait: phaseimpact portrait" if archive.kind_of(result) == "trajectory" else ""
+        raise ValueError(f"archive = {args.archive!r} is a {archive.kind_of(result)} archive, which plot does not "
+                         "draw; allowed: a sweep, an atlas, a critical curve, an orbit diagram, basins or a map branch "
+                         f"(its contents: phaseimpact.archive.load or to_xarray{portrait})")
     if archive.kind_of(result) in archive.TRAIN_KINDS:
         kind = archive.kind_of(result)
         if kind == "impact-train":
@@ -1503,6 +1547,14 @@ def build_parser() -> argparse.ArgumentParser:
         p.add_argument("--no-progress", action="store_true",
                        help="no progress bar (there is one only when stderr is a terminal)")
 
+    def run_out(p, what):
+        p.add_argument("--out", type=_path("out"), default=None, metavar="FILE.nc",
+                       help=f"also write {what} as a netCDF-4/CF archive, .nc (docs/archive.md; written atomically; "
+                            "phaseimpact.archive.load reads it back; refused if it exists and is not an archive of "
+                            "the same work, unless --force) (default: none)")
+        p.add_argument("--force", action="store_true",
+                       help="replace --out even if it holds something else (default: refuse)")
+
     def figure_out(p):
         p.add_argument("--out", type=_figure_path, required=True, metavar="FIG.png",
                        help="figure to write, .png, .pdf or .svg (written atomically; an existing file that is "
@@ -1580,6 +1632,7 @@ def build_parser() -> argparse.ArgumentParser:
     target(p)
     horizon(p, "horizon")
     tolerance(p)
+    run_out(p, "the trajectory (its steps, event log and summary)")
     json_option(p)
     p.set_defaults(func=cmd_simulate)
 
@@ -1625,6 +1678,7 @@ def build_parser() -> argparse.ArgumentParser:
     samples(p, DEFAULT_SAMPLES)
     kappa_tolerance(p, "width of each transition's final bracket")
     tolerance(p)
+    run_out(p, "the transitions")
     json_option(p)
     p.set_defaults(func=cmd_transitions)
 

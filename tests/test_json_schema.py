@@ -39,6 +39,7 @@ def outputs(tmp_path_factory):
         "params:thornton": ["params", "--case", "sand-gelcoat", "--law", "thornton"],
         "simulate": ["simulate", "--kappa", "2e12"],
         "simulate:thornton": ["simulate", "--case", "sand-gelcoat", "--law", "thornton", "--t-end", "1e-5"],
+        "simulate:out": ["simulate", "--kappa", "2e12", "--out", tmp / "run.nc"],
         "fixed-points": ["fixed-points"],
         "critical": ["critical", "--v", "2", "--exponents"],
         "critical:not-found": ["critical", "--case", "sand-gelcoat"],
@@ -88,6 +89,7 @@ def test_the_variants_print_their_conditional_keys(outputs):
     assert "yield_velocity" in outputs["simulate:thornton"] and "exponents" in outputs["critical"]
     assert outputs["critical:not-found"]["kappa_c_status"] == "not-found"
     assert {"first_split", "boundaries"} <= set(outputs["sweep:paper"])
+    assert outputs["simulate:out"]["out"].endswith("run.nc") and outputs["simulate"]["out"] is None
 
 
 def test_a_dropped_key_fails_validation(outputs):

@@ -120,9 +120,13 @@ def test_a_summary_run_has_its_events_and_summary_without_samples():
     assert set(_flag(ds, "outcome")) <= set(OUTCOMES) and set(_flag(ds, "status")) <= set(STATUSES)
 
 
-def test_a_trajectory_carries_its_own_case():
-    with pytest.raises(TypeError, match="carries its own"):
-        archive.to_xarray(simulate(PARAMS, LAW, save="summary"), params=PARAMS)
+def test_a_trajectory_carries_its_own_law_and_takes_only_its_own_case():
+    run = simulate(PARAMS, LAW, save="summary")
+    with pytest.raises(TypeError, match="carries its own law"):
+        archive.to_xarray(run, law=LAW)
+    with pytest.raises(ValueError, match="params is not the trajectory's case"):
+        archive.to_xarray(run, params=PARAMS.replace(v=2.0))
+    assert archive.to_xarray(run, params=PARAMS).attrs["parameters"] == archive.to_xarray(run).attrs["parameters"]
 
 
 # ------------------------------------------------------------------------------------------------
@@ -229,8 +233,8 @@ def test_basins(trains, monkeypatch):
 def test_an_unsupported_type_is_named():
     with pytest.raises(TypeError, match=r"cannot convert a dict; allowed: .*, a Trajectory, .*ImpactTrain"):
         archive.to_xarray({})
-    with pytest.raises(TypeError, match=r"cannot archive a Trajectory; allowed: .*OrbitDiagram"):
-        archive.save(simulate(PARAMS, LAW, save="summary"), "unused.nc")
+    with pytest.raises(TypeError, match=r"cannot archive a dict; allowed: .*, a Trajectory, .*OrbitDiagram"):
+        archive.save({}, "unused.nc")
 
 
 # ------------------------------------------------------------------------------------------------
