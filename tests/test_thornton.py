@@ -184,6 +184,36 @@ def test_contacts_on_the_plate_are_counted_by_force(ratio, contacts):
                                atol=1e-12 * tr.t_stop)
 
 
+#: Steps a Thornton impact of the sweep below may take (they take 24 to 61): a separation that
+#: restarted just inside the force separated again at once, without end (too-many-steps after
+#: ~55 s, issue 42), which this cap turns into a quick failure.
+STEP_CAP = 10_000
+CHATTER_CASE = seed_parameters(v=1.0, kappa=3e9, limiting_pressure=2e9)
+
+
+def test_a_separation_from_a_dent_does_not_separate_again():
+    """``phaseimpact warmup``'s run (the stiff kappa = 1e14 at 5 m/s on the plate): before the dent
+    it ended in milliseconds, two contacts, max force 23271.2385 N (the engine before contacts were
+    counted by force); the separation at the dent's gap must not restart inside the force."""
+    tr = simulate(CHATTER_CASE.replace(kappa=1e14, v=5.0), "thornton", 2e-3, max_steps=STEP_CAP)
+    assert tr.status == "success" and tr.outcome == "rebound"
+    assert tr.n_contacts == 2 and len(tr.events_of("separation")) == 2
+    assert tr.max_force == pytest.approx(23271.2385, rel=1e-7)
+
+
+@pytest.mark.parametrize("target", ["plate", "rigid"])
+@pytest.mark.parametrize("kappa", [3e9, 1e14])
+@pytest.mark.parametrize("v", [1.0, 5.0, 20.0])
+def test_contacts_and_separations_alternate_in_a_few_steps(target, kappa, v):
+    """Each contact ends once: contacts and separations alternate, and the run ends with success in
+    a bounded number of steps and events."""
+    tr = simulate(CHATTER_CASE.replace(target=target, kappa=kappa, v=v), "thornton", 2e-3, max_steps=STEP_CAP)
+    assert tr.status == "success" and tr.outcome == "rebound"
+    kinds = [e.kind for e in tr.events if e.kind in ("contact", "separation")]
+    assert kinds == ["contact", "separation"] * tr.n_contacts and tr.n_contacts >= 1
+    assert tr.nsteps <= 200 and len(tr.events) <= 30
+
+
 def test_the_law_passes_the_conformance_suite():
     """Force, partials, the energy ledger on the plate (two contacts: the second reloads the dent on
     the unloading curve, then yields again), momentum, and scipy restarted at the turning point."""

@@ -85,7 +85,7 @@ def event_value(code, c, y, f, force, mode, energy_limit, column):
     side). Inactive events are held at +-1 so that they never fire."""
     stuck = mode == STUCK
     if column == DELTA:
-        return contact_gap(code, c, y[X1] - y[X2])
+        return contact_gap(code, c, y[X1], y[X2])
     if column == ENERGY:
         return energy_limit - energy(code, c, y)
     if column == PAIR_CENTRE:
@@ -105,7 +105,7 @@ def event_value(code, c, y, f, force, mode, energy_limit, column):
         p_delta, p_rate = partials_of(code, c, y[X1] - y[X2], deltadot, mode)
         return p_delta * deltadot + p_rate * (f[V1] - f[V2])
     # REACH
-    if not stuck and is_unilateral(code) and c[SPRINGS_] > 0 and contact_gap(code, c, y[X1] - y[X2]) < 0 \
+    if not stuck and is_unilateral(code) and c[SPRINGS_] > 0 and contact_gap(code, c, y[X1], y[X2]) < 0 \
             and y[V1] < 0:
         return -(y[X1] + target_reach(c, y))
     return -1.0
@@ -194,7 +194,8 @@ def transition(code, c, column, y, mode, settle):
     """
     action = GO_ON
     if column == DELTA:
-        # the event is a zero gap: remove the root finder's residue
+        # the event is a zero gap: remove the root finder's residue (contact_gap's own expression, so
+        # that the gap is exactly 0 and the next phase's side is that of deltadot)
         y[X1] = y[X2] + dent_depth(code, c) if has_memory(code) else y[X2]
         deltadot = y[V1] - y[V2]
         kind = CONTACT if deltadot > 0 else SEPARATION

@@ -269,14 +269,18 @@ def has_memory(code):
 
 
 @kernel(python=True, inline="always")
-def contact_gap(code, c, delta):
-    """How far the bodies are from touching at the indentation ``delta`` (m): ``delta`` itself, or for
-    a law with memory ``delta - delta_p``, past the residual indentation ``delta_p`` of its dent: a
-    projectile inside its plastic dent feels no force (the dent is state, not contact), so its
-    contact starts and ends where the force does (0 before the first yield)."""
+def contact_gap(code, c, x1, x2):
+    """How far the bodies at ``x1``, ``x2`` are from touching (m): the indentation ``x1 - x2``, or for
+    a law with memory ``x1 - (x2 + delta_p)``, past the residual indentation ``delta_p`` of its dent:
+    a projectile inside its plastic dent feels no force (the dent is state, not contact), so its
+    contact starts and ends where the force does (0 before the first yield). Written as the
+    separation places ``x1`` (``x2 + delta_p``, :func:`~phaseimpact.integrate.events.transition`) so
+    that the gap there is exactly 0 and the next phase takes its side from ``deltadot``: as
+    ``(x1 - x2) - delta_p`` its rounding left it +-1 ulp, and a restart just inside the force
+    separated again at once, without end (issue 42)."""
     if has_memory(code):
-        return delta - c[MEMORY_ + 2]
-    return delta
+        return x1 - (x2 + c[MEMORY_ + 2])
+    return x1 - x2
 
 
 @kernel(python=True, inline="always")

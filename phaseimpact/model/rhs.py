@@ -144,7 +144,7 @@ def contact_side(code, c, y, mode):
     """
     if mode == STUCK or mode == PLAIN:
         return PLAIN_PHASE
-    delta = contact_gap(code, c, y[X1] - y[X2])  # a law with memory flies inside its dent
+    delta = contact_gap(code, c, y[X1], y[X2])  # a law with memory flies inside its dent
     deltadot = y[V1] - y[V2]
     side = 1 if delta > 0 else (-1 if delta < 0 else (1 if deltadot > 0 else (-1 if deltadot < 0 else 0)))
     if side < 0 and force_of(code, c, -1.0, 0.0, mode) == 0.0:
