@@ -1594,7 +1594,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser("warmup", help="compile the engine ahead, and say where its cache is",
                        description="Compile every entry of the engine into its cache now (the first command that "
-                                   "integrates would otherwise do it, about 35 s on 2 cores), and say where the "
+                                   "integrates would otherwise do it, about a minute on 2 cores), and say where the "
                                    "cache is: for containers, cluster workers and a fresh install (each user who "
                                    "cannot write the install compiles once into ~/.cache/phaseimpact). On a warm "
                                    "cache it only loads.")

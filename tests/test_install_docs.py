@@ -64,7 +64,7 @@ def test_troubleshooting_and_changelog_are_in_the_site():
                     if isinstance(e, dict) and "pymdownx.snippets" in e)
     assert snippets["check_paths"] is True  # a missing CHANGELOG.md fails the build
     page = (ROOT / "docs" / "troubleshooting.md").read_text()
-    for needed in ("NUMBA_CACHE_DIR", "phaseimpact warmup", "read-only", "XDG_CACHE_HOME", "17.1 s"):
+    for needed in ("NUMBA_CACHE_DIR", "phaseimpact warmup", "read-only", "XDG_CACHE_HOME"):
         assert needed in page, needed
 
 
@@ -73,9 +73,8 @@ def test_the_first_compile_time_quoted_is_the_benchmarks():
     table = (ROOT / "figures" / "benchmarks.md").read_text()
     measured = re.search(r"\| first command on an empty cache \(phaseimpact simulate\) \| [^|]+ \| ([\d.]+) s \|",
                          table).group(1)
-    every = re.search(r"\| first-ever compile per environment \| [^|]+ \| ([\d.]+) s ", table).group(1)
     page = (ROOT / "docs" / "troubleshooting.md").read_text()
-    assert f"took {measured} s, and compiling every entry {every} s" in " ".join(page.split())
+    assert f"on an empty cache took {measured} s" in " ".join(page.split())
 
 
 def test_citation_cites_this_version():
