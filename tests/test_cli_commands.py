@@ -9,6 +9,7 @@ runs on either side, continuation against independent searches, and atlas points
 
 from __future__ import annotations
 
+import argparse
 import importlib
 import json
 import math
@@ -544,6 +545,8 @@ def test_shell_completion_knows_every_command_and_option(shell):
     for name, sub in commands.items():
         assert name in out, name
         for action in sub._actions:
+            if action.help == argparse.SUPPRESS:  # removed spellings, kept only to point at their successors
+                continue
             for option in action.option_strings:
                 if option.startswith("--"):
                     assert option in out, (name, option)

@@ -549,8 +549,10 @@ def load_law_file(path) -> list[str]:
         # what the file prints goes to stderr: stdout holds the command's output (--json)
         with contextlib.redirect_stdout(sys.stderr):
             exec(compile(source, absolute, "exec"), module.__dict__)  # noqa: S102 (the user's own law file)
-    except UserLawError:
-        raise
+    except UserLawError as exc:  # define_law's own message names the law; the file is named too
+        if path in str(exc):
+            raise
+        raise UserLawError(f"law file {path!r}: {exc}") from None
     except SystemExit as exc:
         raise UserLawError(f"law file {path!r} exited (status {exc.code!r}) while it was run (sys.exit or "
                            "os._exit); allowed: a file that only defines laws (remove the exit)") from None
