@@ -13,13 +13,13 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from _registry import restored_registry
 
 import phaseimpact
 from phaseimpact import checks
 from phaseimpact._oracle import BudgetExceeded, oracle
 from phaseimpact.checks import LawReport, Verdict, check_law
 from phaseimpact.cli import main
-from phaseimpact.model import REGISTRY
 from phaseimpact.parameters import seed_parameters
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -67,13 +67,8 @@ def _law_file(tmp_path, name):
 
 @pytest.fixture(autouse=True)
 def _registry_restored():
-    from phaseimpact.model import laws
-
-    before = dict(REGISTRY)
-    yield
-    REGISTRY.clear()
-    REGISTRY.update(before)
-    laws._named_law.cache_clear()
+    with restored_registry():
+        yield
 
 
 def _check_law_cli(capsys, *args):

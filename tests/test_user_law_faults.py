@@ -11,6 +11,7 @@ import textwrap
 import time
 
 import pytest
+from _registry import restored_registry
 
 from phaseimpact import define_law, seed_parameters, simulate
 from phaseimpact.cli import main
@@ -60,13 +61,8 @@ SLOW = textwrap.dedent('''\
 
 @pytest.fixture(scope="module", autouse=True)
 def _registry_restored():
-    from phaseimpact.model import laws
-
-    before = dict(REGISTRY)
-    yield
-    REGISTRY.clear()
-    REGISTRY.update(before)
-    laws._named_law.cache_clear()
+    with restored_registry():
+        yield
 
 
 def _cli(*args, timeout=240):

@@ -6,6 +6,7 @@ import textwrap
 
 import numpy as np
 import pytest
+from _registry import restored_registry
 
 import phaseimpact
 from phaseimpact import ContactLaw, check_law, define_law, seed_parameters, simulate
@@ -58,14 +59,8 @@ def kk_potential(delta, K, alpha):
 
 @pytest.fixture(scope="module", autouse=True)
 def _registry_restored():
-    """The laws these tests define leave the registry with them (later tests enumerate it)."""
-    from phaseimpact.model import laws
-
-    before = dict(REGISTRY)
-    yield
-    REGISTRY.clear()
-    REGISTRY.update(before)
-    laws._named_law.cache_clear()
+    with restored_registry():
+        yield
 
 
 @pytest.fixture(scope="module")
