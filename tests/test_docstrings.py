@@ -36,6 +36,8 @@ MODULES = (
     "phaseimpact.model.userlaw",
     "phaseimpact.model.restitution",
     "phaseimpact.model.rhs",
+    "phaseimpact.model.laminate",
+    "phaseimpact.model.regime",
     "phaseimpact.checks",
     "phaseimpact.integrate",
 )

@@ -26,7 +26,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..parameters import MODULUS_RANGE, DENSITY_RANGE, LENGTH_RANGE, is_number, require, require_choice, require_in
+from ..parameters import DENSITY_RANGE, LENGTH_RANGE, MODULUS_RANGE, is_number, require, require_choice, require_in
 
 __all__ = [
     "Ply", "Laminate", "transformed_stiffness", "lekhnitskii_rigidity", "isotropic_part",
@@ -285,7 +285,7 @@ class Laminate:
         """
         z = self.interfaces()
         A, B, D = (np.zeros((3, 3)) for _ in range(3))
-        for ply, low, high in zip(self.plies, z[:-1], z[1:]):
+        for ply, low, high in zip(self.plies, z[:-1], z[1:], strict=True):
             Q = transformed_stiffness(ply)
             A += Q * (high - low)
             B += Q * (high**2 - low**2) / 2

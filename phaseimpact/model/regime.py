@@ -145,7 +145,8 @@ def zener_lambda(M1: float, v: float, K: float, impedance: float) -> float:
     >>> print(f"{zener_lambda(0.263056, 1.0, 2.17570e10, 2457.328):.4g}")
     2.492
     """
-    for name, value, unit in (("M1", M1, "kg"), ("v", v, "m/s"), ("K", K, "N/m^1.5"), ("impedance", impedance, "N s/m")):
+    for name, value, unit in (("M1", M1, "kg"), ("v", v, "m/s"), ("K", K, "N/m^1.5"),
+                              ("impedance", impedance, "N s/m")):
         _positive(name, value, unit)
     return M1**0.6 * v**0.2 * K**0.4 / impedance
 
