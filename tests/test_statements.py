@@ -218,6 +218,24 @@ def undamped_max_force():
 
 
 @functools.cache
+def yang_sun_over_exact(nu):
+    """Yang-Sun's half-space compliance of an isotropic face over the exact one (docs/physics.md §8)."""
+    from phaseimpact.model.laminate import Ply, transversely_isotropic_compliance, yang_sun_compliance
+
+    E = 2.1e11
+    return (yang_sun_compliance(Ply.isotropic(E, nu, 7850.0, 1e-3))
+            / transversely_isotropic_compliance(E, nu, E, nu, E / (2 * (1 + nu))))
+
+
+def seed_plate_impedance():
+    """The seed plate's infinite-plate impedance 8 sqrt(D rho h), N s/m (docs/physics.md §8)."""
+    from phaseimpact.model.regime import infinite_plate_impedance
+    from phaseimpact.parameters import STEEL, Geometry
+
+    h = Geometry().h
+    return infinite_plate_impedance(STEEL.E * h**3 / (12 * (1 - STEEL.nu**2)), STEEL.rho * h)
+
+
 def seed():
     from phaseimpact import seed_parameters
 
@@ -446,6 +464,8 @@ STATEMENTS = [
                        100 * (1 - hertz(reduced_mass())[1] / hertz(seed().M1)[1]),
                        hertz(reduced_mass())[2], hertz(reduced_mass())[3] / 1e9)),
     Statement(D, "(`m` the reduced mass; {} mJ for the seed at 1 m/s)", lambda: below_kc_energy_mj()[1]),
+    Statement(D, "larger by `1/(1 - nu^2)` ({} at `nu = 0.3`)", lambda: yang_sun_over_exact(0.3)),
+    Statement(D, "Seed plate: `c = {} N s/m`.", lambda: seed_plate_impedance()),
     Statement(D, "Scales: contact time about {} s at 1 m/s ({} s on a rigid target); plate period "
                  "`2 pi sqrt(M2/Kb)` about {} s.",
               lambda: (hertz(reduced_mass())[1], hertz(seed().M1)[1], 2 * math.pi * math.sqrt(seed().M2 / seed().Kb))),
@@ -505,7 +525,10 @@ EXEMPT = {
         "7850": "input (steel density)", "353": "eq. 5b's formula", "191": "eq. 5b's formula",
         "648": "eq. 5b's formula", "6.35": "the speed of an example point (input)",
         "3.2145": "the literature's rounded value, quoted as such", "2002": "year", "2008": "year",
-        "1997": "year", "383": "page (Thornton 1997, J. Appl. Mech. 64:383)"},
+        "1997": "year", "383": "page (Thornton 1997, J. Appl. Mech. 64:383)",
+        **{year: "year" for year in ("1941", "1960", "1968", "1982", "1985", "1992", "1998", "1999", "2000", "2004")},
+        "669": "page (Zener 1941, Phys. Rev. 59:669)", "1587": "page (Olsson 1992, AIAA J. 30:1587)",
+        "879": "page (Olsson 2000, Composites A 31:879)"},
     PL: {"1997": "year", "383": "page (Thornton 1997, J. Appl. Mech. 64:383)"},
     TR: {"200": "input (impacts dropped)", "400": "input (values of T)"},
     "studies/train_bifurcations.py": {
