@@ -259,6 +259,16 @@ def test_ply_refuses_bad_values_naming_them(change, message):
         Ply(**{**T300, "angle": 0, **change})
 
 
+def test_validate_ply_names_the_case_file_field():
+    """A case file's [[plate.ply]] table is checked with its place in the message."""
+    table = {**T300, "angle": 0}
+    lam.validate_ply(table)
+    with pytest.raises(ValueError, match=r"plate.ply\[2\].nu12 = 5.0 is out of range; allowed: \|nu12\| < sqrt"):
+        lam.validate_ply({**table, "nu12": 5.0}, prefix="plate.ply[2].")
+    with pytest.raises(ValueError, match=r"plate.ply\[0\]: missing thickness, unknown E3; allowed: E1, E2"):
+        lam.validate_ply({**{k: v for k, v in table.items() if k != "thickness"}, "E3": 1e10}, prefix="plate.ply[0].")
+
+
 def test_laminate_refuses_empty_and_mixed_shear():
     with pytest.raises(ValueError, match=r"plies = \(\) is out of range; allowed: a non-empty sequence of Ply"):
         Laminate(())

@@ -21,7 +21,9 @@ What each stiffness reads (docs/physics.md §8 states the formulas and their sou
 
 from __future__ import annotations
 
+import dataclasses
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass
 
 import numpy as np
@@ -29,7 +31,7 @@ import numpy as np
 from ..parameters import DENSITY_RANGE, LENGTH_RANGE, MODULUS_RANGE, is_number, require, require_choice, require_in
 
 __all__ = [
-    "Ply", "Laminate", "transformed_stiffness", "lekhnitskii_rigidity", "isotropic_part",
+    "Ply", "Laminate", "validate_ply", "transformed_stiffness", "lekhnitskii_rigidity", "isotropic_part",
     "bending_stiffness", "membrane_stiffness", "shear_stiffness", "bending_shear_stiffness",
     "yang_sun_compliance", "transversely_isotropic_compliance", "MEMBRANE_FORMULAS", "SHEAR_FACTOR",
 ]
@@ -38,11 +40,57 @@ __all__ = [
 MEMBRANE_FORMULAS = ("printed", "shivakumar")
 #: Mindlin/Reissner shear correction factor of a homogeneous section.
 SHEAR_FACTOR = 5.0 / 6.0
-_PLY_MODULI = ("E1", "E2", "G12")
+#: A ply's fields, as a case file's ``[[plate.ply]]`` table names them (``G13``, ``G23`` optional).
+PLY_FIELDS = ("E1", "E2", "G12", "nu12", "rho", "angle", "thickness", "G13", "G23")
 
 
 def _finite(value) -> bool:
     return is_number(value) and math.isfinite(value)
+
+
+def validate_ply(values: Mapping, prefix: str = "") -> None:
+    """Check a ply's fields given as a mapping (a case file's ``[[plate.ply]]`` table).
+
+    Parameters
+    ----------
+    values : Mapping
+        ``E1, E2, G12, nu12, rho, angle, thickness`` and optionally ``G13, G23`` (see :class:`Ply`).
+    prefix : str
+        Prepended to the field names in error messages (``"plate.ply[2]."``).
+
+    Raises
+    ------
+    ValueError
+        Naming the (prefixed) field, its value and the allowed range; for a missing or unknown field.
+
+    Examples
+    --------
+    >>> from phaseimpact.model.laminate import validate_ply
+    >>> ply = dict(E1=1.4e11, E2=1e10, G12=5e9, nu12=0.3, rho=1600.0, angle=0, thickness=1e-4)
+    >>> validate_ply(ply)
+    >>> validate_ply({**ply, "angle": 400}, prefix="plate.ply[1].")
+    Traceback (most recent call last):
+        ...
+    ValueError: plate.ply[1].angle = 400 is out of range; allowed: -360 <= angle <= 360 (degrees)
+    """
+    missing = [name for name in PLY_FIELDS[:7] if name not in values]
+    unknown = [name for name in values if name not in PLY_FIELDS]
+    if missing or unknown:
+        raise ValueError(f"{prefix.rstrip('.') or 'ply'}: missing {', '.join(missing) or 'nothing'}, unknown "
+                         f"{', '.join(unknown) or 'nothing'}; allowed: {', '.join(PLY_FIELDS)} (G13, G23 optional)")
+    for name in ("E1", "E2", "G12"):
+        require_in(prefix + name, values[name], MODULUS_RANGE, "Pa")
+    nu12, bound = values["nu12"], math.sqrt(values["E1"] / values["E2"])
+    require(prefix + "nu12", nu12, f"|nu12| < sqrt(E1/E2) = {bound:g}", _finite(nu12) and abs(nu12) < bound)
+    require_in(prefix + "rho", values["rho"], DENSITY_RANGE, "kg/m^3")
+    angle = values["angle"]
+    require(prefix + "angle", angle, "-360 <= angle <= 360 (degrees)", _finite(angle) and abs(angle) <= 360)
+    require_in(prefix + "thickness", values["thickness"], LENGTH_RANGE, "m")
+    G13, G23 = values.get("G13"), values.get("G23")
+    require(prefix + "G13", G13, "both G13 and G23 (Pa), or neither", (G13 is None) == (G23 is None))
+    for name, value in (("G13", G13), ("G23", G23)):
+        if value is not None:
+            require_in(prefix + name, value, MODULUS_RANGE, "Pa")
 
 
 @dataclass(frozen=True)
@@ -90,18 +138,8 @@ class Ply:
     G23: float | None = None
 
     def __post_init__(self):
-        for name in _PLY_MODULI:
-            require_in(name, getattr(self, name), MODULUS_RANGE, "Pa")
-        bound = math.sqrt(self.E1 / self.E2)
-        require("nu12", self.nu12, f"|nu12| < sqrt(E1/E2) = {bound:g}", _finite(self.nu12) and abs(self.nu12) < bound)
-        require_in("rho", self.rho, DENSITY_RANGE, "kg/m^3")
-        require("angle", self.angle, "-360 <= angle <= 360 (degrees)", _finite(self.angle) and abs(self.angle) <= 360)
-        require_in("thickness", self.thickness, LENGTH_RANGE, "m")
-        require("G13", self.G13, "both G13 and G23 (Pa), or neither", (self.G13 is None) == (self.G23 is None))
-        for name in ("G13", "G23"):
-            if getattr(self, name) is not None:
-                require_in(name, getattr(self, name), MODULUS_RANGE, "Pa")
-        for name in (*_PLY_MODULI, "nu12", "rho", "angle", "thickness", "G13", "G23"):
+        validate_ply(dataclasses.asdict(self))
+        for name in PLY_FIELDS:
             if getattr(self, name) is not None:
                 object.__setattr__(self, name, float(getattr(self, name)))
 
