@@ -14,7 +14,7 @@ from phaseimpact.model import regime
 from phaseimpact.model.laminate import Laminate, Ply
 from phaseimpact.parameters import Geometry, Material, derive_parameters
 
-#: T300/5208 graphite/epoxy (Kaw, *Mechanics of Composite Materials*, 2nd ed., 2006, Example 2.6).
+#: T300/5208 graphite/epoxy (Kaw, *Mechanics of Composite Materials*, 2nd ed., 2006, ch. 2's worked example of [Q]).
 T300 = dict(E1=181e9, E2=10.3e9, G12=7.17e9, nu12=0.28, rho=1600.0, thickness=0.125e-3)
 
 
@@ -29,7 +29,7 @@ def hand_q(E1, E2, G12, nu12, **_):
 
 
 def hand_qbar(ply, angle):
-    """Jones (1999) eq. 2.85, term by term."""
+    """Jones (1999, ch. 2), Q-bar term by term."""
     Q11, Q22, Q12, Q66 = hand_q(**ply)
     c, s = math.cos(math.radians(angle)), math.sin(math.radians(angle))
     q11 = Q11 * c**4 + 2 * (Q12 + 2 * Q66) * s**2 * c**2 + Q22 * s**4
@@ -64,7 +64,7 @@ QUASI_ISOTROPIC = (0, 45, -45, 90, 90, -45, 45, 0)
 
 
 def test_reduced_stiffness_matches_the_published_example():
-    """Kaw (2006) Example 2.6: Q11 = 181.8, Q12 = 2.897, Q22 = 10.35, Q66 = 7.17 GPa."""
+    """Kaw (2006): Q11 = 181.8, Q12 = 2.897, Q22 = 10.35, Q66 = 7.17 GPa."""
     Q = Ply(angle=0, **T300).reduced_stiffness() / 1e9
     assert np.allclose([Q[0, 0], Q[0, 1], Q[1, 1], Q[2, 2]], [181.8, 2.897, 10.35, 7.17], rtol=1e-3)
     assert Q[0, 2] == Q[1, 2] == 0

@@ -5,7 +5,7 @@ Conventions. Plies are listed from the impacted face down; ``z`` is measured fro
 positive in the direction of flight (the impacted face is at ``z = -h/2``). Ply angles are in
 degrees from the plate's ``x`` axis. Strains are engineering strains, so ``A``, ``B``, ``D`` are
 the usual 3 x 3 matrices of ``(N, M) = [[A, B], [B, D]] (eps0, kappa)`` in the order
-``(x, y, xy)`` (Jones, *Mechanics of Composite Materials*, 2nd ed., 1999, §4.3).
+``(x, y, xy)`` (Jones, *Mechanics of Composite Materials*, 2nd ed., 1999, ch. 4).
 
 What each stiffness reads (docs/physics.md §8 states the formulas and their sources):
 
@@ -183,7 +183,7 @@ class Ply:
         return self.G13 is not None
 
     def reduced_stiffness(self) -> np.ndarray:
-        """The plane-stress reduced stiffness ``Q`` in the ply's axes (Jones eq. 2.61).
+        """The plane-stress reduced stiffness ``Q`` in the ply's axes (Jones, ch. 2).
 
         Returns
         -------
@@ -206,7 +206,7 @@ class Ply:
 
 
 def transformed_stiffness(ply: Ply) -> np.ndarray:
-    """The ply's stiffness ``Q-bar`` in the plate's axes: ``T^-1 Q T^-T`` (Jones §2.6, engineering strain).
+    """The ply's stiffness ``Q-bar`` in the plate's axes: ``T^-1 Q T^-T`` (Jones, ch. 2; engineering strain).
 
     Parameters
     ----------
@@ -302,7 +302,7 @@ class Laminate:
         return z
 
     def abd(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Extensional, coupling and bending stiffnesses (Jones eq. 4.28).
+        """Extensional, coupling and bending stiffnesses (Jones, ch. 4).
 
         ``A = sum Qk (z_k - z_k-1)``, ``B = sum Qk (z_k^2 - z_k-1^2) / 2``,
         ``D = sum Qk (z_k^3 - z_k-1^3) / 3``, ``Qk`` the ply's :func:`transformed_stiffness`.
@@ -392,7 +392,7 @@ def lekhnitskii_rigidity(D) -> float:
 
     ``D* = (3 D11 + 2 D12 + 4 D66 + 3 D22) / 8``: the centre deflection is ``P a^2 / (16 pi D*)``
     (Lekhnitskii, *Anisotropic Plates*, 1968, as used by Abrate, *Impact on Composite Structures*,
-    1998, §4). It is also the rotation average (Tsai and Pagano's invariant ``U1``) of ``D``;
+    1998). It is also the rotation average (Tsai and Pagano's invariant ``U1``) of ``D``;
     ``D16``, ``D26`` do not enter.
 
     Parameters
@@ -420,7 +420,7 @@ def isotropic_part(M) -> tuple[float, float]:
     """The rotation-averaged (isotropic) part of a stiffness matrix: ``(M11, M12)`` of its average.
 
     ``U1 = (3 M11 + 3 M22 + 2 M12 + 4 M66) / 8``, ``U4 = (M11 + M22 + 6 M12 - 4 M66) / 8``
-    (Tsai and Pagano, 1968; Jones §4.6): the isotropic matrix ``[[U1, U4, 0], [U4, U1, 0],
+    (Tsai and Pagano, 1968): the isotropic matrix ``[[U1, U4, 0], [U4, U1, 0],
     [0, 0, (U1 - U4)/2]]`` nearest the rotations of ``M``. ``M`` itself for an isotropic one.
 
     Parameters
@@ -586,7 +586,7 @@ def bending_shear_stiffness(Kb: float, Ks: float) -> float:
 def yang_sun_compliance(ply: Ply) -> float:
     """The half-space term of the contact compliance ``eta`` (eq. 4) for a composite top ply: ``1/E3``.
 
-    Yang and Sun (1982), as used by Abrate (1998, §3): a transversely isotropic laminate face
+    Yang and Sun (1982), as used by Abrate (1998): a transversely isotropic laminate face
     enters the Hertz modulus through its through-thickness modulus alone, ``E3 = E2`` of the
     ply. For an isotropic ply it gives ``1/E`` where the exact term is ``(1 - nu^2)/E``.
 
@@ -613,7 +613,7 @@ def transversely_isotropic_compliance(E_p: float, nu_p: float, E_t: float, nu_tp
     """The half-space term of ``eta`` for a solid transversely isotropic about the surface normal.
 
     ``1/M`` with the exact indentation modulus in the closed form of Delafargue and Ulm (2004,
-    Int. J. Solids Struct. 41:7351, eq. 24), ``M = 2 sqrt((C11 C33 - C13^2) / (C11 (1/C44 +
+    Int. J. Solids Struct. 41:7351), ``M = 2 sqrt((C11 C33 - C13^2) / (C11 (1/C44 +
     2/(sqrt(C11 C33) + C13))))``, the stiffnesses ``C`` from the engineering constants. It gives
     ``(1 - nu^2)/E`` for an isotropic solid; a unidirectional ply, whose symmetry axis lies in
     the surface, is outside its assumptions.
