@@ -196,3 +196,19 @@ def test_a_map_without_a_call_says_what_it_lacks():
 
     with pytest.raises(NotImplementedError, match="does not define __call__"):
         fixed_point(Empty())
+
+
+def test_the_generic_analyses_import_nothing_of_the_model():
+    """base, orbit_diagram, basins and continuation work over any map: they import neither the engine
+    nor the model, nor the model's map (read from the sources)."""
+    import ast
+    from pathlib import Path
+
+    folder = Path(__file__).resolve().parents[1] / "phaseimpact" / "maps"
+    for name in ("base", "orbit_diagram", "basins", "continuation"):
+        tree = ast.parse((folder / f"{name}.py").read_text())
+        imported = {node.module for node in ast.walk(tree) if isinstance(node, ast.ImportFrom)}
+        imported |= {alias.name for node in ast.walk(tree) if isinstance(node, ast.Import) for alias in node.names}
+        assert not {m for m in imported if m and m.split(".")[0] in ("integrate", "model", "impact",
+                                                                      "impact_analyses")}, (name, imported)
+        assert not any("phaseimpact.integrate" in m or "phaseimpact.model" in m for m in imported if m), name

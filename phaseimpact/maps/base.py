@@ -91,6 +91,8 @@ class ImpactMap:
         Names of the counts :meth:`structure` gives per step (none by default).
     positive_parameters : tuple of str
         Parameters that stay positive (a two-parameter continuation keeps its windows above 0).
+    states : str
+        What its states are, for messages (``states of the map`` by default).
 
     Examples
     --------
@@ -102,6 +104,7 @@ class ImpactMap:
     parameters: tuple[str, ...] = ()
     structure_names: tuple[str, ...] = ()
     positive_parameters: tuple[str, ...] = ()
+    states = "states of the map"
 
     def __call__(self, state) -> np.ndarray:
         raise NotImplementedError(f"{type(self).__name__} does not define __call__(state), the next state")
@@ -593,8 +596,8 @@ def check_samples(imap: ImpactMap, samples) -> np.ndarray:
     samples = np.asarray(samples, dtype=float)
     n = len(imap.scale)
     if samples.ndim != 2 or samples.shape[1] != n or len(samples) < 2 or not np.all(np.isfinite(samples)):
-        raise ValueError(f"samples of shape {samples.shape} are out of range; allowed: finite states of the map, "
-                         f"shape (m, {n}) with m >= 2")
+        raise ValueError(f"samples of shape {samples.shape} are out of range; allowed: finite {imap.states}, "
+                         f"shape (n, {n}) with n >= 2")
     return samples
 
 

@@ -30,7 +30,7 @@ BIFURCATION_KINDS = ("period-doubling", "fold", "neimark-sacker", "grazing")
 
 @dataclass(frozen=True)
 class MapBifurcation:
-    """A located bifurcation of a periodic orbit of the impact map.
+    """A located bifurcation of a periodic orbit of a map (the impact map's units in brackets).
 
     Attributes
     ----------
@@ -38,15 +38,15 @@ class MapBifurcation:
         ``period-doubling`` (a real multiplier crosses -1: a period-``2k`` orbit is born or dies),
         ``fold`` (a real multiplier crosses +1: two orbits of period ``k`` meet; ``turning`` says
         whether the branch turns back in the parameter there), ``neimark-sacker`` (a complex pair
-        crosses the unit circle) or ``grazing`` (the orbit's contact structure changes: see
-        :func:`continue_orbit`).
+        crosses the unit circle) or ``grazing`` (the orbit's structure, for the impact map its
+        contacts, changes: see :func:`continue_orbit`).
     param : str
-        ``T``, ``kappa`` or ``v``.
+        The parameter (``T``, ``kappa`` or ``v``).
     value : float
         The parameter at the point (s, the law's damping unit or m/s).
-    plate : ndarray, shape (2,)
-        The orbit's ``(x2, x2dot)`` before its first impact there (m, m/s).
-    multipliers : ndarray, shape (2,), complex
+    plate : ndarray, shape (n,)
+        The orbit's state at its first step there (the plate's ``(x2, x2dot)``, m and m/s).
+    multipliers : ndarray, shape (n,), complex
         Floquet multipliers there.
     bracket : float
         Width of the final bracket of the bisection in the parameter (its unit): the location's
@@ -54,9 +54,9 @@ class MapBifurcation:
     test_value : float
         The test function at the point: ``det(J + I)``, ``det(J - I)``, ``det J - 1`` (``J`` the
         Jacobian of ``P^k``); 0 for grazing.
-    contacts : tuple of 2 (int, int, int)
-        Contacts, stick phases and overlaps per period of the orbit on either side (grazing; else
-        both alike).
+    contacts : tuple of 2 tuples of int
+        The orbit's structure per period on either side (grazing; else both alike): for the impact
+        map its contacts, stick phases and overlaps.
     turning : bool
         Fold only: the branch's parameter turns back there (a saddle-node), not a crossing.
 
@@ -101,23 +101,24 @@ class MapBifurcation:
 
 @dataclass(frozen=True)
 class MapBranch:
-    """A branch of period-``k`` orbits of the impact map followed over a parameter, with its
-    located bifurcations.
+    """A branch of period-``k`` orbits of a map followed over a parameter, with its located
+    bifurcations (the impact map's units in brackets).
 
     Attributes
     ----------
     param : str
-        ``T``, ``kappa`` or ``v``.
+        The parameter (``T``, ``kappa`` or ``v``).
     period_k : int
     values : ndarray, shape (n,)
         The parameter along the branch, in the order followed (it turns back at a fold).
-    plate : ndarray, shape (n, 2)
-        ``(x2, x2dot)`` of the orbit before its first impact (m, m/s).
-    multipliers : ndarray, shape (n, 2), complex
+    plate : ndarray, shape (n, dim)
+        The orbit's state at its first step (the plate's ``(x2, x2dot)`` before its first impact, m
+        and m/s).
+    multipliers : ndarray, shape (n, dim), complex
     stable : ndarray of bool, shape (n,)
-    contacts : ndarray of int, shape (n, 3)
-        Contacts, stick phases and overlaps (a projectile still in contact at the next arrival) per
-        period of the orbit.
+    contacts : ndarray of int, shape (n, len(structure_names))
+        The orbit's structure per period: for the impact map its contacts, stick phases and overlaps
+        (a projectile still in contact at the next arrival).
     points : list of MapBifurcation
         The located points, in the order met.
     message : str
@@ -168,23 +169,22 @@ class MapBranch:
 
 @dataclass(frozen=True)
 class BifurcationCurve:
-    """A bifurcation of the impact map followed in a second parameter: where it lies in the first
-    parameter at each value of the second.
+    """A bifurcation of a map followed in a second parameter: where it lies in the first parameter
+    at each value of the second.
 
     Attributes
     ----------
     kind : str
         One of :data:`BIFURCATION_KINDS`.
     param, second : str
-        The first parameter (where the point is located) and the second (the grid), each ``T``,
-        ``kappa`` or ``v``.
+        The first parameter (where the point is located) and the second (the grid).
     second_values : ndarray, shape (m,)
         The grid of the second parameter, in the order followed.
     values : ndarray, shape (m,)
         The first parameter at the bifurcation (NaN where it was lost).
-    plate : ndarray, shape (m, 2)
-        The orbit's ``(x2, x2dot)`` there (m, m/s; NaN where lost).
-    multipliers : ndarray, shape (m, 2), complex
+    plate : ndarray, shape (m, dim)
+        The orbit's state there (the plate's ``(x2, x2dot)``, m and m/s; NaN where lost).
+    multipliers : ndarray, shape (m, dim), complex
     bracket : ndarray, shape (m,)
         Each location's final bracket in the first parameter.
     message : str

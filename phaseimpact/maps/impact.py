@@ -26,7 +26,7 @@ import numpy as np
 from ..integrate import simulate
 from ..model import as_law
 from ..parameters import Parameters, is_number
-from .base import ImpactMap, MapFixedPoint, attracting_orbit_of, check_count, fixed_point, lyapunov
+from .base import ImpactMap, MapFixedPoint, attracting_orbit_of, check_count, check_samples, fixed_point, lyapunov
 
 __all__ = ["ModelImpactMap", "ImpactTrain", "impact_map", "impact_train", "map_fixed_point", "map_jacobian",
            "attracting_orbit", "lyapunov_exponent", "period_range", "check_period", "TRAIN_PARAMETERS",
@@ -136,6 +136,7 @@ class ModelImpactMap(ImpactMap):
     parameters = TRAIN_PARAMETERS
     structure_names = ("contacts", "stick phases", "overlaps")
     positive_parameters = ("T", "v")
+    states = "plate states (x2, x2dot)"
 
     def __init__(self, params: Parameters, law, period: float | None, rtol: float = 1e-10):
         self.params, self.law, self.period, self.rtol = params, as_law(law), period, rtol
@@ -607,7 +608,7 @@ def attracting_orbit(params: Parameters, law, period: float, samples, *, max_per
     >>> orbit.period_k, f"{min(orbit.multipliers.real):.3f}"
     (1, '-0.963')
     """
-    law = as_law(law)
+    samples = check_samples(ModelImpactMap(params, law, period, rtol), samples)
     period = check_period(period, params)
     return attracting_orbit_of(ModelImpactMap(params, law, period, rtol), samples, max_period=max_period)
 
