@@ -629,12 +629,12 @@ BASINS = ["basins", *HC_TRAIN, "--grid", "3", "--iterations", "20"]
     ([*BASINS, "--period", "1e-308"], "period = 1e-308 is out of range"),
 ], ids=lambda value: " ".join(value) if isinstance(value, list) else None)
 def test_train_family_inputs_named_before_any_work(args, message, tmp_path, monkeypatch):
-    import phaseimpact.train as train_module
+    import phaseimpact.maps.impact as impact_module
 
     def forbidden(*args, **kwargs):
         raise AssertionError("work started before the input was refused")
 
-    monkeypatch.setattr(train_module, "simulate", forbidden)
+    monkeypatch.setattr(impact_module, "simulate", forbidden)
     monkeypatch.chdir(tmp_path)
     code, out, err = run(args)
     lines = err.strip().splitlines()

@@ -13,7 +13,7 @@ ROOT = Path(__file__).resolve().parents[1]
 #: The layers below everything else.
 ENGINE = ("integrate", "model")
 #: What they may not import, at any depth ("" is the package face, ``phaseimpact/__init__.py``).
-ABOVE = ("", "continuation", "analysis", "archive", "cli", "plotting", "train")
+ABOVE = ("", "continuation", "analysis", "maps", "archive", "cli", "plotting", "train")
 
 
 def _module(package_root: Path, path: Path) -> str:
