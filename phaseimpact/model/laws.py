@@ -3,11 +3,11 @@ r"""Contact laws, each defined once (seed eq. 2 and 8; docs/physics.md §3).
 A law is one :class:`LawEntry` in :data:`REGISTRY`: its kernel form, its flags (unilateral,
 Filippov, runaway guard), its options, and the name, unit and exponent of its damping parameter.
 Nothing outside this module names a law: the kernels read the law's flags from its kernel code
-(:attr:`ContactLaw.code`, bits :data:`FILIPPOV`, :data:`UNILATERAL`, :data:`CLAMP`, :data:`MEMORY`) and its
-runaway guard from the packed coefficients; the command line, archives and plots take names and
-units from the entry. The kernels below (compiled with numba, callable from Python too) give
-the contact force ``P(delta, deltadot)``, its partial derivatives and the contact potential;
-the right-hand side, the Jacobian, the event functions and the energy ledger
+(:attr:`ContactLaw.code`, bits :data:`FILIPPOV`, :data:`UNILATERAL`, :data:`CLAMP`,
+:data:`MEMORY`) and its runaway guard from the packed coefficients; the command line, archives
+and plots take names and units from the entry. The kernels below (compiled with numba, callable
+from Python too) give the contact force ``P(delta, deltadot)``, its partial derivatives and the
+contact potential; the right-hand side, the Jacobian, the event functions and the energy ledger
 (:mod:`phaseimpact.model.rhs`) are composed from them, so a law's physics lives here only.
 
 ==========================  ===============================================================
@@ -222,9 +222,8 @@ def _native_partials(code, delta, deltadot, mode, K, damping, alpha):
             _native(address, int(D_RATE), delta, deltadot, mode, K, damping, alpha))
 
 
-# The branches of the laws added after the first ones call out-of-line kernels: the body of
-# contact_force and force_partials stays small enough for LLVM to inline them into the steppers'
-# stages (a Hunt-Crossley step evaluates the force 12 times).
+# The branches of the laws added after the first ones call out-of-line kernels (the inlining rule
+# of the module's guide): the steppers' stages inline contact_force and force_partials whole.
 @kernel(python=True)
 def contact_force(code, delta, deltadot, mode, K, damping, alpha):
     """Contact force ``P`` (N, positive pushing the bodies apart) while slipping or free.
