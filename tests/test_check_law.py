@@ -7,7 +7,6 @@ import json
 import os
 import subprocess
 import sys
-import textwrap
 import zipfile
 from pathlib import Path
 
@@ -223,24 +222,24 @@ def test_no_module_of_the_package_imports_tests_or_touches_sys_path():
 
 @pytest.mark.slow
 def test_check_law_from_a_built_wheel_runs_the_oracle(tmp_path):
-    """The wheel alone (no checkout on the path, run from elsewhere): the oracle check is there and
-    passes (before, an installed package skipped it: tests/oracle.py not found)."""
+    """The wheel installed by pip (offline, no checkout on the path) and its own ``phaseimpact``
+    command, run from elsewhere: the oracle check is there and passes (before, an installed
+    package skipped it: tests/oracle.py not found)."""
     code = f"from setuptools import build_meta as b; print(b.build_wheel({str(tmp_path)!r}))"
     built = subprocess.run([sys.executable, "-c", code], cwd=ROOT, capture_output=True, text=True, check=True)
     wheel = tmp_path / built.stdout.strip().splitlines()[-1]
     with zipfile.ZipFile(wheel) as whl:
         assert "phaseimpact/_oracle.py" in whl.namelist()
-        whl.extractall(tmp_path / "installed")
-    run = textwrap.dedent("""\
-        import sys
-        import phaseimpact
-        from phaseimpact.cli import main
-        print(phaseimpact.__file__, file=sys.stderr)
-        sys.exit(main(["check-law", "hunt-crossley", "--json"]))
-        """)
-    env = {**os.environ, "PYTHONPATH": str(tmp_path / "installed")}
-    done = subprocess.run([sys.executable, "-c", run], cwd=tmp_path, capture_output=True, text=True, env=env)
-    assert str(tmp_path / "installed" / "phaseimpact") in done.stderr
+    installed = tmp_path / "installed"
+    subprocess.run([sys.executable, "-m", "pip", "install", "--quiet", "--no-deps", "--no-index", "--target",
+                    str(installed), str(wheel)], check=True, capture_output=True)
+    command = installed / "bin" / "phaseimpact"  # the wheel's console script, run by this interpreter
+    env = {**os.environ, "PYTHONPATH": str(installed)}
+    where = subprocess.run([sys.executable, "-c", "import phaseimpact; print(phaseimpact.__file__)"], cwd=tmp_path,
+                           capture_output=True, text=True, env=env)
+    assert where.stdout.strip() == str(installed / "phaseimpact" / "__init__.py"), where.stdout + where.stderr
+    done = subprocess.run([sys.executable, str(command), "check-law", "hunt-crossley", "--json"], cwd=tmp_path,
+                          capture_output=True, text=True, env=env)
     assert done.returncode == 0, done.stdout[-2000:] + done.stderr[-2000:]
     checks_run = {c["check"]: c["passed"] for c in json.loads(done.stdout)["laws"][0]["checks"]}
     assert checks_run["oracle"] is True

@@ -3,11 +3,11 @@ r"""Contact laws, each defined once (seed eq. 2 and 8; docs/physics.md §3).
 A law is one :class:`LawEntry` in :data:`REGISTRY`: its kernel form, its flags (unilateral,
 Filippov, runaway guard), its options, and the name, unit and exponent of its damping parameter.
 Nothing outside this module names a law: the kernels read the law's flags from its kernel code
-(:attr:`ContactLaw.code`, bits :data:`FILIPPOV`, :data:`UNILATERAL`, :data:`CLAMP`) and its
-runaway guard from the packed coefficients; the command line, archives and plots take names and
-units from the entry. The kernels below (compiled with numba, callable from Python too) give
-the contact force ``P(delta, deltadot)``, its partial derivatives and the contact potential;
-the right-hand side, the Jacobian, the event functions and the energy ledger
+(:attr:`ContactLaw.code`, bits :data:`FILIPPOV`, :data:`UNILATERAL`, :data:`CLAMP`,
+:data:`MEMORY`) and its runaway guard from the packed coefficients; the command line, archives
+and plots take names and units from the entry. The kernels below (compiled with numba, callable
+from Python too) give the contact force ``P(delta, deltadot)``, its partial derivatives and the
+contact potential; the right-hand side, the Jacobian, the event functions and the energy ledger
 (:mod:`phaseimpact.model.rhs`) are composed from them, so a law's physics lives here only.
 
 ==========================  ===============================================================
@@ -25,6 +25,9 @@ the right-hand side, the Jacobian, the event functions and the energy ledger
                             a Filippov system. ``contact="printed"`` (default) reads
                             ``|delta|`` literally, so the law also acts in tension;
                             ``contact="unilateral"`` sets ``P = 0`` for ``delta <= 0``
+``thornton``                elastic-perfectly plastic sphere (Thornton 1997): Hertz to the
+                            yield indentation, then linear at the limiting pressure ``p_y``;
+                            unloading on Hertz with an enlarged radius (a law with memory)
 ==========================  ===============================================================
 
 Modes (``paper``): ``+1``/``-1`` while slipping with that sign of ``deltadot``, ``STUCK`` (0)
@@ -35,25 +38,42 @@ Adding a law
 ------------
 A law of your own needs no edit of the package: :func:`phaseimpact.define_law` takes plain
 Python functions and compiles them (:mod:`phaseimpact.model.userlaw`). To ship a law with the
-package, in this module only:
+package:
 
-1. Give its force a kernel form: a new constant next to :data:`ELASTIC` ... :data:`KUWABARA_KONO`
-   (below :data:`NATIVE`), or reuse a form whose force it shares (the restitution laws reuse
-   :data:`HUNT_CROSSLEY`).
+1. Give its force a kernel form: a new constant next to :data:`ELASTIC` ... :data:`THORNTON`
+   (below :data:`NATIVE`; :data:`FORM_MASK` leaves room for 15 shipped forms) and its entry in
+   :data:`FORMS` (its name, and the memory slots its kernels keep), or reuse a form whose force
+   it shares (the restitution laws reuse :data:`HUNT_CROSSLEY`). :func:`register` refuses a form
+   missing from :data:`FORMS`, and the kernels give NaN for a form without a branch: a law is
+   never computed with another law's force.
 2. Write the form's branch in :func:`contact_force`, :func:`force_partials` (exact partial
    derivatives, zero where ``P`` is 0) and, if its elastic term has a potential,
-   :func:`contact_potential` (a Filippov law has none). A branch reads the flags from ``code``:
-   :data:`UNILATERAL` (the kernels already return 0 for ``delta <= 0``), :data:`CLAMP`
-   (``P >= 0``), and the sign factor of a :data:`FILIPPOV` law from ``mode``. (A Filippov law
-   sticks while the required force stays within its force at rest, :func:`stick_bound`;
-   ``paper``'s is its elastic term ``K |delta|^alpha``: a new form gives its own there.)
-3. :func:`register` a :class:`LawEntry`: name, form, damping source (``"kappa"``,
-   ``"restitution"`` or None), the flags, the options it allows (``"clamp"``, ``"bilateral"``,
-   ``"contact"``), the damping's exponent ``damping_power(alpha)`` (its unit is
-   ``N s/m^damping_power``) and a description.
-4. Run ``phaseimpact check-law NAME`` and ``pytest tests/test_laws.py``: the conformance suite
-   (:func:`phaseimpact.checks.check_law`; partials against finite differences, the energy
-   ledger, momentum, agreement with the scipy oracle) picks it up from :func:`law_variants`.
+   :func:`contact_potential` (a Filippov law has none; a Filippov form also gives its force at
+   rest in :func:`stick_bound`: the stick holds while the required force stays within it). A
+   branch reads the flags from ``code``: :data:`UNILATERAL` (the kernels already return 0 for
+   ``delta <= 0``), :data:`CLAMP` (``P >= 0``), and the sign factor of a :data:`FILIPPOV` law
+   from ``mode``. A law with memory (:data:`MEMORY`, set from :attr:`LawEntry.memory`) writes its
+   branch in :func:`force_of`, :func:`partials_of` and :func:`remember` instead, reading its
+   state from the packed coefficients (its dent, if any, at ``DENT_``).
+   **Inlining rule:** the branch calls an out-of-line kernel of the form's own
+   (``_kuwabara_kono_force``, ``_thornton``), never writes the physics inline: the bodies of
+   :func:`contact_force` and :func:`force_partials` must stay small enough for LLVM to inline
+   them into the steppers' stages (a Hunt-Crossley step evaluates the force 12 times). Only the
+   first laws' one-line forms are inline.
+3. :func:`register` a :class:`LawEntry` (every field by keyword): name, form, damping source
+   (``"kappa"``, ``"restitution"`` or None), the flags, the options it allows (``"clamp"``,
+   ``"bilateral"``, ``"contact"``), the damping's exponent ``damping_power(alpha)`` (its unit is
+   ``N s/m^damping_power``), its own coefficients and memory, and a description.
+4. Check it: ``phaseimpact check-law NAME`` and ``pytest tests/test_laws.py``: the conformance
+   suite (:func:`phaseimpact.checks.check_law`; partials against finite differences, the energy
+   ledger, momentum, agreement with scipy and with the oracle, :mod:`phaseimpact._oracle`) runs
+   on every variant of :func:`law_variants`, so the new law is in it once registered. Add a test
+   module of its own against a known answer (a closed form or a published series:
+   ``tests/test_kuwabara_kono.py``, ``tests/test_thornton.py``).
+5. Document it: its row in the table above, docs/physics.md §3 (the force, its potential or why
+   it has none), docs/commands.md (the ``--law`` list and what it takes), the CHANGELOG's
+   "Unreleased" section; a law with memory or a new coefficient also docs/physics.md §4 (the
+   energy ledger) and the parameters it reads (:meth:`ContactLaw.coefficients`).
 
 The engine's compiled cache is keyed on a digest of these sources: the next run recompiles.
 """
@@ -77,10 +97,18 @@ __all__ = [
 
 # A kernel code is an integer (the compiled loop reads no strings): its low bits are the law's
 # flags, the next bits its form (which branch of the kernels computes the force) and, for a user
-# law, the bits above FORM the address of its compiled function (phaseimpact.model.userlaw).
-FILIPPOV, UNILATERAL, CLAMP = 1, 2, 4
-FORM_SHIFT, FORM_MASK, ADDRESS_SHIFT = 3, 7, 6
-ELASTIC, HUNT_CROSSLEY, PAPER, KUWABARA_KONO, THORNTON, NATIVE = 0, 1, 2, 3, 4, 7
+# law, the bits above FORM the address of its compiled function (phaseimpact.model.userlaw; a
+# user-space address has at most 48 bits, so the code stays within int64).
+FILIPPOV, UNILATERAL, CLAMP, MEMORY = 1, 2, 4, 8
+FORM_SHIFT, FORM_BITS = 4, 4
+FORM_MASK, ADDRESS_SHIFT = (1 << FORM_BITS) - 1, FORM_SHIFT + FORM_BITS
+ELASTIC, HUNT_CROSSLEY, PAPER, KUWABARA_KONO, THORNTON = 0, 1, 2, 3, 4
+NATIVE = FORM_MASK  # the last form: the shipped ones take 5, 6, ... below it
+#: The forms the kernels below have a branch for, by name, with the memory slots each form's memory
+#: branch keeps (:attr:`LawEntry.memory`). :func:`register` refuses a law of any other form, and
+#: the kernels give NaN for one: a form without its own branch never computes another law's force.
+FORMS = {ELASTIC: ("ELASTIC", 0), HUNT_CROSSLEY: ("HUNT_CROSSLEY", 0), PAPER: ("PAPER", 0),
+         KUWABARA_KONO: ("KUWABARA_KONO", 0), THORNTON: ("THORNTON", 3), NATIVE: ("NATIVE", 0)}
 # What a user law's compiled function returns (its first argument).
 FORCE, D_DELTA, D_RATE, POTENTIAL = 0, 1, 2, 3
 STUCK, PLAIN = 0, 2
@@ -100,10 +128,13 @@ GUARD_ENERGY_FACTOR = 100.0
 # The packed coefficients of one run (:func:`phaseimpact.model.rhs.pack`): the model's parameters,
 # the law's own coefficients (LAW_, N_LAW of them) and its memory (MEMORY_, N_MEMORY slots: what a
 # law keeps over a run, e.g. Thornton's largest indentation; 0 at the start, updated only by
-# :func:`remember`, in the run's own copy).
+# :func:`remember`, in the run's own copy). Every law with memory keeps its residual indentation
+# (its dent, 0 if it leaves none) in the last slot, DENT_: the contact events read it there
+# (:func:`contact_gap`, :func:`dent_depth`).
 M1_, M2_, K_, KB_, KM_, DAMP_, ALPHA_, SPRINGS_, RIGID_, GUARD_ = range(10)
 LAW_, N_LAW = 10, 2
 MEMORY_, N_MEMORY = LAW_ + N_LAW, 3
+DENT_ = MEMORY_ + N_MEMORY - 1
 N_COEF = MEMORY_ + N_MEMORY
 
 
@@ -191,9 +222,8 @@ def _native_partials(code, delta, deltadot, mode, K, damping, alpha):
             _native(address, int(D_RATE), delta, deltadot, mode, K, damping, alpha))
 
 
-# The branches of the laws added after the first ones call out-of-line kernels: the body of
-# contact_force and force_partials stays small enough for LLVM to inline them into the steppers'
-# stages (a Hunt-Crossley step evaluates the force 12 times).
+# The branches of the laws added after the first ones call out-of-line kernels (the inlining rule
+# of the module's guide): the steppers' stages inline contact_force and force_partials whole.
 @kernel(python=True)
 def contact_force(code, delta, deltadot, mode, K, damping, alpha):
     """Contact force ``P`` (N, positive pushing the bodies apart) while slipping or free.
@@ -216,9 +246,10 @@ def contact_force(code, delta, deltadot, mode, K, damping, alpha):
         return _kuwabara_kono_force(code, delta, deltadot, K, damping, alpha)
     if form == NATIVE:
         return _native(code >> ADDRESS_SHIFT, int(FORCE), delta, deltadot, mode, K, damping, alpha)
-    # paper (eq. 8)
-    sign = _sign(deltadot) if mode == PLAIN else float(mode)
-    return (K + damping * deltadot) * hertz_power(abs(delta), alpha) * sign
+    if form == PAPER:  # eq. 8
+        sign = _sign(deltadot) if mode == PLAIN else float(mode)
+        return (K + damping * deltadot) * hertz_power(abs(delta), alpha) * sign
+    return math.nan  # a form without a branch here (register refuses it): never another law's force
 
 
 @kernel(python=True)
@@ -243,29 +274,35 @@ def force_partials(code, delta, deltadot, mode, K, damping, alpha):
         return _kuwabara_kono_partials(code, delta, deltadot, K, damping, alpha, stiffness)
     if form == NATIVE:
         return _native_partials(code, delta, deltadot, mode, K, damping, alpha)
-    sign = _sign(deltadot) if mode == PLAIN else float(mode)
-    return sign * (K + damping * deltadot) * stiffness * _sign(delta), sign * damping * hertz_power(ad, alpha)
+    if form == PAPER:
+        sign = _sign(deltadot) if mode == PLAIN else float(mode)
+        return sign * (K + damping * deltadot) * stiffness * _sign(delta), sign * damping * hertz_power(ad, alpha)
+    return math.nan, math.nan
 
 
 @kernel(python=True)
 def contact_potential(code, delta, K, alpha):
-    """Potential of the elastic term, ``K |delta|^(alpha+1)/(alpha+1)`` (J), for the laws whose
-    elastic term is conservative; 0 for a Filippov law (``paper``), whose elastic term acts like
-    friction; a user law's own potential (0 if it gives none)."""
+    """Potential of the elastic term, ``K |delta|^(alpha+1)/(alpha+1)`` (J), for the forms whose
+    elastic term is ``K delta^alpha``; 0 for a Filippov law (``paper``), whose elastic term acts like
+    friction; a user law's own potential (0 if it gives none); NaN for any other form (a law with
+    memory: :func:`potential_of`)."""
     if (code & FILIPPOV) != 0:
         return 0.0
     if (code & UNILATERAL) != 0 and delta <= 0:
         return 0.0
-    if (code >> FORM_SHIFT) & FORM_MASK == NATIVE:
+    form = (code >> FORM_SHIFT) & FORM_MASK
+    if form == NATIVE:
         return _native(code >> ADDRESS_SHIFT, int(POTENTIAL), delta, 0.0, int(PLAIN), K, 0.0, alpha)
-    ad = abs(delta)
-    return K * ad * hertz_power(ad, alpha) / (alpha + 1.0)
+    if form == ELASTIC or form == HUNT_CROSSLEY or form == KUWABARA_KONO:
+        ad = abs(delta)
+        return K * ad * hertz_power(ad, alpha) / (alpha + 1.0)
+    return math.nan
 
 
 @kernel(python=True, inline="always")
 def has_memory(code):
-    """Whether the law keeps state over a run (:attr:`LawEntry.memory`; Thornton's form)."""
-    return (code >> FORM_SHIFT) & FORM_MASK == THORNTON
+    """Whether the law keeps state over a run (flag :data:`MEMORY`, set from :attr:`LawEntry.memory`)."""
+    return (code & MEMORY) != 0
 
 
 @kernel(python=True, inline="always")
@@ -279,7 +316,7 @@ def contact_gap(code, c, x1, x2):
     ``(x1 - x2) - delta_p`` its rounding left it +-1 ulp, and a restart just inside the force
     separated again at once, without end (issue 42)."""
     if has_memory(code):
-        return x1 - (x2 + c[MEMORY_ + 2])
+        return x1 - (x2 + c[DENT_])
     return x1 - x2
 
 
@@ -287,7 +324,7 @@ def contact_gap(code, c, x1, x2):
 def dent_depth(code, c):
     """The residual indentation ``delta_p`` of a law with memory, m (0 for other laws, and before the
     first yield): where :func:`contact_gap` is zero."""
-    return c[MEMORY_ + 2] if has_memory(code) else 0.0
+    return c[DENT_] if has_memory(code) else 0.0
 
 
 @kernel
@@ -306,7 +343,7 @@ def _thornton(c, delta):
     below the largest indentation so far (memory), else Hertz loading up to ``delta_y`` and a
     linear rise at the limiting pressure beyond (``dP = pi p_y R ddelta``)."""
     if delta < c[MEMORY_]:
-        depth = delta - c[MEMORY_ + 2]
+        depth = delta - c[DENT_]
         if depth <= 0:
             return 0.0, 0.0
         root = math.sqrt(depth)
@@ -319,41 +356,53 @@ def _thornton(c, delta):
     return f_y + slope * (delta - delta_y), slope
 
 
-@kernel(python=True)
-def remember(code, c, delta):
-    """A law's memory update at an extremum ``delta`` of the indentation (event ``REVERSAL``), in
-    the run's own coefficients ``c``; True if the memory changed (the run then restarts there, on
-    the law's new branch).
-
-    Thornton: a new largest indentation ``delta_max`` fixes the unloading curve, Hertz with the
-    radius ``R_p`` enlarged by the plastic flow, ``P = K_p (delta - delta_p)^(3/2)`` with
-    ``K_p = 4/3 E* sqrt(R_p)``, through ``(delta_max, P_max)``: ``R_p = 4 E* a_p^3 / (3 P_max)``,
-    ``a_p^2 = (2 P_max + F_y) / (2 pi p_y)`` (Thornton 1997, eq. 11-13); ``delta_p`` is the
-    residual indentation. Below ``delta_y`` it is Hertz itself (``K_p = K``, ``delta_p = 0``).
-    """
-    if not has_memory(code) or delta <= c[MEMORY_]:
+@kernel
+def _thornton_remember(c, delta):
+    """Thornton's memory update at an extremum ``delta``: a new largest indentation ``delta_max``
+    fixes the unloading curve, Hertz with the radius ``R_p`` enlarged by the plastic flow,
+    ``P = K_p (delta - delta_p)^(3/2)`` with ``K_p = 4/3 E* sqrt(R_p)``, through
+    ``(delta_max, P_max)``: ``R_p = 4 E* a_p^3 / (3 P_max)``, ``a_p^2 = (2 P_max + F_y) / (2 pi p_y)``
+    (Thornton 1997, eq. 11-13); ``delta_p`` is the residual indentation. Below ``delta_y`` it is
+    Hertz itself (``K_p = K``, ``delta_p = 0``)."""
+    if delta <= c[MEMORY_]:
         return False
     e_star, delta_y, f_y = _thornton_yield(c)
     c[MEMORY_] = delta
     if delta <= delta_y:
         c[MEMORY_ + 1] = c[K_]
-        c[MEMORY_ + 2] = 0.0
+        c[DENT_] = 0.0
         return True
     p_y = c[LAW_]
     f_max = f_y + math.pi * p_y * c[LAW_ + 1] * (delta - delta_y)
     a_p = math.sqrt((2.0 * f_max + f_y) / (2.0 * math.pi * p_y))
     k_p = 4.0 / 3.0 * e_star * math.sqrt(4.0 * e_star * a_p**3 / (3.0 * f_max))
     c[MEMORY_ + 1] = k_p
-    c[MEMORY_ + 2] = delta - (f_max / k_p) ** (2.0 / 3.0)
+    c[DENT_] = delta - (f_max / k_p) ** (2.0 / 3.0)
     return True
+
+
+@kernel(python=True)
+def remember(code, c, delta):
+    """A law's memory update at an extremum ``delta`` of the indentation (event ``REVERSAL``), in
+    the run's own coefficients ``c``; True if the memory changed (the run then restarts there, on
+    the law's new branch). False for a law without memory (or a form without a memory branch,
+    whose force is NaN: :func:`force_of`)."""
+    if not has_memory(code):
+        return False
+    if (code >> FORM_SHIFT) & FORM_MASK == THORNTON:
+        return _thornton_remember(c, delta)
+    return False
 
 
 @kernel(python=True, inline="always")
 def force_of(code, c, delta, deltadot, mode):
     """The contact force of a run with packed coefficients ``c`` (what the engine calls): the
-    law's :func:`contact_force`, or a law with memory read from ``c``."""
+    law's :func:`contact_force`, or a law with memory read from ``c`` (its form's memory branch;
+    NaN for a form without one)."""
     if has_memory(code):
-        return _thornton(c, delta)[0] if delta > 0 else 0.0
+        if (code >> FORM_SHIFT) & FORM_MASK == THORNTON:
+            return _thornton(c, delta)[0] if delta > 0 else 0.0
+        return math.nan
     return contact_force(code, delta, deltadot, mode, c[K_], c[DAMP_], c[ALPHA_])
 
 
@@ -361,7 +410,9 @@ def force_of(code, c, delta, deltadot, mode):
 def partials_of(code, c, delta, deltadot, mode):
     """``(dP/ddelta, dP/ddeltadot)`` of :func:`force_of`."""
     if has_memory(code):
-        return (_thornton(c, delta)[1] if delta > 0 else 0.0), 0.0
+        if (code >> FORM_SHIFT) & FORM_MASK == THORNTON:
+            return (_thornton(c, delta)[1] if delta > 0 else 0.0), 0.0
+        return math.nan, math.nan
     return force_partials(code, delta, deltadot, mode, c[K_], c[DAMP_], c[ALPHA_])
 
 
@@ -378,12 +429,16 @@ def potential_of(code, c, delta):
 def stick_bound(code, delta, K, damping, alpha):
     """The largest force a stuck Filippov contact gives at ``delta`` (N): ``|P(delta, 0)|``, the
     law's force at rest (``paper``: its elastic term ``K |delta|^alpha``). The stick holds while
-    the force that keeps the bodies together stays within it (docs/physics.md §5)."""
+    the force that keeps the bodies together stays within it (docs/physics.md §5); NaN for a form
+    that is not Filippov."""
     if (code & UNILATERAL) != 0 and delta <= 0:
         return 0.0
-    if (code >> FORM_SHIFT) & FORM_MASK == NATIVE:
+    form = (code >> FORM_SHIFT) & FORM_MASK
+    if form == NATIVE:
         return abs(_native(code >> ADDRESS_SHIFT, int(FORCE), delta, 0.0, int(STUCK_SIGN), K, damping, alpha))
-    return K * hertz_power(abs(delta), alpha)
+    if form == PAPER:
+        return K * hertz_power(abs(delta), alpha)
+    return math.nan
 
 
 def _number_text(x: float) -> str:
@@ -413,16 +468,16 @@ def _hertz_damping_power(alpha: float) -> float:
     return 1.0 + alpha
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, kw_only=True)
 class LawEntry:
-    """A registered contact law: everything the package knows about it.
+    """A registered contact law: everything the package knows about it (every field by keyword).
 
     Attributes
     ----------
     name : str
     form : int
-        Kernel form (:data:`ELASTIC`, :data:`HUNT_CROSSLEY`, :data:`PAPER`,
-        :data:`KUWABARA_KONO`, or :data:`NATIVE` for a user law).
+        Kernel form, one of :data:`FORMS` (:data:`ELASTIC`, :data:`HUNT_CROSSLEY`, :data:`PAPER`,
+        :data:`KUWABARA_KONO`, :data:`THORNTON`, or :data:`NATIVE` for a user law).
     damping : {None, "kappa", "restitution"}
         The law's one source of damping: the parameter ``kappa``, a coefficient of
         restitution, or none.
@@ -460,7 +515,8 @@ class LawEntry:
         :data:`LAW_`; it raises ``ValueError`` when ``params`` lack what the law needs.
     memory : int
         Slots of state the law keeps over a run (at most :data:`N_MEMORY`, at :data:`MEMORY_`,
-        0 at the start), updated by :func:`remember` at each extremum of ``delta``.
+        0 at the start), updated by :func:`remember` at each extremum of ``delta``: the number its
+        form's memory branch keeps (:data:`FORMS`); sets the law's flag :data:`MEMORY`.
     plastic : bool
         The contact yields (Thornton): pressure, contact radius and validity are read from the
         elastic-plastic model (:func:`phaseimpact.case.plastic_contact`), not from Hertz.
@@ -569,24 +625,39 @@ def register(entry: LawEntry) -> LawEntry:
 
     >>> from phaseimpact.model import REGISTRY, ContactLaw
     >>> from phaseimpact.model.laws import HUNT_CROSSLEY, LawEntry, register
-    >>> entry = register(LawEntry("example-hc", HUNT_CROSSLEY, "kappa", False, True, True,
-    ...                           description="Hunt-Crossley under another name"))
+    >>> entry = register(LawEntry(name="example-hc", form=HUNT_CROSSLEY, damping="kappa", filippov=False,
+    ...                           unilateral=True, conservative=True, description="Hunt-Crossley under another name"))
     >>> ContactLaw("example-hc").code == ContactLaw("hunt-crossley").code
     True
     >>> del REGISTRY["example-hc"]
+
+    Raises
+    ------
+    ValueError
+        For a form the kernels have no branch for (not in :data:`FORMS`), or a
+        :attr:`~LawEntry.memory` other than the one its form's memory branch keeps.
     """
+    form = FORMS.get(entry.form)
+    if form is None:
+        raise ValueError(f"law {entry.name!r}: form = {entry.form!r} has no kernels (a branch in contact_force and "
+                         "force_partials, phaseimpact/model/laws.py); allowed: "
+                         + ", ".join(f"{code} ({name})" for code, (name, _) in FORMS.items()))
+    if entry.memory != form[1]:
+        raise ValueError(f"law {entry.name!r}: memory = {entry.memory!r}, but the kernels of form {form[0]} keep "
+                         f"{form[1]} slot{'' if form[1] == 1 else 's'} of memory")
     REGISTRY[entry.name] = entry
     if "_named_law" in globals():
         _named_law.cache_clear()
     return entry
 
 
-register(LawEntry("abrate", ELASTIC, None, False, True, True, options=("bilateral",),
-                  description="Hertz contact, no damping (seed eq. 2)"))
-register(LawEntry("paper", PAPER, "kappa", True, False, False, options=("contact",),
-                  runaway_factor=RUNAWAY_ENERGY_FACTOR,
+register(LawEntry(name="abrate", form=ELASTIC, damping=None, filippov=False, unilateral=True, conservative=True,
+                  options=("bilateral",), description="Hertz contact, no damping (seed eq. 2)"))
+register(LawEntry(name="paper", form=PAPER, damping="kappa", filippov=True, unilateral=False, conservative=False,
+                  options=("contact",), runaway_factor=RUNAWAY_ENERGY_FACTOR,
                   description="eq. 8: (K + kappa deltadot) |delta|^alpha sgn(deltadot)"))
-register(LawEntry("hunt-crossley", HUNT_CROSSLEY, "kappa", False, True, True, options=("clamp",), inverse=True,
+register(LawEntry(name="hunt-crossley", form=HUNT_CROSSLEY, damping="kappa", filippov=False, unilateral=True,
+                  conservative=True, options=("clamp",), inverse=True,
                   description="(K + kappa deltadot) delta^alpha for delta > 0"))
 for _name, _chi, _text in (
     ("hunt-crossley-approx", lambda e: 1.5 * (1 - e), "chi = 3(1-e)/2"),
@@ -594,12 +665,12 @@ for _name, _chi, _text in (
     ("flores", lambda e: 1.6 * (1 - e) / e, "chi = 8(1-e)/(5e)"),
     ("gonthier", lambda e: (1 - e * e) / e, "chi = (1-e^2)/e"),
 ):
-    register(LawEntry(_name, HUNT_CROSSLEY, "restitution", False, True, True, chi=_chi, options=("clamp",),
+    register(LawEntry(name=_name, form=HUNT_CROSSLEY, damping="restitution", filippov=False, unilateral=True,
+                      conservative=True, chi=_chi, options=("clamp",),
                       description=f"K delta^alpha (1 + chi deltadot / v), {_text}"))
-register(LawEntry("kuwabara-kono", KUWABARA_KONO, "kappa", False, True, True, options=("clamp",),
-                  damping_name="gamma", damping_power=lambda alpha: alpha,
+register(LawEntry(name="kuwabara-kono", form=KUWABARA_KONO, damping="kappa", filippov=False, unilateral=True,
+                  conservative=True, options=("clamp",), damping_name="gamma", damping_power=lambda alpha: alpha,
                   description="K delta^alpha + gamma delta^(alpha-1) deltadot for delta > 0 (viscoelastic spheres)"))
-
 
 
 def _thornton_coefficients(params: Parameters) -> tuple:
@@ -614,8 +685,8 @@ def _thornton_coefficients(params: Parameters) -> tuple:
     return params.limiting_pressure, params.R
 
 
-register(LawEntry("thornton", THORNTON, None, False, True, False, coefficients=_thornton_coefficients, memory=3,
-                  plastic=True,
+register(LawEntry(name="thornton", form=THORNTON, damping=None, filippov=False, unilateral=True, conservative=False,
+                  coefficients=_thornton_coefficients, memory=3, plastic=True,
                   description="elastic-perfectly plastic sphere (Thornton 1997): Hertz to the yield indentation, then "
                               "linear at the limiting pressure p_y; Hertz unloading with the enlarged radius"))
 
@@ -708,6 +779,8 @@ class ContactLaw:
             flags |= UNILATERAL
         if self.clamp:
             flags |= CLAMP
+        if entry.memory:
+            flags |= MEMORY
         return flags
 
     @property

@@ -464,7 +464,8 @@ def _define(name: str, definition: dict, identity: str | None = None) -> LawEntr
                        identity or _source_digest(force, partials, potential, file_digest=file_digest),
                        {"force": force, "partials": partials, "potential": potential}, record, path, definition)
     power = (lambda alpha: 1.0 + alpha) if damping_power is None else (lambda alpha, p=float(damping_power): p)
-    entry = LawEntry(name, NATIVE, "kappa", filippov, unilateral, potential is not None,
+    entry = LawEntry(name=name, form=NATIVE, damping="kappa", filippov=filippov, unilateral=unilateral,
+                     conservative=potential is not None,
                      description=description or f"user law ({getattr(force, '__module__', '')}."
                                                 f"{getattr(force, '__name__', 'force')})",
                      damping_name=damping[0], damping_power=power, native=native,
