@@ -720,7 +720,6 @@ KILL = textwrap.dedent("""
     import importlib, os, signal, sys
     import numpy as np
     from phaseimpact import archive, seed_parameters
-from phaseimpact.archive import _digests
     from phaseimpact.continuation import atlas
 
     importlib.import_module("phaseimpact.continuation.sweep").CHUNK_THREADS = 5
