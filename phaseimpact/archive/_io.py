@@ -47,7 +47,8 @@ MapBranch or Basins
     Returns
     -------
     str
-        One of :data:`KINDS`, :data:`RUN_KINDS` or :data:`TRAIN_KINDS`.
+        One of :data:`KINDS`, :data:`RUN_KINDS` or :data:`TRAIN_KINDS` (or a kind added with
+        :func:`~phaseimpact.archive.register_kind`).
 
     Raises
     ------
