@@ -149,7 +149,7 @@ and object headers (attributes included) are checksummed; root attribute ``text_
 SHA-256 of the text attributes (HDF5 keeps them in its global heap, without a checksum); the chunk
 index (a v1 B-tree, without one) is checked on load. Fletcher-32 passes a chunk whose data and checksum
 were both zeroed or filled with 0xFF: root attribute ``data_sha256`` is the SHA-256 of each dataset's
-contents (:func:`_dataset_digest`), checked by :func:`load`; a file written before it, killed while a
+contents (:func:`._digests._dataset_digest`), checked by :func:`load`; a file written before it, killed while a
 checkpoint wrote in place, or copied by another netCDF writer (xarray), loads unverified by it.
 :func:`load` and :func:`describe` also check the
 content (codes within their tables, finite axes, scalar attributes; :func:`load`: a finite

@@ -78,12 +78,12 @@ _CHECKED = {"fletcher32": True}
 #: so that a newer HDF5 writes the same bytes. Not 1.10's format: its superblock marks the file open
 #: while a checkpoint writes in place, which refuses readers then and every open after a kill -9.
 #: What its metadata checksums leave out is checked on load: the chunk index (a v1 B-tree, see
-#: :func:`_check_storage`) and the global heap of variable-length strings (:data:`_TEXT_DIGEST`).
+#: :func:`._digests._check_storage`) and the global heap of variable-length strings (:data:`_TEXT_DIGEST`).
 _LIBVER = ("v108", "v108")
 #: Root attribute: SHA-256 of the file's text attributes, which HDF5 keeps in its global heap (no
 #: checksum there: a changed digit of the case JSON would load silently).
 _TEXT_DIGEST = "text_sha256"
-#: Root attribute: the SHA-256 of each dataset's contents (:func:`_dataset_digest`), JSON ``{path: hex}`` in a
+#: Root attribute: the SHA-256 of each dataset's contents (:func:`._digests._dataset_digest`), JSON ``{path: hex}`` in a
 #: fixed-length text, so that a checkpoint rewrites it in place. Fletcher-32 passes a chunk whose data and
 #: checksum were both zeroed or filled with 0xFF; this digest does not.
 _DATA_DIGEST = "data_sha256"

@@ -78,8 +78,8 @@ def _reserve(f, nbytes: int) -> None:
     HDF5 must never meet a full disk: a failed write leaves objects it can no longer close (their
     finalizers print a traceback each) and the interpreter's exit then crashes inside HDF5 (a
     segfault). Reserved first, a full disk is an ``OSError`` here, before HDF5 writes (and the file is
-    discarded: :func:`_write_file`). An archive built in memory (:func:`to_xarray`) has no disk to
-    reserve."""
+    discarded: :func:`._io._write_file`). An archive built in memory
+    (:func:`~phaseimpact.archive.to_xarray`) has no disk to reserve."""
     if f.driver == "fileobj":
         return
     fd = f.id.get_vfd_handle()

@@ -308,7 +308,7 @@ def _checked_header(f, path) -> int:
 def _check_law_defined(f, path: str) -> None:
     """Refuse, as what it is, an archive of a user law not defined in this process (not damage):
     its results need the law's entry (name, units). A case that records its law file defines it
-    (the file is run, as :func:`_base` would)."""
+    (the file is run, as :func:`._common._base` would)."""
     from ..model import LAWS
     from ..model import REGISTRY as DEFINED_LAWS
 
