@@ -15,3 +15,16 @@ def restored_registry():
         REGISTRY.clear()
         REGISTRY.update(before)
         laws._named_law.cache_clear()
+
+
+@contextlib.contextmanager
+def restored_archive_kinds():
+    """The archive kinds registered inside leave the archive registry with it."""
+    from phaseimpact.archive import REGISTRY as KINDS
+
+    before = dict(KINDS)
+    try:
+        yield
+    finally:
+        KINDS.clear()
+        KINDS.update(before)

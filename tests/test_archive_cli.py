@@ -16,6 +16,7 @@ import numpy as np
 import pytest
 
 from phaseimpact import _atomic, archive, seed_parameters
+from phaseimpact.archive import _common
 from phaseimpact.cli import main
 from phaseimpact.continuation import sweep
 from phaseimpact.model import ContactLaw
@@ -102,7 +103,7 @@ def test_numpy_scalars_are_stored_as_plain_numbers(tmp_path):
         assert type(stored["v"]) is float and stored["v"] == 1.0
         assert isinstance(f.attrs["t_end"], (float, np.floating))
     assert archive.load(path).t_end == pytest.approx(2e-3, rel=1e-6)
-    assert json.loads(archive._json({"a": np.float32(0.5), "b": np.int64(3), "c": np.arange(2)})) == \
+    assert json.loads(_common._json({"a": np.float32(0.5), "b": np.int64(3), "c": np.arange(2)})) == \
         {"a": 0.5, "b": 3, "c": [0, 1]}
 
 

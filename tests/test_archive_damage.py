@@ -18,6 +18,7 @@ import numpy as np
 import pytest
 
 from phaseimpact import archive, seed_parameters
+from phaseimpact.archive import _digests, _files, _io
 from phaseimpact.cli import main
 from phaseimpact.continuation import CriticalCurve, SweepResult, atlas, critical_curve, sweep
 from phaseimpact.integrate import OUTCOMES, STATUSES
@@ -56,7 +57,7 @@ def files(results, tmp_path_factory):
 @pytest.fixture(autouse=True)
 def no_retry_pauses(monkeypatch):
     """A read that fails a checksum is retried after pauses (a reader racing a checkpoint); not here."""
-    monkeypatch.setattr(archive, "_RETRY_PAUSES", ())
+    monkeypatch.setattr(_files, "_RETRY_PAUSES", ())
 
 
 def copy(src, dst) -> str:
@@ -126,8 +127,8 @@ def test_a_chunk_overwritten_with_0xff_is_refused_by_load_plot_and_resume(tmp_pa
 def test_a_checksum_failure_is_read_again_as_a_reader_may_race_a_checkpoint(monkeypatch, files):
     """A reader may catch a chunk while a checkpoint rewrites it in place: a checksum failure is read
     again (after a pause); damage on disk fails every time (the test above: refused)."""
-    monkeypatch.setattr(archive, "_RETRY_PAUSES", (0.0, 0.0))
-    real, calls = archive._load, []
+    monkeypatch.setattr(_files, "_RETRY_PAUSES", (0.0, 0.0))
+    real, calls = _io._load, []
 
     def torn_once(path):
         calls.append(path)
@@ -135,7 +136,7 @@ def test_a_checksum_failure_is_read_again_as_a_reader_may_race_a_checkpoint(monk
             raise archive.DamagedArchiveError(path, "variable status: checksum", checksum=True)
         return real(path)
 
-    monkeypatch.setattr(archive, "_load", torn_once)
+    monkeypatch.setattr(_io, "_load", torn_once)
     assert isinstance(archive.load(files["sweep"]), SweepResult) and len(calls) == 2
 
 
@@ -459,8 +460,8 @@ def test_the_digest_is_of_the_values_whatever_the_chunks_or_filters(tmp_path, fi
             else:
                 g.create_dataset(name, data=data)
     with h5py.File(other, "r") as g:
-        pieces = archive._file_pieces(g)
-    assert {name: archive._dataset_digest(*entry) for name, entry in pieces.items()} == stored
+        pieces = _digests._file_pieces(g)
+    assert {name: _digests._dataset_digest(*entry) for name, entry in pieces.items()} == stored
 
 
 def test_a_checkpoint_keeps_the_digests_true_and_a_killed_one_is_rewritten_whole(tmp_path, results, monkeypatch):

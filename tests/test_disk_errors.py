@@ -2,7 +2,7 @@
 complete checkpoint kept, no crash, no lock or temporary file left; non-regular files (FIFO,
 device) refused as ``--out`` and as an archive to read, exit 2, before any work.
 
-HDF5 never meets the full disk: :func:`phaseimpact.archive._reserve` allocates an archive's blocks
+HDF5 never meets the full disk: :func:`phaseimpact.archive._files._reserve` allocates an archive's blocks
 before HDF5 writes into them. HDF5 that met it (before this) left objects it could not close,
 printed a traceback from each finalizer and crashed when the interpreter exited (rc 139). The
 errors are injected here; a real 2 MiB tmpfs is used too where this process may mount one.
@@ -24,6 +24,7 @@ import pytest
 from _cli import run
 
 from phaseimpact import _atomic, archive, seed_parameters
+from phaseimpact.archive import _files
 from phaseimpact.continuation import sweep
 from phaseimpact.model import ContactLaw
 
@@ -50,7 +51,7 @@ def test_save_on_a_full_disk_names_the_path_and_keeps_the_previous_file(tmp_path
     path = tmp_path / "s.h5"
     archive.save(small_sweep, path)
     before = path.read_bytes()
-    monkeypatch.setattr(archive, "reserve", full_disk)
+    monkeypatch.setattr(_files, "reserve", full_disk)
     with pytest.raises(OSError) as raised:
         archive.save(small_sweep, path, force=True)
     assert raised.value.errno == errno.ENOSPC and raised.value.filename == str(path)
@@ -62,7 +63,7 @@ def test_reserving_changes_no_byte_of_an_archive(tmp_path, small_sweep, monkeypa
     monkeypatch.setenv("SOURCE_DATE_EPOCH", "1700000000")  # one time stamp, whatever second each is made in
     reserved = tmp_path / "reserved.h5"
     archive.save(small_sweep, reserved)
-    monkeypatch.setattr(archive, "reserve", lambda fd, end: None)
+    monkeypatch.setattr(_files, "reserve", lambda fd, end: None)
     plain = tmp_path / "plain.h5"
     archive.save(small_sweep, plain)
     assert reserved.read_bytes() == plain.read_bytes()
@@ -71,14 +72,14 @@ def test_reserving_changes_no_byte_of_an_archive(tmp_path, small_sweep, monkeypa
 def test_a_sweep_whose_disk_fills_after_its_first_checkpoint_exits_1_and_keeps_it(tmp_path, monkeypatch):
     monkeypatch.setattr(importlib.import_module("phaseimpact.continuation.sweep"), "CHUNK_THREADS", 4)
     path = tmp_path / "s.h5"
-    real = archive.reserve
+    real = _files.reserve
 
     def fills_once_the_archive_exists(fd, end):  # the first checkpoint fits, the final save does not
         if path.exists():
             full_disk()
         real(fd, end)
 
-    monkeypatch.setattr(archive, "reserve", fills_once_the_archive_exists)
+    monkeypatch.setattr(_files, "reserve", fills_once_the_archive_exists)
     code, _, err = run([*SWEEP, *kappas(40), "--jobs", "1", "--out", path])
     assert code == 1, err
     assert err.strip() == f"phaseimpact: error: [Errno 28] No space left on device: {str(path)!r}"
@@ -100,9 +101,9 @@ def test_an_hdf5_write_failure_reads_as_the_os_error():
     message = ("Unable to synchronously create dataset (file write failed: time = Wed Nov 25 00:37:42 2026\n, "
                "filename = '/tmp/full/.a.h5.12510-x3ss8twg.tmp', file descriptor = 6, errno = 28, error message = "
                "'No space left on device', buf = 0x55f33168d0f5, total write size = 6815)")
-    error = archive._as_disk_error(ValueError(message))
+    error = _files._as_disk_error(ValueError(message))
     assert isinstance(error, OSError) and error.errno == errno.ENOSPC
-    assert archive._as_disk_error(ValueError("Unable to synchronously open object (not found)")) is None
+    assert _files._as_disk_error(ValueError("Unable to synchronously open object (not found)")) is None
 
 
 # ------------------------------------------------------------------------------------------------
