@@ -32,6 +32,7 @@ MODULES = (
     "phaseimpact.parameters",
     "phaseimpact.case",
     "phaseimpact.model",
+    "phaseimpact.model.contact",
     "phaseimpact.model.laws",
     "phaseimpact.model.userlaw",
     "phaseimpact.model.restitution",
