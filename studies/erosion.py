@@ -20,10 +20,11 @@ import numpy as np
 from _plots import V_LABEL, claim, known, log_ticks, loglog_fit
 
 from phaseimpact import simulate_many
+from phaseimpact._figure_data import save_h5
 from phaseimpact.case import list_cases, load_case
 from phaseimpact.model.contact import CONTACT_RATIO_LIMIT, hertz_contact, hertz_scales, validity
 from phaseimpact.parameters import FIRST_YIELD_FACTOR
-from phaseimpact.plotting import figure, save, save_h5, style
+from phaseimpact.plotting import figure, save, style
 
 FIGURES = Path(__file__).resolve().parents[1] / "figures"
 NAME = "erosion"

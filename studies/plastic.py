@@ -21,9 +21,10 @@ import numpy as np
 from _plots import claim, known, loglog_fit
 
 from phaseimpact import simulate_many
+from phaseimpact._figure_data import save_h5
 from phaseimpact.case import list_cases, load_case
 from phaseimpact.model.contact import plastic_validity
-from phaseimpact.plotting import figure, save, save_h5, style
+from phaseimpact.plotting import figure, save, style
 
 FIGURES = Path(__file__).resolve().parents[1] / "figures"
 NAME = "plastic"
