@@ -176,8 +176,8 @@ from dataclasses import dataclass
 import h5py
 import numpy as np
 
-from . import __version__
 from ._atomic import atomic_path, exclusive, fsync_file, release_reserve, reserve
+from ._version import __version__
 from .continuation import CriticalCurve, SweepResult, Transition
 from .continuation.grid import Axis, Grid
 from .continuation.sweep import ENGINE as _ENGINE

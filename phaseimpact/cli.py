@@ -28,8 +28,8 @@ import signal
 import sys
 import threading
 
-from . import __version__
 from ._atomic import check_target, exclusive
+from ._version import __version__
 from .case import QUANTITIES, SETTABLE, setting_name
 from .parameters import KAPPA_MAX, TARGETS, V_RANGE
 
