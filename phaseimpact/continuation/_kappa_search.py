@@ -10,8 +10,9 @@ from dataclasses import asdict, dataclass
 
 from ..parameters import KAPPA_MAX, Parameters, is_number
 
-__all__ = ["RunFailed", "Transition", "check_params", "check_kappa_range", "check_rtol_of_kappa",
-           "default_kappa_range", "A_MIN"]
+# check_params, check_rtol_of_kappa and default_kappa_range serve the searches and the command line,
+# not users: outside __all__, as they were in transition.py.
+__all__ = ["RunFailed", "Transition", "check_kappa_range", "A_MIN"]
 
 #: Lower end of the default search range, as a damping number ``a = kappa v / K``: below it the
 #: approach phase is undamped to 1e-8 (``delta*`` moves by ``O(a)``), so the margin cannot change

@@ -20,8 +20,7 @@ from ..parameters import Parameters
 from ._kappa_search import RunFailed, Transition, check_kappa_range, check_params, check_rtol_of_kappa
 from ._renamed import renamed_tolerances
 
-__all__ = ["SamplingWarning", "SAMPLES_RANGE", "check_samples", "delta_extremum", "extrema", "contact_count",
-           "grazing_transitions"]
+__all__ = ["SamplingWarning", "SAMPLES_RANGE", "check_samples", "delta_extremum", "extrema", "grazing_transitions"]
 
 _REVERSAL = EVENT_KINDS.index("reversal")
 #: Horizon of an extremum search, in plate periods: every contact of an impact happens within a
