@@ -163,26 +163,9 @@ def plot_atlas(result, *, contours: str | None = None, curves=()):
         ax.grid(False)
         present = {names[i] for i in np.unique(codes)}
         if contours:
-            count = np.asarray(result.values[contours], dtype=float).reshape(result.shape)
-            count[result.status.reshape(result.shape) != 0] = np.nan
-            finite = count[np.isfinite(count)]
-            if finite.size and finite.max() > finite.min() and min(result.shape) >= 2:
-                low = int(finite.min())
-                levels = np.arange(low, min(int(finite.max()), low + 10)) + 0.5
-                lines = ax.contour(ax0.values, ax1.values, count.T, levels=levels, colors="k", linewidths=0.8)
-                ax.clabel(lines, fmt=lambda x: f"{int(x - 0.5)}|{int(x + 0.5)}", fontsize=MIN_TEXT_PT)
-            label = "stick phases" if contours == "n_stick" else "contacts"
-            ax.plot([], [], "k-", lw=0.8, label=f"{label}: n|n+1")
+            _draw_count_contours(ax, result, contours)
         for i, curve in enumerate(curves):
-            keep = np.isfinite(curve.kappa)
-            x, y = (curve.kappa[keep], curve.values[keep]) if ax0.name == "kappa" else (curve.values[keep],
-                                                                                       curve.kappa[keep])
-            ax.plot(x, y, color="k" if i == 0 else f"C{i}", lw=1.6, label=f"{_what_label(curve)} (continued)")
-            closed = np.isfinite(curve.closed_form)
-            if np.any(closed):
-                cx, cy = ((curve.closed_form[closed], curve.values[closed]) if ax0.name == "kappa"
-                          else (curve.values[closed], curve.closed_form[closed]))
-                ax.plot(cx, cy, color="w", ls="--", lw=1.0, label=r"closed-form $\kappa_c$")
+            _draw_curve(ax, curve, i, kappa_across=ax0.name == "kappa")
         boundaries = result.extras.get("boundaries")
         if boundaries is not None and len(boundaries["points"]):
             points = np.asarray(boundaries["points"], dtype=float)
@@ -197,6 +180,35 @@ def plot_atlas(result, *, contours: str | None = None, curves=()):
                      f"{result.shape[0]} x {result.shape[1]} points{partial}")
     return fig
 
+
+
+def _draw_count_contours(ax, result, contours: str) -> None:
+    """Contours between successive counts ``n|n+1`` of the column ``contours`` (failed points left
+    out; at most ten levels from the lowest count), and their legend entry."""
+    ax0, ax1 = result.grid.axes
+    count = np.asarray(result.values[contours], dtype=float).reshape(result.shape)
+    count[result.status.reshape(result.shape) != 0] = np.nan
+    finite = count[np.isfinite(count)]
+    if finite.size and finite.max() > finite.min() and min(result.shape) >= 2:
+        low = int(finite.min())
+        levels = np.arange(low, min(int(finite.max()), low + 10)) + 0.5
+        lines = ax.contour(ax0.values, ax1.values, count.T, levels=levels, colors="k", linewidths=0.8)
+        ax.clabel(lines, fmt=lambda x: f"{int(x - 0.5)}|{int(x + 0.5)}", fontsize=MIN_TEXT_PT)
+    label = "stick phases" if contours == "n_stick" else "contacts"
+    ax.plot([], [], "k-", lw=0.8, label=f"{label}: n|n+1")
+
+
+def _draw_curve(ax, curve, i: int, kappa_across: bool) -> None:
+    """A continued curve over an atlas (the ``i``-th: black, then the colour cycle), with its closed
+    form where it has one; ``kappa_across``: kappa is the atlas's first (horizontal) axis."""
+    keep = np.isfinite(curve.kappa)
+    x, y = (curve.kappa[keep], curve.values[keep]) if kappa_across else (curve.values[keep], curve.kappa[keep])
+    ax.plot(x, y, color="k" if i == 0 else f"C{i}", lw=1.6, label=f"{_what_label(curve)} (continued)")
+    closed = np.isfinite(curve.closed_form)
+    if np.any(closed):
+        cx, cy = ((curve.closed_form[closed], curve.values[closed]) if kappa_across
+                  else (curve.values[closed], curve.closed_form[closed]))
+        ax.plot(cx, cy, color="w", ls="--", lw=1.0, label=r"closed-form $\kappa_c$")
 
 def plot_sweep(result):
     """A sweep (one axis): the long-time count (stick phases for ``paper``, contacts otherwise) and the
@@ -430,15 +442,11 @@ def plot_portraits(trajectories, plane=("delta", "deltadot"), *, summaries=None,
     ['1 stick phase, 1 contact (at least: cut)', '2 stick phases, 1 contact']
     >>> import matplotlib.pyplot as plt; plt.close(fig)
     """
-    from ..analysis import plane_coordinates
-
     plane = tuple(plane)
     summaries = trajectories if summaries is None else summaries
     n = len(trajectories)
     ncols = min(n, 2)  # two panels a row: each wide enough for its legend at the printed size
     nrows = -(-n // ncols)
-    names = {"delta": r"$\delta = x_1 - x_2$ (µm)", "deltadot": r"$\dot\delta$ (m/s)", "x1": "$x_1$ (µm)",
-             "x2": "$x_2$ (µm)", "x1dot": r"$\dot x_1$ (m/s)", "x2dot": r"$\dot x_2$ (m/s)"}
     with style():
         fig = plt.figure(figsize=(COLUMN_WIDTH if n == 1 else PAGE_WIDTH, 3.0 * nrows + 0.3 * bool(title)))
         # each panel spans two grid columns, so an odd last panel is centred rather than beside an empty slot
@@ -446,44 +454,62 @@ def plot_portraits(trajectories, plane=("delta", "deltadot"), *, summaries=None,
         for k, (tr, summary) in enumerate(zip(trajectories, summaries, strict=True)):
             row, col = divmod(k, ncols)
             first = 2 * col + (ncols - (n - row * ncols) if row == nrows - 1 else 0)
-            ax = fig.add_subplot(grid[row, first:first + 2])
-            a, b = plane_coordinates(tr.y, plane)
-            ax.plot(np.asarray(a) * UM, b, color="0.25", lw=0.8)
-            a0, b0 = plane_coordinates(summary.initial_state, plane)
-            ax.plot([a0 * UM], [b0], "ks", ms=3, label="start")
-            for kind, (marker, colour, label) in EVENT_MARKERS.items():
-                events = summary.events_of(kind)
-                if events:
-                    ea, eb = plane_coordinates(np.array([e.state for e in events]), plane)
-                    ax.plot(ea * UM, eb, ls="none", marker=marker, color=colour, ms=5, mew=1.0,
-                            label=f"{label} ({len(events)})")
-            _, delta, dwell = summary.stick_points()
-            if len(delta):
-                permanent = np.isinf(dwell)
-                if plane == ("delta", "deltadot"):
-                    pa, pb = delta, np.zeros_like(delta)
-                else:
-                    sticks = summary.events_of("stick")
-                    pa, pb = plane_coordinates(np.array([e.state for e in sticks]), plane)
-                if np.any(~permanent):
-                    ax.plot(pa[~permanent] * UM, pb[~permanent], ls="none", marker="o", mfc="none", mec="#4477aa",
-                            ms=6, mew=1.1, label=f"stick phase ({np.count_nonzero(~permanent)})")
-                if np.any(permanent):
-                    label = ("asymptotic point (permanent stick)" if plane == ("delta", "deltadot")
-                             else "permanent stick begins")
-                    ax.plot(pa[permanent] * UM, pb[permanent], ls="none", marker="*", color="#4477aa", ms=11,
-                            mec="k", mew=0.6, label=label)
-            ax.set_xlabel(names[plane[0]])
-            ax.set_ylabel(names[plane[1]])
-            kappa = summary.law.kappa(summary.params)
-            counts = (f"{summary.n_stick} stick phase{'s' if summary.n_stick != 1 else ''}, "
-                      f"{summary.n_contacts} contact{'s' if summary.n_contacts != 1 else ''}")
-            if summary.cut:
-                counts += " (at least: cut)"
-            if not summary.ok:
-                counts += f"; {summary.status}"
-            ax.set_title(rf"$\kappa$ = {kappa:.6g}: {summary.outcome}" + f"\n{counts}")
-            ax.legend(loc="best", frameon=True, framealpha=0.8, edgecolor="none")
+            _draw_portrait(fig.add_subplot(grid[row, first:first + 2]), tr, summary, plane)
         if title:
             fig.suptitle(title)
     return fig
+
+
+_PLANE_LABELS = {"delta": r"$\delta = x_1 - x_2$ (µm)", "deltadot": r"$\dot\delta$ (m/s)", "x1": "$x_1$ (µm)",
+                 "x2": "$x_2$ (µm)", "x1dot": r"$\dot x_1$ (m/s)", "x2dot": r"$\dot x_2$ (m/s)"}
+
+
+def _draw_portrait(ax, tr, summary, plane) -> None:
+    """One panel of :func:`plot_portraits`: the run ``tr`` in ``plane``, the events and stick phases
+    of ``summary``, a title with its outcome and counts, a legend."""
+    from ..analysis import plane_coordinates
+
+    a, b = plane_coordinates(tr.y, plane)
+    ax.plot(np.asarray(a) * UM, b, color="0.25", lw=0.8)
+    a0, b0 = plane_coordinates(summary.initial_state, plane)
+    ax.plot([a0 * UM], [b0], "ks", ms=3, label="start")
+    for kind, (marker, colour, label) in EVENT_MARKERS.items():
+        events = summary.events_of(kind)
+        if events:
+            ea, eb = plane_coordinates(np.array([e.state for e in events]), plane)
+            ax.plot(ea * UM, eb, ls="none", marker=marker, color=colour, ms=5, mew=1.0,
+                    label=f"{label} ({len(events)})")
+    _mark_stick_phases(ax, summary, plane, plane_coordinates)
+    ax.set_xlabel(_PLANE_LABELS[plane[0]])
+    ax.set_ylabel(_PLANE_LABELS[plane[1]])
+    kappa = summary.law.kappa(summary.params)
+    counts = (f"{summary.n_stick} stick phase{'s' if summary.n_stick != 1 else ''}, "
+              f"{summary.n_contacts} contact{'s' if summary.n_contacts != 1 else ''}")
+    if summary.cut:
+        counts += " (at least: cut)"
+    if not summary.ok:
+        counts += f"; {summary.status}"
+    ax.set_title(rf"$\kappa$ = {kappa:.6g}: {summary.outcome}" + f"\n{counts}")
+    ax.legend(loc="best", frameon=True, framealpha=0.8, edgecolor="none")
+
+
+def _mark_stick_phases(ax, summary, plane, plane_coordinates) -> None:
+    """Each stick phase where it starts, in the ``(delta, deltadot)`` plane at the point
+    ``(delta*, 0)`` it rests at: a filled star for a permanent stick, hollow circles for transient ones."""
+    _, delta, dwell = summary.stick_points()
+    if not len(delta):
+        return
+    permanent = np.isinf(dwell)
+    if plane == ("delta", "deltadot"):
+        pa, pb = delta, np.zeros_like(delta)
+    else:
+        sticks = summary.events_of("stick")
+        pa, pb = plane_coordinates(np.array([e.state for e in sticks]), plane)
+    if np.any(~permanent):
+        ax.plot(pa[~permanent] * UM, pb[~permanent], ls="none", marker="o", mfc="none", mec="#4477aa",
+                ms=6, mew=1.1, label=f"stick phase ({np.count_nonzero(~permanent)})")
+    if np.any(permanent):
+        label = ("asymptotic point (permanent stick)" if plane == ("delta", "deltadot")
+                 else "permanent stick begins")
+        ax.plot(pa[permanent] * UM, pb[permanent], ls="none", marker="*", color="#4477aa", ms=11,
+                mec="k", mew=0.6, label=label)
