@@ -29,6 +29,8 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from _common import emit, load, machine, save_section, save_targets, table, target  # noqa: E402
 
+import phaseimpact.continuation.grazing as grazing  # noqa: E402
+import phaseimpact.continuation.kappa_2 as kappa_2  # noqa: E402
 import phaseimpact.continuation.transition as transition  # noqa: E402
 from phaseimpact import seed_parameters, simulate_many  # noqa: E402
 from phaseimpact.continuation import critical_curve, critical_damping, grazing_transitions, locate_kappa_2  # noqa: E402
@@ -37,7 +39,10 @@ RTOL = 1e-10
 
 
 class Split:
-    """Wraps the ``simulate`` the transition module calls: time and count per kind of run."""
+    """Wraps the ``simulate`` the searches in kappa call (transition, kappa_2 and grazing modules): time and
+    count per kind of run."""
+
+    MODULES = (transition, kappa_2, grazing)
 
     def __init__(self):
         self.inner = transition.simulate
@@ -54,11 +59,13 @@ class Split:
             self.count[kind] = self.count.get(kind, 0) + 1
 
     def __enter__(self):
-        transition.simulate = self
+        for module in self.MODULES:
+            module.simulate = self
         return self
 
     def __exit__(self, *exc):
-        transition.simulate = self.inner
+        for module in self.MODULES:
+            module.simulate = self.inner
 
 
 def median_time(fn, repeats):

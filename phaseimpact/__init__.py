@@ -16,12 +16,10 @@ contact time 0.000108 s
 ('abrate', 'paper', 'hunt-crossley')
 """
 
-# First: phaseimpact._jit names its cache directory with it.
-__version__ = "0.2.0"
-
 from typing import TYPE_CHECKING
 
 from . import _environment, _lazy
+from ._version import __version__
 
 # NumPy's f2py reads SOURCE_DATE_EPOCH once, when it is first imported (SciPy and numba import it),
 # and crashes on a bad value; so an empty one is unset (it means unset) and a malformed one is hidden

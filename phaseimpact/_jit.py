@@ -104,7 +104,7 @@ def linked_only_requested() -> bool:
 # ------------------------------------------------------------------------------------------------
 
 def _version() -> str:
-    from . import __version__  # defined before anything else in phaseimpact/__init__.py
+    from ._version import __version__
 
     return __version__
 

@@ -28,8 +28,8 @@ import signal
 import sys
 import threading
 
-from . import __version__
 from ._atomic import check_target, exclusive
+from ._version import __version__
 from .case import QUANTITIES, SETTABLE, setting_name
 from .parameters import KAPPA_MAX, TARGETS, V_RANGE
 
@@ -670,7 +670,7 @@ PARAM_UNITS = {"M1": "kg", "M2": "kg", "K": "N/m^1.5", "Kb": "N/m", "Km": "N/m^3
 
 
 def cmd_params(args) -> int:
-    from .case import hertz_scales, validity
+    from .model.contact import hertz_scales, validity
 
     setup = _setup(args)
     p, case, law = setup.params, setup.case, setup.law
@@ -708,7 +708,7 @@ def cmd_params(args) -> int:
 def _contact_reading(trajectory, setup: Setup) -> dict:
     """Hertz contact radius and peak pressure at the run's largest force, and whether elastic Hertz
     contact holds there (null when the run has no finite force)."""
-    from .case import hertz_contact, plastic_contact, plastic_validity, validity_for_force
+    from .model.contact import hertz_contact, plastic_contact, plastic_validity, validity_for_force
 
     force = trajectory.max_force
     if not (isinstance(force, float) and math.isfinite(force)) or setup.params.R is None:

@@ -22,9 +22,10 @@ from _plots import KAPPA_LABEL, V_LABEL, claim, known, loglog_fit, save_archive
 from matplotlib.ticker import NullFormatter
 
 from phaseimpact import scales
+from phaseimpact.archive import save_h5
 from phaseimpact.case import apply_settings, load_case
 from phaseimpact.continuation import critical_curve, critical_damping
-from phaseimpact.plotting import figure, save, save_h5, style
+from phaseimpact.plotting import figure, save, style
 
 FIGURES = Path(__file__).resolve().parents[1] / "figures"
 NAME = "critical_surface"

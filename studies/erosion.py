@@ -20,16 +20,11 @@ import numpy as np
 from _plots import V_LABEL, claim, known, log_ticks, loglog_fit
 
 from phaseimpact import simulate_many
-from phaseimpact.case import (
-    CONTACT_RATIO_LIMIT,
-    FIRST_YIELD_FACTOR,
-    hertz_contact,
-    hertz_scales,
-    list_cases,
-    load_case,
-    validity,
-)
-from phaseimpact.plotting import figure, save, save_h5, style
+from phaseimpact.archive import save_h5
+from phaseimpact.case import list_cases, load_case
+from phaseimpact.model.contact import CONTACT_RATIO_LIMIT, hertz_contact, hertz_scales, validity
+from phaseimpact.parameters import FIRST_YIELD_FACTOR
+from phaseimpact.plotting import figure, save, style
 
 FIGURES = Path(__file__).resolve().parents[1] / "figures"
 NAME = "erosion"

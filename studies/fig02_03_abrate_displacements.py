@@ -10,7 +10,8 @@ from pathlib import Path
 import numpy as np
 
 from phaseimpact import ContactLaw, seed_parameters, simulate
-from phaseimpact.plotting import MS, UM, figure, plot_displacements, save, save_h5, style
+from phaseimpact.archive import save_h5
+from phaseimpact.plotting import MS, UM, figure, plot_displacements, save, style
 
 ROOT = Path(__file__).resolve().parents[1] / "figures"
 NAME = "fig02_03_abrate_displacements"

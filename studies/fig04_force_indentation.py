@@ -9,7 +9,8 @@ from pathlib import Path
 import numpy as np
 
 from phaseimpact import ContactLaw, seed_parameters, simulate
-from phaseimpact.plotting import COLUMN_WIDTH, UM, figure, plot_hysteresis, save, save_h5, style
+from phaseimpact.archive import save_h5
+from phaseimpact.plotting import COLUMN_WIDTH, UM, figure, plot_hysteresis, save, style
 from phaseimpact.quantities import impact_quantities
 
 ROOT = Path(__file__).resolve().parents[1] / "figures"

@@ -13,7 +13,8 @@ from pathlib import Path
 import numpy as np
 
 from phaseimpact import seed_parameters, simulate
-from phaseimpact.plotting import MS, UM, figure, plot_force, plot_hysteresis, save, save_h5, style
+from phaseimpact.archive import save_h5
+from phaseimpact.plotting import MS, UM, figure, plot_force, plot_hysteresis, save, style
 
 ROOT = Path(__file__).resolve().parents[1] / "figures"
 NAME = "fig06_08_damped"

@@ -17,8 +17,9 @@ import numpy as np
 from _plots import COUNT_ATOL, COUNT_RTOL, READINGS, claim, outcome_of
 
 from phaseimpact import seed_parameters, simulate
+from phaseimpact.archive import save_h5
 from phaseimpact.continuation import critical_damping
-from phaseimpact.plotting import MS, UM, figure, mark_points, save, save_h5, style
+from phaseimpact.plotting import MS, UM, figure, mark_points, save, style
 
 FIGURES = Path(__file__).resolve().parents[1] / "figures"
 NAME = "fig09_10_phase_diagrams"

@@ -23,8 +23,9 @@ from _plots import KAPPA_LABEL, V_LABEL, kappa_axis, save_archive
 from scipy.optimize import brentq
 
 from phaseimpact import seed_parameters
+from phaseimpact.archive import save_h5
 from phaseimpact.continuation import atlas, critical_curve, delta_extremum, sweep, transitions
-from phaseimpact.plotting import PAGE_WIDTH, UM, save, save_h5, style
+from phaseimpact.plotting import PAGE_WIDTH, UM, save, style
 
 FIGURES = Path(__file__).resolve().parents[1] / "figures"
 NAME = "grazing"

@@ -18,9 +18,10 @@ import numpy as np
 from _plots import READINGS, claim, log_ticks
 
 from phaseimpact import ContactLaw, seed_parameters, simulate
+from phaseimpact.archive import save_h5
 from phaseimpact.continuation import critical_damping, sweep
 from phaseimpact.model import hunt_crossley_restitution
-from phaseimpact.plotting import COLUMN_WIDTH, figure, save, save_h5, style
+from phaseimpact.plotting import COLUMN_WIDTH, figure, save, style
 
 RUNAWAY = 2  # index of "runaway" in the stop reasons
 

@@ -21,8 +21,10 @@ import numpy as np
 from _plots import claim, known, loglog_fit
 
 from phaseimpact import simulate_many
-from phaseimpact.case import list_cases, load_case, plastic_validity
-from phaseimpact.plotting import figure, save, save_h5, style
+from phaseimpact.archive import save_h5
+from phaseimpact.case import list_cases, load_case
+from phaseimpact.model.contact import plastic_validity
+from phaseimpact.plotting import figure, save, style
 
 FIGURES = Path(__file__).resolve().parents[1] / "figures"
 NAME = "plastic"

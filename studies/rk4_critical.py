@@ -19,8 +19,9 @@ from matplotlib.ticker import MaxNLocator
 
 from phaseimpact import seed_parameters, simulate
 from phaseimpact.analysis import find_asymptotic_points
+from phaseimpact.archive import save_h5
 from phaseimpact.continuation import critical_damping
-from phaseimpact.plotting import figure, save, save_h5, style
+from phaseimpact.plotting import figure, save, style
 
 FIGURES = Path(__file__).resolve().parents[1] / "figures"
 NAME = "rk4_critical"

@@ -19,8 +19,9 @@ import numpy as np
 from _plots import COUNT_ATOL, COUNT_RTOL, READINGS, claim, loglog_fit, missed_restick
 
 from phaseimpact import seed_parameters, simulate
+from phaseimpact.archive import save_h5
 from phaseimpact.continuation import critical_damping
-from phaseimpact.plotting import figure, save, save_h5, style
+from phaseimpact.plotting import figure, save, style
 
 FIGURES = Path(__file__).resolve().parents[1] / "figures"
 NAME = "staircase"

@@ -25,9 +25,10 @@ import numpy as np
 from _plots import claim, known
 
 from phaseimpact import seed_parameters
+from phaseimpact.archive import save_h5
 from phaseimpact.continuation._parallel import map_in_threads
 from phaseimpact.integrate import scales
-from phaseimpact.plotting import figure, save, save_h5, style
+from phaseimpact.plotting import figure, save, style
 from phaseimpact.train import attracting_orbit, impact_train, orbit_diagram
 
 FIGURES = Path(__file__).resolve().parents[1] / "figures"

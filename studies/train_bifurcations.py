@@ -27,6 +27,7 @@ import numpy as np
 from _plots import claim, known
 
 from phaseimpact import seed_parameters
+from phaseimpact.archive import save_h5
 from phaseimpact.integrate import scales
 from phaseimpact.plotting import (
     BIFURCATION_MARKERS,
@@ -35,7 +36,6 @@ from phaseimpact.plotting import (
     plot_bifurcation_curves,
     plot_map_branch,
     save,
-    save_h5,
     style,
 )
 from phaseimpact.train import basins, continue_map_bifurcation, continue_map_orbit, impact_train, orbit_diagram

@@ -20,12 +20,17 @@ MODULES = (
     "phaseimpact.continuation.sweep",
     "phaseimpact.continuation.grid",
     "phaseimpact.continuation.transition",
+    "phaseimpact.continuation.kappa_2",
+    "phaseimpact.continuation.grazing",
+    "phaseimpact.continuation._kappa_search",
     "phaseimpact.continuation.curve",
     "phaseimpact.continuation.boundary",
     "phaseimpact.continuation.confirm",
     "phaseimpact.archive",
     "phaseimpact.analysis",
-    "phaseimpact.plotting",
+    "phaseimpact.plotting._style",
+    "phaseimpact.plotting._results",
+    "phaseimpact.plotting._impact_map",
     "phaseimpact.quantities",
     "phaseimpact.train",
     "phaseimpact.maps",
@@ -39,6 +44,7 @@ MODULES = (
     "phaseimpact.parameters",
     "phaseimpact.case",
     "phaseimpact.model",
+    "phaseimpact.model.contact",
     "phaseimpact.model.laws",
     "phaseimpact.model.userlaw",
     "phaseimpact.model.restitution",
@@ -175,7 +181,7 @@ def test_public_objects_are_found():
     names = {name for name, _ in _public_objects()}
     for expected in ("phaseimpact.integrate.api.simulate", "phaseimpact.integrate.result.Trajectory",
                      "phaseimpact.continuation.sweep.atlas", "phaseimpact.archive.Checkpoint",
-                     "phaseimpact.plotting.style", "phaseimpact.quantities.impact_quantities"):
+                     "phaseimpact.plotting._style.style", "phaseimpact.quantities.impact_quantities"):
         assert expected in names
     assert len(names) > 60
 

@@ -13,8 +13,8 @@ import pytest
 from scipy.integrate import quad
 
 import phaseimpact as pi
-from phaseimpact.case import hertz_scales
 from phaseimpact.integrate.api import hertz_contact_time, scales
+from phaseimpact.model.contact import hertz_scales
 
 #: 2 tau, quoted in issue 23 and (as tau = 1.4716376...) in docs/physics.md §4.
 TWO_TAU_QUOTED = 2.943275

@@ -1,6 +1,11 @@
-"""The engine's layering: ``phaseimpact/integrate`` and ``phaseimpact/model`` import nothing above
-them (the analyses, the archive, the command line, plotting, the package's face) and no module of
-theirs is part of an import cycle. Read from the sources (``ast``), not by importing them."""
+"""The package's layering (docs/design.md, "Layers"): every module belongs to a declared layer, imports
+nothing from a layer above its own (at module level or inside a function), and no modules import
+each other in a cycle. Read from the sources (``ast``), not by importing them.
+
+A layer's unit is the first name under the package (``phaseimpact.integrate.api`` is in
+``integrate``), so ``archive`` and ``cli`` are units whether they are modules or packages; ``""`` is
+the package's face, ``phaseimpact/__init__.py``.
+"""
 
 from __future__ import annotations
 
@@ -10,10 +15,36 @@ from pathlib import Path
 import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
-#: The layers below everything else.
-ENGINE = ("integrate", "model")
-#: What they may not import, at any depth ("" is the package face, ``phaseimpact/__init__.py``).
-ABOVE = ("", "continuation", "analysis", "maps", "archive", "cli", "plotting", "train")
+
+#: The layers, bottom to top: a unit imports its own layer and those below, never one above.
+LAYERS = (
+    ("_environment", "_lazy", "_signals", "_atomic", "_version", "cases"),  # no import of the package
+    ("_jit",),  # the compiler's hooks and cache (the engine's sources import it)
+    ("parameters",),
+    ("model",),  # all physics: laws, equations of motion, restitution, contact mechanics
+    ("integrate", "_oracle"),  # trajectories (and the independent scipy oracle of the checks)
+    ("case",),  # case files and settings (read the laws' names)
+    ("analysis", "quantities", "checks"),  # one trajectory or one law at a time
+    ("continuation",),  # sweeps, atlases, transitions, curves (the only joblib/Dask importer)
+    ("maps", "train"),  # maps of a state to the next (ImpactMap), trains of impacts; train is the face
+    ("archive",),  # HDF5 / netCDF-4 (h5py), the studies' figure data included
+    ("plotting",),  # matplotlib
+    ("cli",),
+    ("", "_entry", "__main__"),  # the package's face and the entry points
+)
+
+#: Cycles through imports inside functions (a module-level cycle is never allowed) that are known and
+#: due to be broken, each with the edit that breaks it. An entry that no longer occurs fails the test.
+KNOWN_CYCLES = {
+    # Two cycles through model.laws, one component. (1) laws <-> restitution: ContactLaw's damping
+    # imports restitution.kappa_for_restitution, and restitution.attainable_restitution(name) looks
+    # the law's chi up in laws.REGISTRY; taking the chi itself (check_attainable passes
+    # law.entry.chi) drops restitution's import of laws. (2) laws <-> userlaw: ContactLaw.__setstate__
+    # imports userlaw.ensure_defined to define a user law in a worker; a recipe object of userlaw's
+    # whose unpickling calls ensure_defined (its __reduce__) drops laws' import of userlaw. Breaking
+    # one leaves the other: replace this entry by the cycle that remains.
+    ("phaseimpact.model.laws", "phaseimpact.model.restitution", "phaseimpact.model.userlaw"),
+}
 
 
 def _module(package_root: Path, path: Path) -> str:
@@ -47,33 +78,46 @@ def _imports(package_root: Path, path: Path) -> list[tuple[str, int, bool]]:
     return found
 
 
-def layering_errors(package_root: Path) -> list[str]:
-    """Upward imports from the engine's layers (any depth) and import cycles through them (imports
-    at module level: a function-level import runs after every module is loaded)."""
-    name = package_root.name
-    engine = tuple(f"{name}.{layer}" for layer in ENGINE)
-    above = tuple(f"{name}.{layer}".rstrip(".") for layer in ABOVE)
-    graph: dict[str, set[str]] = {}
+def _unit(module: str) -> str:
+    """The layer's unit of a module: the first name under the package, "" for the package itself."""
+    parts = module.split(".")
+    return parts[1] if len(parts) > 1 else ""
+
+
+def layering_errors(package_root: Path, layers=LAYERS, known_cycles=frozenset()) -> list[str]:
+    """Modules in no layer, imports from a layer above (module level or inside a function), cycles
+    through module-level imports, and cycles through any imports but ``known_cycles`` (each a sorted
+    tuple of the cycle's modules; one that no longer occurs is reported too)."""
+    level = {unit: i for i, names in enumerate(layers) for unit in names}
+    top_graph: dict[str, set[str]] = {}
+    any_graph: dict[str, set[str]] = {}
     errors = []
     for path in sorted(package_root.rglob("*.py")):
         module = _module(package_root, path)
-        graph[module] = set()
+        top_graph[module], any_graph[module] = set(), set()
+        if _unit(module) not in level:
+            errors.append(f"{path.relative_to(package_root.parent)}: {module} is in no layer")
+            continue
         for target, line, at_top in _imports(package_root, path):
+            any_graph[module].add(target)
             if at_top:
-                graph[module].add(target)
-            in_engine = any(module == e or module.startswith(e + ".") for e in engine)
-            upward = any(target == a if a == name else target == a or target.startswith(a + ".") for a in above)
-            if in_engine and upward:
-                errors.append(f"{path.relative_to(package_root.parent)}:{line}: {module} imports {target}, above it")
-    for cycle in _cycles(graph):
-        if any(m == e or m.startswith(e + ".") for m in cycle for e in engine):
-            errors.append("import cycle: " + " -> ".join([*cycle, cycle[0]]))
+                top_graph[module].add(target)
+            if level.get(_unit(target), -1) > level[_unit(module)]:
+                errors.append(f"{path.relative_to(package_root.parent)}:{line}: {module} imports {target}, "
+                              f"a layer above it")
+    for cycle in _cycles(top_graph):
+        errors.append("import cycle: " + " -> ".join([*cycle, cycle[0]]))
+    cycles = {tuple(cycle) for cycle in _cycles(any_graph)}
+    for cycle in sorted(cycles - set(known_cycles) - {tuple(c) for c in _cycles(top_graph)}):
+        errors.append("import cycle (inside functions): " + " -> ".join([*cycle, cycle[0]]))
+    for cycle in sorted(set(known_cycles) - cycles):
+        errors.append("known cycle no longer found (remove it from KNOWN_CYCLES): " + " -> ".join(cycle))
     return errors
 
 
 def _cycles(graph: dict[str, set[str]]) -> list[list[str]]:
-    """One cycle through each strongly connected component with more than one module (or a module
-    importing itself)."""
+    """The modules of each strongly connected component with more than one module (or a module
+    importing itself), sorted."""
     index, low, stack, on_stack, components = {}, {}, [], set(), []
 
     def visit(node):
@@ -105,8 +149,17 @@ def _cycles(graph: dict[str, set[str]]) -> list[list[str]]:
     return components
 
 
-def test_the_engine_imports_nothing_above_it_and_is_in_no_cycle():
-    assert layering_errors(ROOT / "phaseimpact") == []
+def test_the_package_imports_downwards_only_and_has_no_cycle():
+    assert layering_errors(ROOT / "phaseimpact", LAYERS, KNOWN_CYCLES) == []
+
+
+def test_every_declared_unit_exists():
+    """A layer naming a module that is gone would let its replacement go unchecked."""
+    for unit in (u for layer in LAYERS for u in layer if u):
+        assert (ROOT / "phaseimpact" / f"{unit}.py").is_file() or (ROOT / "phaseimpact" / unit).is_dir(), unit
+
+
+LAYERS_OF_TEST = (("_jit",), ("model",), ("integrate",), ("continuation",), ("cli",), ("",))
 
 
 def _package(tmp_path: Path, files: dict[str, str]) -> Path:
@@ -119,15 +172,32 @@ def _package(tmp_path: Path, files: dict[str, str]) -> Path:
 
 @pytest.mark.parametrize(("files", "expected"), [
     ({"cli.py": "", "integrate/api.py": "def f():\n    from ..cli import main\n"},
-     ["pkg/integrate/api.py:2: pkg.integrate.api imports pkg.cli, above it"]),
+     ["pkg/integrate/api.py:2: pkg.integrate.api imports pkg.cli, a layer above it"]),
     ({"integrate/api.py": "from .. import __version__\n"},
-     ["pkg/integrate/api.py:1: pkg.integrate.api imports pkg, above it"]),
+     ["pkg/integrate/api.py:1: pkg.integrate.api imports pkg, a layer above it"]),
     ({"continuation/__init__.py": "", "model/laws.py": "import pkg.continuation.branch\n"},
-     ["pkg/model/laws.py:1: pkg.model.laws imports pkg.continuation.branch, above it"]),
+     ["pkg/model/laws.py:1: pkg.model.laws imports pkg.continuation.branch, a layer above it"]),
+    ({"cli/__init__.py": "", "cli/run.py": "from ..continuation import sweep\n", "continuation/__init__.py": "",
+      "continuation/sweep.py": "from ..cli import run\n"},
+     ["pkg/continuation/sweep.py:1: pkg.continuation.sweep imports pkg.cli.run, a layer above it",
+      "import cycle: pkg.cli.run -> pkg.continuation.sweep -> pkg.cli.run"]),
     ({"model/laws.py": "from . import rhs\n", "model/rhs.py": "from .laws import force\n"},
      ["import cycle: pkg.model.laws -> pkg.model.rhs -> pkg.model.laws"]),
-    ({"model/laws.py": "def f():\n    from . import rhs\n", "model/rhs.py": "from .laws import force\n",
-      "_jit.py": "", "integrate/driver.py": "from .. import _jit\nfrom ..model import rhs\n"}, []),
-], ids=["nested-upward", "package-face", "absolute-upward", "cycle", "allowed"])
-def test_the_check_finds_upward_imports_and_cycles(tmp_path, files, expected):
-    assert layering_errors(_package(tmp_path, files)) == expected
+    ({"model/laws.py": "def f():\n    from . import rhs\n", "model/rhs.py": "from .laws import force\n"},
+     ["import cycle (inside functions): pkg.model.laws -> pkg.model.rhs -> pkg.model.laws"]),
+    ({"plotting.py": ""}, ["pkg/plotting.py: pkg.plotting is in no layer"]),
+    ({"_jit.py": "", "integrate/driver.py": "from .. import _jit\nfrom ..model import rhs\n", "model/rhs.py": "",
+      "cli.py": "from .integrate import driver\n"}, []),
+], ids=["nested-upward", "package-face", "absolute-upward", "package-to-package", "cycle", "cycle-in-function",
+        "undeclared", "allowed"])
+def test_the_check_finds_upward_imports_cycles_and_strays(tmp_path, files, expected):
+    assert layering_errors(_package(tmp_path, files), LAYERS_OF_TEST) == expected
+
+
+def test_a_known_cycle_is_allowed_until_it_is_gone(tmp_path):
+    files = {"model/laws.py": "def f():\n    from . import rhs\n", "model/rhs.py": "from .laws import force\n"}
+    known = {("pkg.model.laws", "pkg.model.rhs")}
+    assert layering_errors(_package(tmp_path, files), LAYERS_OF_TEST, known) == []
+    files["model/laws.py"] = ""
+    assert layering_errors(_package(tmp_path, files), LAYERS_OF_TEST, known) == [
+        "known cycle no longer found (remove it from KNOWN_CYCLES): pkg.model.laws -> pkg.model.rhs"]

@@ -18,9 +18,9 @@ import numpy as np
 import pytest
 
 from phaseimpact import archive, seed_parameters
+from phaseimpact.archive import save_h5
 from phaseimpact.continuation import sweep
 from phaseimpact.model import ContactLaw
-from phaseimpact.plotting import save_h5
 
 ROOT = Path(__file__).resolve().parents[1]
 

@@ -188,7 +188,8 @@ def erosion_slope(group, x, y, where=None):
 
 
 def sand_lep_radius_ratio():
-    from phaseimpact.case import hertz_scales, load_case
+    from phaseimpact.case import load_case
+    from phaseimpact.model.contact import hertz_scales
 
     c = load_case("sand-lep")
     return hertz_scales(c.parameters(), c.plate)["contact_radius"] / c.geometry.R1

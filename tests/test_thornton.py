@@ -7,10 +7,11 @@ import numpy as np
 import pytest
 
 from phaseimpact import ContactLaw, simulate, simulate_many
-from phaseimpact.case import hertz_scales, load_case, plastic_validity
+from phaseimpact.case import load_case
 from phaseimpact.cli import main
 from phaseimpact.continuation import Axis, atlas
 from phaseimpact.model import pack
+from phaseimpact.model.contact import hertz_scales, plastic_validity
 from phaseimpact.model.laws import DENT_, force_of, partials_of, remember
 from phaseimpact.parameters import FIRST_YIELD_FACTOR, STEEL, seed_parameters
 
@@ -25,7 +26,7 @@ def thornton_restitution(r):
 
 
 def test_the_yield_velocity_is_where_the_hertz_pressure_reaches_p_y():
-    """Two routes: the Hertz peak pressure of an impact at v_y (closed form, case.hertz_scales) is p_y;
+    """Two routes: the Hertz peak pressure of an impact at v_y (closed form, contact.hertz_scales) is p_y;
     and Thornton's sphere-on-a-wall form v_y = (pi^2/sqrt(40)) sqrt(p_y^5 / (E*^4 rho)) with E* from
     the materials (not from K) and m = M1 = 4/3 pi R^3 rho, here with R the effective radius."""
     v_y = RIGID.yield_velocity

@@ -20,7 +20,7 @@ from phaseimpact.continuation import (
     refine_boundaries,
     transitions,
 )
-from phaseimpact.continuation.transition import contact_count
+from phaseimpact.continuation.grazing import contact_count
 
 SEED = seed_parameters(v=1.0)
 

@@ -192,6 +192,7 @@ from ._common import (
     created_timestamp,
 )
 from ._common import CONVENTIONS as CONVENTIONS
+from ._figure_data import save_h5
 from ._grid import stick_phases
 from ._io import describe, kind_of, load, save, to_xarray
 from ._overwrite import check_overwrite, open_for_resume, same_work
@@ -201,7 +202,7 @@ __all__ = ["SCHEMA_VERSION", "KINDS", "TRAIN_KINDS", "RUN_KINDS", "TRANSITION_KI
            "CHUNK_POINTS", "Checkpoint", "save", "load", "describe", "same_work",
            "check_overwrite", "open_for_resume", "kind_of", "created_timestamp", "DamagedArchiveError", "to_xarray",
            "stick_phases", "unit_attributes", "ArchiveKind", "REGISTRY", "register_kind", "unregister_kind",
-           "record_named", "record_of"]
+           "record_named", "record_of", "save_h5"]
 
 for _name in __all__:  # the public face names them (reprs, pickles, help): phaseimpact.archive.save
     if callable(globals()[_name]):

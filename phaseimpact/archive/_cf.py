@@ -8,7 +8,7 @@ import re
 
 import numpy as np
 
-from .. import __version__
+from .._version import __version__
 from ..continuation.sweep import ENGINE as _ENGINE
 from ..model import ContactLaw
 from ._common import (

@@ -5,8 +5,9 @@ two-parameter continuation (:mod:`.curve`). Only :mod:`._parallel` knows about j
 Every name below is documented where it is defined: :mod:`.sweep` (:func:`sweep`, :func:`atlas`,
 :class:`SweepResult`), :mod:`.grid` (:class:`Axis`, :class:`Grid`, :func:`parse_axis`),
 :mod:`.boundary` (:func:`refine_boundaries`), :mod:`.transition` (:func:`critical_damping`,
-:func:`transitions`...), :mod:`.curve` (:func:`critical_curve`) and :mod:`.confirm`
-(:func:`confirmed_count`).
+:func:`transitions`...), :mod:`.kappa_2` (:func:`locate_kappa_2`, :func:`adding_sliding_exponents`),
+:mod:`.grazing` (:func:`grazing_transitions`, :func:`delta_extremum`), :mod:`.curve`
+(:func:`critical_curve`) and :mod:`.confirm` (:func:`confirmed_count`).
 
 Examples
 --------

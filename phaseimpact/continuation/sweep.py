@@ -16,7 +16,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from tqdm.auto import tqdm
 
-from .. import __version__
+from .._version import __version__
 from ..case import Case
 from ..integrate import driver as drv
 from ..integrate.api import check_bool, check_rtol, check_t_end, scales
