@@ -83,16 +83,10 @@ def _curve_values(args, setup: Setup):
     return param, values
 
 
-def run_critical_curve(args) -> int:
-    import numpy as np
-
-    from .. import archive
-    from ..continuation import critical_curve, transitions
-    from ..continuation.transition import RunFailed
-
-    setup = _setup(args)
-    law = setup.law
-    what = args.what
+def _check_what(args, setup: Setup) -> None:
+    """The options ``--what`` reads and refuses: kappa_c and kappa_2 are a Filippov law's, a grazing value a
+    unilateral law's on a plate, in a kappa range."""
+    law, what = setup.law, args.what
     if what in ("kappa_c", "kappa_2"):
         if not law.is_filippov:
             raise ValueError(f"what = {what!r} is out of range for law {law.name!r}; allowed: what kappa_c or "
@@ -117,6 +111,19 @@ def run_critical_curve(args) -> int:
             raise ValueError("kappa-min, kappa-max are required by what = 'grazing' (the range in which the first "
                              "grazing value is looked for); allowed: --kappa-min A --kappa-max B")
         _check_kappa_range(args)
+
+
+def run_critical_curve(args) -> int:
+    import numpy as np
+
+    from .. import archive
+    from ..continuation import critical_curve, transitions
+    from ..continuation.transition import RunFailed
+
+    setup = _setup(args)
+    law = setup.law
+    what = args.what
+    _check_what(args, setup)
     param, values = _curve_values(args, setup)
     out = args.out
     archive.created_timestamp()

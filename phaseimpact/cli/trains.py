@@ -31,14 +31,33 @@ from ._common import (
 )
 
 
+def _period_option(p, *, required: bool) -> None:
+    """``--period``: required by a train and basins; orbit-diagram and map-continuation take it unless the
+    axis is ``T``."""
+    help_ = ("time between arrivals, s, T > 0" if required
+             else "time between arrivals (s) when the axis is not T (default: none)")
+    p.add_argument("--period", type=_real("period", 0.0, None, low_open=True, unit="s"), required=required,
+                   default=None, metavar="T", help=help_)
+
+
+def _threads_option(p, what: str) -> None:
+    p.add_argument("--jobs", type=_integer("jobs", 1, MAX_JOBS), default=1,
+                   help=f"{what} computed side by side in threads (default: %(default)s)")
+
+
+def _figure_option(p, what: str) -> None:
+    p.add_argument("--out", type=_figure_path, default=None, metavar="FIG.png",
+                   help=f"also draw {what} into this figure, .png, .pdf or .svg (default: none)")
+    p.add_argument("--force", action="store_true", help="replace --out even if it is not a figure (default: refuse)")
+
+
 def add_train(p) -> None:
     options.case_options(p)
     options.law_options(p)
     options.speed(p)
     options.damping(p)
     options.target(p)
-    p.add_argument("--period", type=_real("period", 0.0, None, low_open=True, unit="s"), required=True, metavar="T",
-                   help="time between arrivals, s, T > 0")
+    _period_option(p, required=True)
     p.add_argument("--impacts", type=_integer("impacts", 1, 100_000), default=20,
                    help="number of impacts, 1 to 100000 (default: %(default)s)")
     p.add_argument("--fixed-point", action="store_true", help="also find the period-1 orbit and its multipliers")
@@ -54,18 +73,14 @@ def add_orbit_diagram(p) -> None:
     options.damping(p)
     options.target(p)
     options.axis_option(p, "the parameter varied and its values (s, N s/m^(1+alpha) or m/s; e.g. T=2e-3:8e-3:400)",
-                names="T, kappa, v", limit=MAX_CURVE_POINTS)
-    p.add_argument("--period", type=_real("period", 0.0, None, low_open=True, unit="s"), default=None, metavar="T",
-                   help="time between arrivals (s) when the axis is not T (default: none)")
+                        names="T, kappa, v", limit=MAX_CURVE_POINTS)
+    _period_option(p, required=False)
     p.add_argument("--transients", type=_integer("transients", 0, 100_000), default=200,
                    help="impacts dropped at each value (default: %(default)s)")
     p.add_argument("--samples", type=_integer("samples", 1, 100_000), default=50,
                    help="impacts kept at each value (default: %(default)s)")
-    p.add_argument("--jobs", type=_integer("jobs", 1, MAX_JOBS), default=1,
-                   help="values computed side by side in threads (default: %(default)s)")
-    p.add_argument("--out", type=_figure_path, default=None, metavar="FIG.png",
-                   help="also draw the diagram into this figure, .png, .pdf or .svg (default: none)")
-    p.add_argument("--force", action="store_true", help="replace --out even if it is not a figure (default: refuse)")
+    _threads_option(p, "values")
+    _figure_option(p, "the diagram")
     options.tolerance(p)
     options.json_option(p)
     options.train_archive_option(p, force=False)
@@ -78,10 +93,9 @@ def add_map_continuation(p) -> None:
     options.damping(p)
     options.target(p)
     options.axis_option(p, "the parameter varied, from START to STOP, the largest step along the branch the axis's "
-                "spacing (s, N s/m^(1+alpha) or m/s; e.g. T=0.99e-3:0.975e-3:6)", names="T, kappa, v",
-                limit=MAX_CURVE_POINTS)
-    p.add_argument("--period", type=_real("period", 0.0, None, low_open=True, unit="s"), default=None, metavar="T",
-                   help="time between arrivals (s) when the axis is not T (default: none)")
+                        "spacing (s, N s/m^(1+alpha) or m/s; e.g. T=0.99e-3:0.975e-3:6)", names="T, kappa, v",
+                        limit=MAX_CURVE_POINTS)
+    _period_option(p, required=False)
     p.add_argument("--k", type=_integer("k", 1, 64), default=1,
                    help="the orbit's period in impacts, 1 to 64 (default: %(default)s)")
     p.add_argument("--max-points", type=_integer("max-points", 3, 100_000), default=500,
@@ -102,8 +116,7 @@ def add_basins(p) -> None:
     options.speed(p)
     options.damping(p)
     options.target(p)
-    p.add_argument("--period", type=_real("period", 0.0, None, low_open=True, unit="s"), required=True, metavar="T",
-                   help="time between arrivals, s, T > 0")
+    _period_option(p, required=True)
     p.add_argument("--x2-max", type=_real("x2-max", 0.0, None, low_open=True, unit="m"), default=None,
                    metavar="X", help="initial positions from -X to X, m, X > 0 (default: 1.5 v / omega, omega = "
                                      "sqrt(Kb/M2): the plate's swing at speed v)")
@@ -115,11 +128,8 @@ def add_basins(p) -> None:
                    help="impacts at most from each state, 1 to 100000 (default: %(default)s)")
     p.add_argument("--max-period", type=_integer("max-period", 1, 64), default=16,
                    help="longest period recognised, 1 to 64 (default: %(default)s)")
-    p.add_argument("--jobs", type=_integer("jobs", 1, MAX_JOBS), default=1,
-                   help="initial states computed side by side in threads (default: %(default)s)")
-    p.add_argument("--out", type=_figure_path, default=None, metavar="FIG.png",
-                   help="also draw the basins into this figure, .png, .pdf or .svg (default: none)")
-    p.add_argument("--force", action="store_true", help="replace --out even if it is not a figure (default: refuse)")
+    _threads_option(p, "initial states")
+    _figure_option(p, "the basins")
     options.tolerance(p)
     options.json_option(p)
     options.train_archive_option(p, force=False)
