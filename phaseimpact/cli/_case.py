@@ -151,4 +151,3 @@ def _case_fields(setup: Setup) -> dict:
     law, p = setup.law, setup.params
     return {**_law_fields(setup), "v": p.v, "kappa": law.kappa(p), "kappa_unit": law.damping_unit(p.alpha),
             "target": p.target}
-

@@ -323,9 +323,7 @@ def _fmt(value, unit="", spec=".6g"):
     return f"{value:{spec}}{' ' + unit if unit else ''}"
 
 
-# ------------------------------------------------------------------------------------------------
-
-
+#: The unit of each quantity ``params`` prints (and of the parameter a critical curve runs over).
 PARAM_UNITS = {"M1": "kg", "M2": "kg", "K": "N/m^1.5", "Kb": "N/m", "Km": "N/m^3", "alpha": "",
                "v": "m/s", "R": "m", "contact_time": "s", "plate_period": "s", "indentation": "m", "peak_force": "N",
                "contact_radius": "m", "peak_pressure": "Pa", "first_yield_pressure": "Pa",
@@ -350,7 +348,6 @@ def _check_figure_target(path: str, force: bool) -> None:
     if not head.startswith(magic):
         raise ValueError(f"out = {path!r} exists and is not a {os.path.splitext(path)[1]} figure; refusing to "
                          "overwrite it (choose another path, or add --force to replace it)")
-
 
 
 def _one_axis(args, note=""):

@@ -175,4 +175,3 @@ def run_critical_curve(args) -> int:
               file=sys.stderr)
         return EXIT_FAILURE
     return EXIT_OK
-

@@ -191,7 +191,3 @@ def run_portrait(args) -> int:
               + "; drawn up to where it stopped", file=sys.stderr)
         return EXIT_FAILURE
     return EXIT_OK
-
-
-# ------------------------------------------------------------------------------------------------
-# Parser

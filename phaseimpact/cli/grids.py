@@ -262,7 +262,3 @@ def run_atlas(args) -> int:
         with exclusive(args.out, "out"):
             archive.save(result, args.out, force=True)  # the same work, with its boundaries
     return _finish_grid(args, result, setup)
-
-
-# ------------------------------------------------------------------------------------------------
-# Critical curves

@@ -439,4 +439,3 @@ def run_basins(args) -> int:
                   f"x2 = {a.plate[0, 0]:.6g} m, x2dot = {a.plate[0, 1]:.6g} m/s before its first impact")
         print(f"  no period within {args.iterations} impacts: {result.not_converged}; runs failed: {result.no_map}")
     return EXIT_FAILURE if result.no_map else EXIT_OK
-
