@@ -16,8 +16,12 @@ How to add a command
      stderr for a numerical failure). ``--json`` prints through ``_print_json(args, {...})``; add the
      command's keys to ``phaseimpact/schemas/cli-1.json`` (tests/test_json_schema.py checks each
      command that takes ``--json``).
+   - The module imports NumPy, the engine or the archive inside ``run_NAME``, not at its top: the
+     parser is built by every command, and those that integrate nothing start without them
+     (tests/test_cache.py).
 
-2. Add one :class:`Command` to :data:`COMMANDS`, where the command is to show in ``--help``:
+2. Add one :class:`Command` to :data:`COMMANDS` (and a new module to the imports below), where the
+   command is to show in ``--help``:
    its name, the two functions, a one-line ``help`` and a ``description``; ``integrates=False`` for a
    command that compiles and integrates nothing (it then starts without numba or SciPy).
 
