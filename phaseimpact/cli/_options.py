@@ -38,7 +38,7 @@ def _settable_help() -> str:
     return ", ".join(f"{name} ({unit})" if unit else name for name, (unit, _) in SETTABLE.items())
 
 
-class _Removed(argparse.Action):
+class Removed(argparse.Action):
     """An option of an earlier version: refused with the ``--axis`` that replaces it (hidden from the help)."""
 
     def __init__(self, option_strings, dest, example="kappa=1e9:1e14:50:log", **kwargs):

@@ -43,7 +43,7 @@ def add_critical_curve(p) -> None:
     options.axis_option(p, "the parameter the curve runs over and its values, increasing, in its SI unit (e.g. "
                         "v=0.5:10:20:log)", names=curve_params, limit=MAX_CURVE_POINTS)
     for removed in ("--param", "--values"):
-        p.add_argument(removed, action=options._Removed, example="v=0.5:10:20:log")
+        p.add_argument(removed, action=options.Removed, example="v=0.5:10:20:log")
     p.add_argument("--what", choices=CURVE_WHATS, default="kappa_c",
                    help="what is continued: kappa_c or kappa_2 (law paper), or grazing (a unilateral law: the first "
                         "grazing value in [KAPPA_MIN, KAPPA_MAX] at the first value) (default: %(default)s)")

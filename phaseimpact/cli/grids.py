@@ -35,7 +35,7 @@ def _add_grid(p, axis_help: str) -> None:
     options.target(p)
     options.axis_option(p, axis_help, repeat=True)
     for removed in ("--kappa-min", "--kappa-max", "--num", "--range"):
-        p.add_argument(removed, action=options._Removed)
+        p.add_argument(removed, action=options.Removed)
     p.add_argument("--refine", default=None, metavar="AXIS",
                    help="after the grid, locate every class boundary between neighbours along AXIS (one of the "
                         "--axis names) by bisection, to --refine-rtol, and store the boundary points in the "
