@@ -429,12 +429,12 @@ def test_portrait_writes_svg_and_refuses_other_formats_before_computing(tmp_path
     out = tmp_path / "p.svg"
     assert main(["portrait", "--kappa", "1e9", "--out", str(out)]) == 0
     assert out.read_bytes().startswith(b"<?xml")
-    from phaseimpact import cli
+    from phaseimpact.cli import figures
 
     def no_work(*args, **kwargs):
         raise AssertionError("computed before refusing the format")
 
-    monkeypatch.setattr(cli, "_portrait_runs", no_work)
+    monkeypatch.setattr(figures, "_portrait_runs", no_work)
     with pytest.raises(SystemExit) as exit_:
         main(["portrait", "--kappa", "1e9", "--out", str(tmp_path / "p.jpg")])
     assert exit_.value.code == 2

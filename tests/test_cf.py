@@ -39,7 +39,7 @@ KAPPA_VARIABLES = ("kappa", "closed_form", "predicted")
 
 
 def _boundaries(result):
-    """The extras ``phaseimpact atlas --refine kappa`` stores (phaseimpact/cli.py)."""
+    """The extras ``phaseimpact atlas --refine kappa`` stores (phaseimpact/cli/grids.py)."""
     found = refine_boundaries(result, "kappa", refine_rtol=1e-4)
     assert len(found) >= 1  # the atlas straddles kappa_c: there is a boundary to store
     return {"axis": found.axis, "points": found.points, "below": found.below, "above": found.above,

@@ -1,0 +1,7 @@
+"""``python -m phaseimpact.cli``: the console script ``phaseimpact``."""
+
+import sys
+
+from . import main
+
+sys.exit(main())
