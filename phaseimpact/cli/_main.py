@@ -99,6 +99,7 @@ def main(argv=None) -> int:
         parser = build_parser()
         args = parser.parse_args(parsed)
         args.argv = argv
+        args.parser = parser  # the completion script is written from the parser that read the command
         _law_of_files(args, law_files)
         if find(args.command).integrates:  # _signals imports numba (0.2 s): only where runs are stopped
             from .. import _signals

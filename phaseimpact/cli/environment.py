@@ -16,9 +16,7 @@ def add_completion(p) -> None:
 def run_completion(args) -> int:
     import shtab
 
-    from .commands import build_parser  # at run time: the table imports this module
-
-    parser = build_parser()
+    parser = args.parser
     preamble = _complete_values(parser)
     script = shtab.complete(parser, shell=args.shell, root_prefix="phaseimpact", preamble=preamble)
     if args.shell == "bash":
