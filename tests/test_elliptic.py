@@ -34,7 +34,7 @@ U = np.concatenate([np.linspace(-25.0, 25.0, 2001), RNG.uniform(-1e3, 1e3, 300),
 
 def ours_jacobi(u, m):
     out = np.empty((len(u), 4))
-    for i, (u_, m_) in enumerate(zip(u, m)):
+    for i, (u_, m_) in enumerate(zip(u, m, strict=True)):
         elliptic.jacobi(u_, m_, out[i])
     return out
 
@@ -116,7 +116,7 @@ def test_jacobi_identities():
     dn_residual = np.abs(dn * dn + m * sn * sn - 1.0)
     assert dn_residual.max() <= 64 * EPS  # m = 0.9, where dn < 1/2 comes from cn / cos(...): 29 ulp
     assert dn_residual[m <= 0.75].max() <= 2 * EPS
-    back = np.array([elliptic.first_kind(p, m_) for p, m_ in zip(phi, m)])
+    back = np.array([elliptic.first_kind(p, m_) for p, m_ in zip(phi, m, strict=True)])
     # F is ill-conditioned near odd multiples of pi/2 as m -> 1 (dF/dphi = 1/dn), and there the
     # amplitude's own error (Cephes' backward recurrence, asin near +-1) grows: 21 of these units
     # at m = 1 - 1e-9, below 3 up to m = 0.999
@@ -232,7 +232,7 @@ def test_the_same_functions_as_cuda_device_functions_in_the_simulator(tmp_path):
                           env=environment, capture_output=True, text=True, timeout=600)
     assert done.returncode == 0, done.stderr
     simulated = np.load(tmp_path / "out.npy")
-    cpu = np.column_stack([ours_jacobi(u, m), [elliptic.first_kind(p, m_) for p, m_ in zip(phi, m)],
+    cpu = np.column_stack([ours_jacobi(u, m), [elliptic.first_kind(p, m_) for p, m_ in zip(phi, m, strict=True)],
                            [elliptic.complete(m_) for m_ in m]])
     assert np.isfinite(cpu).all()
     np.testing.assert_array_equal(simulated, cpu)
