@@ -145,12 +145,14 @@ def test_complete_matches_scipy_within_4_ulp():
 
 def test_outside_the_domain_as_scipy():
     """jacobi: NaN for m outside [0, 1] or NaN; first_kind: NaN above m = 1, asinh(tan phi) at m = 1
-    and infinite from |phi| = pi/2; complete: infinite at 1, NaN above."""
+    and infinite from |phi| = pi/2, 2 K phi / pi for |phi| beyond 2^52 (infinite phi included), 0 at
+    m = -inf; complete: infinite at 1, NaN above."""
     out = np.empty(4)
     for m in (-0.5, 1.5, np.nan):
         elliptic.jacobi(0.7, m, out)
         assert np.isnan(out).all() and np.isnan(scipy.special.ellipj(0.7, m)).all()
-    for phi, m in [(0.3, 1.0), (-1.2, 1.0), (np.pi / 2, 1.0), (-2.0, 1.0), (0.3, 1.5), (np.nan, 0.3), (0.3, np.nan)]:
+    for phi, m in [(0.3, 1.0), (-1.2, 1.0), (np.pi / 2, 1.0), (-2.0, 1.0), (0.3, 1.5), (np.nan, 0.3), (0.3, np.nan),
+                   (np.inf, 0.3), (-np.inf, 0.3), (1e20, 0.5), (-1e300, -1.0), (2.0**52, 0.3), (1.0, -np.inf)]:
         np.testing.assert_allclose(elliptic.first_kind(phi, m), scipy.special.ellipkinc(phi, m), rtol=4 * EPS)
     for m in (1.0, 1.5, np.nan):
         np.testing.assert_equal(elliptic.complete(m), scipy.special.ellipk(m))

@@ -45,6 +45,8 @@ _CARLSON_SPREAD = (3.0 * _CARLSON_R) ** (-1.0 / 6.0)
 #: In :func:`complete` the AGM stops once ``|a - b| <= 1e-8 a``: the next mean is then exact to
 #: ``(a - b)^2 / (16 a) <= 1e-17 a``, below rounding.
 _AGM_GAP = 1e-8
+#: 2^52: every double from there on is a whole number, and no amplitude is reduced by pi.
+_WHOLE = 4503599627370496.0
 
 
 @kernel(python=True)
@@ -148,47 +150,53 @@ def jacobi(u, m, out):
 
 @kernel(python=True)
 def first_kind(phi, m):
-    """``F(phi | m)``, any real ``phi`` and ``m <= 1`` (NaN for ``m > 1`` or NaN)."""
+    """``F(phi | m)``, any ``phi`` and ``m <= 1`` (NaN for ``m > 1`` or NaN)."""
     if math.isnan(phi) or not m <= 1.0:
         return math.nan
     if m == 1.0:  # DLMF 19.6.8: the integral diverges at pi/2
         if abs(phi) >= 0.5 * math.pi:
             return math.inf  # of either sign of phi, as scipy's
         return math.asinh(math.tan(phi))
-    # F(r + n pi) = F(r) + 2 n K with r in [-pi/2, pi/2]
-    turns = math.floor(phi / math.pi + 0.5)
-    reduced = phi - turns * math.pi
-    sin_ = math.sin(reduced)
-    cos_ = math.cos(reduced)
-    x = cos_ * cos_
-    y = x + (1.0 - m) * sin_ * sin_  # 1 - m sin^2 without its cancellation near m = 1, phi = pi/2
-    z = 1.0
-    # Carlson's R_F(x, y, z) by duplication
-    mean0 = (x + y + z) / 3.0
-    dx0, dy0 = mean0 - x, mean0 - y
-    # the largest of |mean0 - x|, |mean0 - y|, |mean0 - z| (no max(): numba's CUDA target compiles
-    # it as a device function of its own, which needs a device present)
-    spread = abs(dx0) if abs(dx0) > abs(dy0) else abs(dy0)
-    spread = _CARLSON_SPREAD * (spread if spread > abs(mean0 - z) else abs(mean0 - z))
-    mean = mean0
-    scale = 1.0  # 4^-n
-    while scale * spread >= abs(mean):
-        root_x, root_y, root_z = math.sqrt(x), math.sqrt(y), math.sqrt(z)
-        lam = root_x * (root_y + root_z) + root_y * root_z
-        x = 0.25 * (x + lam)
-        y = 0.25 * (y + lam)
-        z = 0.25 * (z + lam)
-        mean = 0.25 * (mean + lam)
-        scale *= 0.25
-    dx = dx0 * scale / mean
-    dy = dy0 * scale / mean
-    dz = -(dx + dy)
-    e2 = dx * dy - dz * dz
-    e3 = dx * dy * dz
-    series = 1.0 - e2 / 10.0 + e3 / 14.0 + e2 * e2 / 24.0 - 3.0 * e2 * e3 / 44.0
-    value = sin_ * series / math.sqrt(mean)
-    if turns == 0.0:
-        return value
+    if m == -math.inf:
+        return 0.0
+    if not abs(phi) < _WHOLE:  # no reduction left to do: F = 2 K phi / pi to rounding (inf: inf)
+        turns = phi / math.pi
+        value = 0.0
+    else:
+        # F(r + n pi) = F(r) + 2 n K with r in [-pi/2, pi/2]
+        turns = float(math.floor(phi / math.pi + 0.5))
+        reduced = phi - turns * math.pi
+        sin_ = math.sin(reduced)
+        cos_ = math.cos(reduced)
+        x = cos_ * cos_
+        y = x + (1.0 - m) * sin_ * sin_  # 1 - m sin^2 without its cancellation near m = 1, phi = pi/2
+        z = 1.0
+        # Carlson's R_F(x, y, z) by duplication
+        mean0 = (x + y + z) / 3.0
+        dx0, dy0 = mean0 - x, mean0 - y
+        # the largest of |mean0 - x|, |mean0 - y|, |mean0 - z| (no max(): numba's CUDA target compiles
+        # it as a device function of its own, which needs a device present)
+        spread = abs(dx0) if abs(dx0) > abs(dy0) else abs(dy0)
+        spread = _CARLSON_SPREAD * (spread if spread > abs(mean0 - z) else abs(mean0 - z))
+        mean = mean0
+        scale = 1.0  # 4^-n
+        while scale * spread >= abs(mean):
+            root_x, root_y, root_z = math.sqrt(x), math.sqrt(y), math.sqrt(z)
+            lam = root_x * (root_y + root_z) + root_y * root_z
+            x = 0.25 * (x + lam)
+            y = 0.25 * (y + lam)
+            z = 0.25 * (z + lam)
+            mean = 0.25 * (mean + lam)
+            scale *= 0.25
+        dx = dx0 * scale / mean
+        dy = dy0 * scale / mean
+        dz = -(dx + dy)
+        e2 = dx * dy - dz * dz
+        e3 = dx * dy * dz
+        series = 1.0 - e2 / 10.0 + e3 / 14.0 + e2 * e2 / 24.0 - 3.0 * e2 * e3 / 44.0
+        value = sin_ * series / math.sqrt(mean)
+        if turns == 0.0:
+            return value
     # K(m) by the AGM, as in complete()
     a = 1.0
     b = math.sqrt(1.0 - m)
