@@ -11,7 +11,8 @@ of the caller's array) out, no allocation, no call into C or Python, only ``math
   order of operations, so that ``sn``, ``cn`` and ``phi`` round alike (bit-identical on the test
   grid). ``dn`` is taken from ``sqrt(1 - m sn^2)`` wherever that is at least 1/2, not from the
   quotient, which loses up to a few hundred ulp: the one deliberate difference from scipy.
-  ``0 <= m <= 1``; any other ``m`` gives NaN (scipy's too).
+  ``0 <= m <= 1``; any other ``m`` gives NaN (scipy's too), and so does ``|u| > 709`` for
+  ``m >= 1 - 1e-10``, where the series overflows (a series that holds within a quarter period).
 * :func:`first_kind` ``(phi, m)``: ``F(phi | m)``, by Carlson's symmetric integral
   ``F = sin(phi) R_F(cos^2 phi, 1 - m sin^2 phi, 1)`` (DLMF 19.25.5) for the amplitude reduced to
   ``[-pi/2, pi/2]`` (``F(phi + n pi) = F(phi) + 2 n K``, DLMF 19.2.10), ``R_F`` by duplication
@@ -66,6 +67,9 @@ def jacobi(u, m, out):
         out[3] = u - ai
         return
     if m >= 0.9999999999:  # A&S 16.15: first order in 1 - m
+        if abs(u) > 709.0:  # cosh, sinh, exp overflow (Python's math raises): NaN, as scipy's mostly is
+            out[0] = out[1] = out[2] = out[3] = math.nan
+            return
         ai = 0.25 * (1.0 - m)
         b = math.cosh(u)
         t = math.tanh(u)
