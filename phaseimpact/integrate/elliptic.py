@@ -5,12 +5,13 @@ of the caller's array) out, no allocation, no call into C or Python, only ``math
 * :func:`jacobi` ``(u, m, out)``: ``sn, cn, dn`` of ``(u | m)`` and the amplitude ``phi`` into
   ``out[:4]``. The arithmetic-geometric mean's descending Landen transformation and its backward
   recurrence for the amplitude (DLMF 22.20(ii); Abramowitz & Stegun 16.4), with the series near
-  ``m = 0`` and ``m = 1`` (A&S 16.13, 16.15) and ``dn`` recovered from ``sn`` where ``cn / cos`` of
-  the last two amplitudes' difference is small (after DLMF 22.20.5): the algorithm and the
-  branch points of Cephes' ``ellpj`` (S. L. Moshier), which scipy's ``ellipj`` calls, in the same
-  order of operations, so that ``sn``, ``cn`` and ``phi`` round alike (bit-identical on the test
-  grid). ``dn`` is taken from ``sqrt(1 - m sn^2)`` wherever that is at least 1/2, not from the
-  quotient, which loses up to a few hundred ulp: the one deliberate difference from scipy.
+  ``m = 0`` and ``m = 1`` (A&S 16.13, 16.15): the algorithm, branch points and order of operations
+  of Cephes' ``ellpj`` (S. L. Moshier), which scipy's ``ellipj`` calls, so that ``sn``, ``cn`` and
+  ``phi`` round alike (bit-identical on the test grid). ``dn`` is ``sqrt(1 - m sn^2)`` wherever
+  that is at least 1/2 (every ``u`` for ``m <= 3/4``), and Cephes' ``cn / cos(phi_1 - phi_0)``
+  (DLMF 22.20.5) elsewhere: the one deliberate difference from scipy, whose quotient is off by
+  7 to 9.5 ulp within a period where the square root is within 1.5 (their nome series), and
+  differs from it by up to 6.9e-14 for ``|u| <= 50`` (``benchmarks/elliptic.py``).
   ``0 <= m <= 1``; any other ``m`` gives NaN (scipy's too), and so does ``|u| > 709`` for
   ``m >= 1 - 1e-10``, where the series overflows (a series that holds within a quarter period).
 * :func:`first_kind` ``(phi, m)``: ``F(phi | m)``, by Carlson's symmetric integral
@@ -23,8 +24,8 @@ of the caller's array) out, no allocation, no call into C or Python, only ``math
 * :func:`complete` ``(m)``: ``K(m) = pi / (2 AGM(1, sqrt(1 - m)))`` (DLMF 19.8.5). Any ``m < 1``;
   infinity at ``m = 1``, NaN above it.
 
-``tests/test_elliptic.py`` checks them against scipy on a dense grid and runs them under numba's
-CUDA simulator; ``benchmarks/elliptic.py`` measures their errors and times beside scipy's C entry
+``tests/test_elliptic.py`` checks them against scipy on a dense grid, compiles them to PTX and runs
+them under numba's CUDA simulator; ``benchmarks/elliptic.py`` measures their errors and times beside scipy's C entry
 points as ``flight.py`` calls them.
 """
 
@@ -141,8 +142,8 @@ def jacobi(u, m, out):
     cn = math.cos(phi)
     # dn = sqrt(1 - m sn^2) wherever that is well conditioned (dn^2 >= 1/4: always for m <= 3/4);
     # Cephes takes it only where cn / cos(phi_1 - phi_0) (DLMF 22.20.5) divides by less than 0.1,
-    # and that quotient is off by up to ~300 ulp at |u| <= 25, 1e-11 at |u| = 1e4
-    # (tests/test_elliptic.py). Where dn is small (m -> 1, sn -> +-1) the quotient is the accurate one.
+    # a quotient whose error grows with |u| (the amplitudes' difference loses digits). Where dn is
+    # small (m -> 1, sn -> +-1) the quotient is the accurate one.
     square = 1.0 - m * sn * sn
     divisor = math.cos(phi - previous)
     dn = math.sqrt(square) if square >= 0.25 or abs(divisor) < 0.1 else cn / divisor
