@@ -22,7 +22,7 @@ NEEDED = ("phaseimpact", "tests", "studies", "docs", "benchmarks", "figures")
 #: test (its imports, fixtures and the package from the sdist; INSTEAD_OF_THE_FIRST where that one
 #: would compile the engine cold). Their other quick tests exercise the package, which the sdist
 #: carries file for file (NEEDED) and ``make test`` runs from the checkout: all of them again would
-#: add as long as the quick half of ``make test`` (minutes on 2 cores).
+#: nearly double ``make test`` (1499 of its 1544 tests are quick; this rule picks 248 of them).
 READS_THE_TREE = ("tests/test_figures.py", "tests/test_studies.py", "tests/test_statements.py", "tests/test_docs.py",
                   "tests/test_readme.py")
 #: A file whose first quick test compiles a whole cold engine session (minutes) runs this one instead.
