@@ -20,11 +20,15 @@ Two problems, one mechanism:
 
 A signal's byte is left in the pipe when it is acted on, so that every thread running compiled
 code sees it and stops; a later run that is woken by such an old byte (nothing :data:`deferred`)
-clears the pipe and runs again (:func:`check`).
+clears the pipe and runs again (:func:`check`). A worker thread whose work belongs to the stopped
+caller (a Dask task of an in-process cluster: :func:`stopping_with_the_caller`) must not run again:
+it would hold the cluster's shutdown for a whole chunk. Each signal acted on is therefore counted,
+and such a thread raises it instead when a signal was acted on since its work began.
 """
 
 from __future__ import annotations
 
+import contextlib
 import ctypes
 import os
 import signal
@@ -37,7 +41,8 @@ from numba import types
 from numba.core import cgutils, config
 from numba.extending import intrinsic
 
-__all__ = ["Terminated", "install", "install_command_line", "interrupted", "check", "exit_code", "deferred"]
+__all__ = ["Terminated", "install", "install_command_line", "interrupted", "check", "exit_code", "deferred",
+           "stopping_with_the_caller"]
 
 
 class Terminated(KeyboardInterrupt):
@@ -106,10 +111,38 @@ def _in_ignoring_context(frame) -> bool:
     return False
 
 
+#: Signals acted on (raised) in this process, and the last of them: see stopping_with_the_caller.
+_acted = [0, signal.SIGINT]
+_thread = threading.local()
+
+
 def _raise(signum: int):
     if signum == signal.SIGTERM:
         raise Terminated()
     raise KeyboardInterrupt()
+
+
+def _act(signum: int):
+    """Raise ``signum`` in this thread, counted; a byte goes back into the pipe so that a worker
+    thread that cleared it before this count (an old byte, it thought) is woken again."""
+    _acted[:] = [_acted[0] + 1, signum]
+    if _WRITE_FD >= 0:
+        try:
+            os.write(_WRITE_FD, b"\0")
+        except OSError:  # a full pipe holds bytes enough
+            pass
+    _raise(signum)
+
+
+@contextlib.contextmanager
+def stopping_with_the_caller():
+    """In a worker thread: a signal acted on while the block runs raises it here too (from
+    :func:`check`), instead of the run being repeated as after an old byte."""
+    _thread.since = _acted[0]
+    try:
+        yield
+    finally:
+        del _thread.since
 
 
 def handler(signum, frame):
@@ -118,7 +151,7 @@ def handler(signum, frame):
     if _in_ignoring_context(frame):
         deferred.append(signum)
         return
-    _raise(signum)
+    _act(signum)
 
 
 def _open_pipe() -> bool:
@@ -203,11 +236,15 @@ def check(woken: bool) -> None:
     """After a compiled run: raise the signal that arrived during it (deferred, see
     :func:`handler`). ``woken``: the run stopped because the pipe held a byte; if nothing is
     deferred, that byte is an old one (a signal already acted on): the pipe is cleared and the
-    caller runs again."""
+    caller runs again, unless a signal was acted on since a :func:`stopping_with_the_caller` block
+    of this thread began: it is raised here too."""
     if deferred:
         signum = signal.SIGTERM if signal.SIGTERM in deferred else deferred[0]
         deferred.clear()
-        _raise(signum)
+        _act(signum)
+    since = getattr(_thread, "since", None)
+    if woken and since is not None and _acted[0] != since:
+        _raise(_acted[1])
     if woken and _FD.value >= 0:
         _drain()
 

@@ -11,6 +11,11 @@ checkout stays clean). What is "the same within tolerance" (:func:`equivalent`):
   NaN where NaN; integers, strings and references equal; texts with numbers as for tables;
   attributes named ``*digest`` or ``*sha256``, ``created`` and ``history`` are not compared (they follow the
   data, or say when, not what).
+- Values that a study declares sensitive to last-bit differences: an archive whose attribute
+  ``last_bit_sensitive`` names a dataset and ``last_bit_mask`` a boolean dataset of the same shape
+  (why: ``last_bit_reason``) has that dataset compared only where the mask is false; the mask itself
+  is compared exactly. Where only masked values differ, the figures the archive names in ``drawn_in``
+  (paths under the target folder, drawn from those values) keep their committed files too.
 - Tables and other texts (``.md``, ``.txt``, ``.json``, ``.csv``): equal apart from numbers, each
   within ``RTOL`` relative, or printed with the same digits and one unit of the last apart (a
   rounding flip).
@@ -91,7 +96,13 @@ def _values_equivalent(old, new) -> bool:
     return old == new
 
 
-def _h5_equivalent(old_path: Path, new_path: Path) -> bool:
+def _declared(f, name: str) -> str:
+    value = f.attrs.get(name, "")
+    return value.decode() if isinstance(value, bytes) else str(value)
+
+
+def _h5_equivalent(old_path: Path, new_path: Path, masked: bool = True) -> bool:
+    """Equivalent archives; ``masked``: the declared last-bit-sensitive values are not compared."""
     import h5py
 
     def resolve(f, value):
@@ -116,6 +127,10 @@ def _h5_equivalent(old_path: Path, new_path: Path) -> bool:
         a, b = tree(old), tree(new)
         if a.keys() != b.keys():
             return False
+        sensitive, mask = _declared(new, "last_bit_sensitive"), _declared(new, "last_bit_mask")
+        unmasked = (np.logical_not(old[mask][()]) if masked and sensitive in a and mask in a
+                    and np.array_equal(old[mask][()], new[mask][()]) and old[mask].shape == old[sensitive].shape
+                    else None)
         for name, obj in a.items():
             other = b[name]
             if isinstance(obj, h5py.Dataset) != isinstance(other, h5py.Dataset):
@@ -130,9 +145,23 @@ def _h5_equivalent(old_path: Path, new_path: Path) -> bool:
                     if not _values_equivalent(np.asarray(resolve(old, obj[()]), dtype=object),
                                               np.asarray(resolve(new, other[()]), dtype=object)):
                         return False
+                elif name == sensitive and unmasked is not None:
+                    if not arrays_equivalent(obj[()][unmasked], other[()][unmasked]):
+                        return False
                 elif not arrays_equivalent(obj[()], other[()]):
                     return False
     return True
+
+
+def _drawn_in(path: Path) -> list[str]:
+    """The figures an archive says are drawn from its last-bit-sensitive values (``drawn_in``)."""
+    import h5py
+
+    try:
+        with h5py.File(path, "r") as f:
+            return _declared(f, "drawn_in").split() if _declared(f, "last_bit_sensitive") else []
+    except OSError:
+        return []
 
 
 def _png_equivalent(old_path: Path, new_path: Path) -> bool:
@@ -168,12 +197,18 @@ def settle(staging, target) -> list[str]:
     staging, target = Path(staging), Path(target)
     staged = sorted(p for p in staging.rglob("*") if p.is_file())
     replace = {}
+    kept_drawings = []
     for path in staged:
         relative = path.relative_to(staging)
         if path.suffix.lower() == ".pdf" and path.with_suffix(".png") in staged:
             continue  # decided with its PNG below
         old = target / relative
         replace[relative] = not old.exists() or not equivalent(old, path)
+        if not replace[relative] and path.suffix.lower() == ".h5" and not _h5_equivalent(old, path, masked=False):
+            kept_drawings.extend(Path(name) for name in _drawn_in(path))  # only its sensitive values moved
+    for relative in kept_drawings:
+        if relative in replace and (target / relative).exists():
+            replace[relative] = False
     for path in staged:
         relative = path.relative_to(staging)
         if path.suffix.lower() == ".pdf" and path.with_suffix(".png") in staged:

@@ -132,6 +132,57 @@ def test_settle_keeps_committed_bytes_within_tolerance_and_reports_the_rest(tmp_
     assert not staging.exists()
 
 
+def _chatter_counts(path: Path, counts, chatters=None) -> Path:
+    """An archive like rk4_critical's: counts whose chattering cells (the mask) are last-bit sensitive."""
+    counts = np.asarray(counts)
+    chatters = counts > 1 if chatters is None else np.asarray(chatters)
+    return save_h5(path, {"exact_count": (np.ones(len(counts), int), "1"), "rk4_count": (counts, "1"),
+                          "rk4_chatters": (chatters, "1")},
+                   {"last_bit_sensitive": "rk4_count", "last_bit_mask": "rk4_chatters", "drawn_in": "fig.png",
+                    "last_bit_reason": "a chattering run's count moves with last bits"})
+
+
+def test_declared_last_bit_sensitive_values_compared_by_their_mask(tmp_path):
+    """rk4_critical's chattering counts differ between machines (4 and 13 against 5 and 14): such
+    cells compare as chattering; the others and the mask itself exactly."""
+    old = _chatter_counts(tmp_path / "old.h5", [1, 4, 13, 1])
+    assert _settle.equivalent(old, _chatter_counts(tmp_path / "other.h5", [1, 5, 14, 1]))
+    assert not _settle.equivalent(old, _chatter_counts(tmp_path / "unmasked.h5", [2, 4, 13, 1], [False, True, True,
+                                                                                                   False]))
+    assert not _settle.equivalent(old, _chatter_counts(tmp_path / "stopped.h5", [1, 1, 13, 1]))  # the mask moved
+    undeclared = save_h5(tmp_path / "plain.h5", {"rk4_count": (np.array([1, 4, 13, 1]), "1")})
+    assert not _settle.equivalent(undeclared, save_h5(tmp_path / "plain2.h5", {"rk4_count": (np.array([1, 5, 14, 1]),
+                                                                                               "1")}))
+
+
+def test_a_figure_drawn_from_sensitive_values_follows_its_archive(tmp_path):
+    """Only masked values moved: the archive and its figure keep their committed bytes. The same
+    values with another figure (a change of style) replace the figure."""
+    target, staging = tmp_path / "figures", tmp_path / "staging"
+    for folder in (target, staging):
+        (folder / "data").mkdir(parents=True)
+    _chatter_counts(target / "data" / "c.h5", [1, 4, 13, 1])
+    _figure(target / "fig.png", 1.0)
+    _chatter_counts(staging / "data" / "c.h5", [1, 5, 14, 1])
+    _figure(staging / "fig.png", 1.2)  # drawn from the moved counts
+    committed = (target / "fig.png").read_bytes()
+    assert _settle.settle(staging, target) == []
+    assert (target / "fig.png").read_bytes() == committed
+    staging.mkdir()
+    (staging / "data").mkdir()
+    _chatter_counts(staging / "data" / "c.h5", [1, 4, 13, 1])
+    _figure(staging / "fig.png", 1.2)
+    assert _settle.settle(staging, target) == ["fig.png"]
+
+
+def test_rk4_critical_declares_its_sensitive_counts():
+    with h5py.File(ROOT / "figures" / "data" / "rk4_critical.h5", "r") as f:
+        assert f.attrs["last_bit_sensitive"] == "rk4_count" and f.attrs["last_bit_mask"] == "rk4_chatters"
+        counts, exact = f["rk4_count"][()], f["exact_count"][()]
+        np.testing.assert_array_equal(f["rk4_chatters"][()], counts > exact[None, :, None])
+        assert (ROOT / "figures" / f.attrs["drawn_in"]).exists()
+
+
 def test_makefile_reproduce_outside_a_git_checkout(tmp_path):
     """From `git archive HEAD | tar x` (no .git) the recipe set SOURCE_DATE_EPOCH to '' (git log printed
     nothing), on which NumPy crashed at import: it must pass a usable value or none."""

@@ -199,12 +199,15 @@ def test_library_ctrl_c_inside_a_compiled_run_raises_keyboard_interrupt_within_a
 class Command:
     """A command line in a subprocess whose stderr is a terminal; lines are timestamped."""
 
-    def __init__(self, argv, cwd):
+    def __init__(self, argv, cwd, group=False):
+        """``group``: the command leads a process group of its own and signals go to the whole group,
+        as a terminal's Ctrl-C reaches a foreground job's worker processes too."""
         master, slave = pty.openpty()
         self.lines: list[tuple[float, str]] = []
+        self.group = group
         self.proc = subprocess.Popen([sys.executable, "-m", "phaseimpact.cli", *map(str, argv)], cwd=cwd,
                                      stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=slave,
-                                     preexec_fn=_ctrl_c_as_in_a_terminal)
+                                     preexec_fn=_ctrl_c_as_in_a_terminal, start_new_session=group)
         os.close(slave)
         self._reader = threading.Thread(target=self._read, args=(master,), daemon=True)
         self._reader.start()
@@ -235,10 +238,18 @@ class Command:
     def signal_and_wait(self, signum, timeout=60):
         """Send ``signum``; returns (exit code, seconds to exit, stderr lines after the signal)."""
         sent = time.monotonic()
-        self.proc.send_signal(signum)
+        if self.group:
+            os.killpg(self.proc.pid, signum)
+        else:
+            self.proc.send_signal(signum)
         try:
             self.proc.wait(timeout)
         finally:
+            if self.group:
+                try:
+                    os.killpg(self.proc.pid, signal.SIGKILL)  # its workers too
+                except ProcessLookupError:
+                    pass
             self.proc.kill()
         took = time.monotonic() - sent
         self._reader.join(10)
@@ -307,6 +318,60 @@ def test_atlas_stops_with_the_resume_command_and_no_lock(tmp_path, warm, signum,
     assert sorted(p.name for p in tmp_path.iterdir()) == ["a.h5"]  # no lock, no temporary file
     done = archive.load(out).done
     assert 0 < np.count_nonzero(done) < done.size
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize(("backend", "signum", "code", "word"), [("dask", signal.SIGTERM, 143, "terminated (SIGTERM)"),
+                                                                 ("loky", signal.SIGINT, 130, "interrupted")])
+def test_a_sweep_on_worker_backends_stops_with_one_line_and_no_warnings(tmp_path, warm, backend, signum, code, word):
+    """Dask (an in-process cluster) after SIGTERM and joblib's worker processes after a terminal's
+    Ctrl-C (the whole process group): the resume line only; no CancelledError log, no warning of
+    cancelled tasks, no worker's traceback or leaked semaphores; the workers' chunks stop at their
+    next look instead of running again."""
+    out = tmp_path / "s.nc"
+    cmd = Command(["sweep", "--law", "paper", "--axis", "kappa=1e10:1e14:40000:log", "--backend", backend,
+                   "--jobs", "2", "--out", out], tmp_path, group=True)
+    deadline = time.monotonic() + 300
+    while not out.exists():  # the first checkpoint: chunks are running in the workers
+        assert cmd.proc.poll() is None and time.monotonic() < deadline, cmd.lines
+        time.sleep(0.05)
+    time.sleep(1.0)
+    returned, took, after = cmd.signal_and_wait(signum)
+    everything = "\n".join(line for _, line in cmd.lines)
+    assert returned == code and took < 10.0, everything
+    assert len(after) == 1 and after[0].startswith(f"phaseimpact: {word}; "), everything
+    assert after[0].endswith(" --resume"), everything
+    for noise in ("CancelledError", "Traceback", "leaked", "Warning", "warn", "cancelled"):
+        assert noise not in everything, everything
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["s.nc"]
+
+
+def test_a_worker_thread_of_a_stopped_caller_raises_instead_of_running_again(pipe):
+    """In a worker thread (a Dask task of an in-process cluster), a wake-up after a signal the main
+    thread acted on raises there; an old byte, acted on before the block began, repeats the run."""
+    import threading
+
+    outcome = {}
+
+    def worker(acted_before):
+        if acted_before:
+            with pytest.raises(KeyboardInterrupt):
+                _signals.handler(signal.SIGINT, None)  # acted on: counted, a byte in the pipe
+        with _signals.stopping_with_the_caller():
+            if not acted_before:
+                with pytest.raises(KeyboardInterrupt):
+                    _signals.handler(signal.SIGINT, None)  # as the main thread does, while the block runs
+            try:
+                _signals.check(True)
+                outcome[acted_before] = "runs again"
+            except KeyboardInterrupt:
+                outcome[acted_before] = "raised"
+
+    for acted_before in (False, True):
+        thread = threading.Thread(target=worker, args=(acted_before,))
+        thread.start()
+        thread.join()
+    assert outcome == {False: "raised", True: "runs again"}
 
 
 def test_ctrl_c_while_the_command_line_is_imported_ends_in_one_line(monkeypatch, capsys):

@@ -116,6 +116,13 @@ def h5(name: str, key: str):
         return f.attrs[key]
 
 
+def chattering_cell_kappa(counts_seen) -> float:
+    """rk4_critical: the kappa where h = 2e-7's counts at the two finer tolerances are one of ``counts_seen``."""
+    rows = h5("rk4_critical", "rk4_count")[list(h5("rk4_critical", "step")).index(2e-7)]
+    (i,) = [i for i, row in enumerate(rows) if tuple(int(c) for c in row[1:]) in counts_seen]
+    return float(h5("rk4_critical", "kappa")[i])
+
+
 def train_counts():
     """studies/train.py's classification: period-1 values, all values, period 2 to 8, none approached."""
     counts = list(ast.literal_eval(str(h5("train", "counts"))).values())
@@ -495,6 +502,8 @@ STATEMENTS = [
     Statement("studies/bifurcation.py", "the plastic stick dissipates {} mJ",
               lambda: at_exactly("bifurcation_printed", "kappa", "dissipated_energy", 1e9) * 1e3),
     Statement("studies/rk4_critical.py", "gives kappa_c = {} as the root", lambda: h5("rk4_critical", "kappa_c")),
+    Statement("studies/rk4_critical.py", "4 and 13 against 5 and 14 at kappa = {}, h = 2e-7",
+              lambda: chattering_cell_kappa(((4, 13), (5, 14)))),
     Statement("studies/critical_surface.py", "and reaches {} at R1 = 2 mm",
               lambda: h5("critical_surface", "R1_2mm_v1_kappa_c")),
     Statement("studies/critical_surface.py", "the closed form names the root ({} at R1 = 1 mm",

@@ -64,7 +64,7 @@ def test_a_dask_client_of_four_workers_keeps_them_all_busy():
         with distributed.get_task_stream(client) as stream:
             result = sweep(SEED, "paper", kappas, n_jobs=-1, backend="dask", scheduler=client)
         _same(sweep(SEED, "paper", kappas, n_jobs=2), result)
-        workers = {task["worker"] for task in stream.data if "_run_chunk" in task["key"]}
+        workers = {task["worker"] for task in stream.data if "_run_task" in task["key"]}
         assert len(workers) == 4, workers
         assert client.status == "running"  # not closed: it is the caller's
     with pytest.raises(ValueError, match="jobs = 0 is out of range; allowed: an integer 1..100000"):

@@ -176,6 +176,27 @@ def test_a_nan_law_from_python_names_the_law_and_delta():
     assert simulate(seed_parameters(kappa=1e4), "nan-deep").ok
 
 
+def test_a_finite_but_unphysical_force_names_the_law_and_delta_not_stiffness(capsys):
+    """A force of 1e300 N is finite, but no run can go on with it: the run ends naming the law, the
+    value and delta (it said "the step size collapsed (stiffness ...)")."""
+    from phaseimpact.model.userlaw import FORCE_LIMIT
+
+    assert FORCE_LIMIT < 1e300
+    define_law("huge-deep", lambda d, dd, K, k, a: 1e300 if d > 3e-5 else K * d ** a)
+    tr = simulate(seed_parameters(kappa=1e4), "huge-deep")
+    assert tr.status == "non-finite" and tr.outcome == "failed"
+    assert tr.message.startswith("law 'huge-deep': its force returned 1e+300 N, beyond the finite physical range "
+                                 f"|P| <= {FORCE_LIMIT:g} N, at delta = "), tr.message
+    assert float(tr.message.split("delta = ")[1].split(" m")[0]) > 3e-5
+    # the audit's law, 1e300 * delta, on the command line: one line with the same words
+    define_law("huge", lambda d, dd, K, k, a: 1e300 * d if d > 0 else 0.0)
+    assert main(["simulate", "--law", "huge", "--kappa", "1e4"]) == 1
+    lines = _said(capsys.readouterr().err)
+    assert len(lines) == 1 and "step size collapsed" not in lines[0], lines
+    assert lines[0].startswith("phaseimpact: numerical failure: non-finite: law 'huge': its force returned "), lines
+    assert "beyond the finite physical range" in lines[0]
+
+
 def test_a_sweep_of_a_raising_law_marks_only_its_points_non_finite():
     """A point whose law raised is ``non-finite``; its neighbour, which never reached the bad
     region, is a success (the law's one fault record is attributed run by run)."""

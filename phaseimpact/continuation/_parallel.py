@@ -14,10 +14,13 @@ from __future__ import annotations
 
 import asyncio
 import contextlib
+import logging
 import os
+import warnings
 
 import numpy as np
 
+from .. import _signals
 from ..integrate.api import run_batch
 
 __all__ = ["BACKENDS", "run_chunks", "check_jobs", "check_scheduler", "connect", "warm_workers", "tasks_in_flight",
@@ -95,7 +98,9 @@ def connect(scheduler, n_jobs: int):
         raise ValueError("backend = 'dask' needs dask.distributed: pip install 'phaseimpact[dask]'") from error
     if scheduler is None:
         threads = (os.cpu_count() or 1) if n_jobs == -1 else n_jobs
-        return Client(processes=False, n_workers=1, threads_per_worker=threads, dashboard_address=None), True
+        # the scheduler's HTTP server on a free port: its default, 8787, warns when another cluster has it
+        return Client(processes=False, n_workers=1, threads_per_worker=threads, dashboard_address="127.0.0.1:0",
+                      scheduler_kwargs={"dashboard": False}), True
     check_scheduler(scheduler)
     return Client(scheduler, timeout=CONNECT_TIMEOUT), True
 
@@ -133,6 +138,38 @@ def _run_chunk(batch, rtol, settle, stop_on, threads):
     return run_batch(batch, rtol=rtol, settle=settle, stop_on=stop_on, n_threads=threads)
 
 
+def _run_task(batch, rtol, settle, stop_on):
+    """A chunk as a worker's task (a joblib process or a Dask worker's thread). After Ctrl-C or
+    SIGTERM its run ends at once without running again (:func:`._signals.stopping_with_the_caller`)
+    and the task returns None, which nobody reads: the caller is stopping. A raised
+    ``KeyboardInterrupt`` would print a worker's traceback or break Dask's event loop."""
+    with _signals.stopping_with_the_caller():
+        try:
+            return _run_chunk(batch, rtol, settle, stop_on, 1)
+        except KeyboardInterrupt:
+            return None
+
+
+_END = object()
+#: What joblib and Dask say while a stopped run is torn down: the one line the caller prints is enough.
+_TEARDOWN_WARNING = r".*tasks which were still being processed by the workers have been cancelled"
+
+
+@contextlib.contextmanager
+def _quiet_teardown():
+    """joblib's warning on cancelled tasks and ``distributed``'s log of tasks that ended with
+    CancelledError, silenced while the work of a stopped caller is cancelled and its cluster closed."""
+    log = logging.getLogger("distributed")
+    level = log.level
+    log.setLevel(logging.CRITICAL)
+    try:
+        with warnings.catch_warnings():
+            warnings.filterwarnings("ignore", message=_TEARDOWN_WARNING, category=UserWarning)
+            yield
+    finally:
+        log.setLevel(level)
+
+
 def run_chunks(batches, *, rtol: float, settle: bool, stop_on, n_jobs: int, backend: str, scheduler=None):
     """Yield the :class:`~phaseimpact.integrate.Columns` of each batch, in order."""
     if backend == "threads":
@@ -142,6 +179,8 @@ def run_chunks(batches, *, rtol: float, settle: bool, stop_on, n_jobs: int, back
     import joblib
 
     client, owned = connect(scheduler, n_jobs) if backend == "dask" else (None, False)
+    results = None
+    stopped = False
     try:
         if client is not None:
             warm_workers(client)
@@ -150,10 +189,27 @@ def run_chunks(batches, *, rtol: float, settle: bool, stop_on, n_jobs: int, back
                    else contextlib.nullcontext())
         with context:
             parallel = joblib.Parallel(n_jobs=n_jobs, return_as="generator")
-            yield from parallel(joblib.delayed(_run_chunk)(b, rtol, settle, stop_on, 1) for b in batches)
+            results = parallel(joblib.delayed(_run_task)(b, rtol, settle, stop_on) for b in batches)
+            while True:
+                with warnings.catch_warnings():  # Ctrl-C in here: joblib cancels the tasks and warns of it
+                    warnings.filterwarnings("ignore", message=_TEARDOWN_WARNING, category=UserWarning)
+                    columns = next(results, _END)
+                if columns is _END:
+                    return
+                if columns is None:  # a worker stopped by a signal (a terminal's Ctrl-C reaches them all)
+                    # the last signal acted on here: a worker thread may have taken this thread's deferred
+                    # one (SIGTERM stays SIGTERM); Ctrl-C if none, a worker process's own
+                    _signals._raise(_signals._acted[1])
+                yield columns
+    except BaseException:  # Ctrl-C or SIGTERM here, or in the caller between two chunks
+        stopped = True
+        raise
     finally:
-        if owned:
-            client.close()
+        with _quiet_teardown() if stopped else contextlib.nullcontext():
+            if results is not None:
+                results.close()
+            if owned:
+                client.close()
 
 
 def map_in_threads(function, items, n_jobs: int) -> list:

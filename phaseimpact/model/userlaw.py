@@ -71,9 +71,13 @@ _SAMPLES = ((1e-6, 0.5), (1e-5, -0.3), (2e-5, 1.0), (1e-7, 0.0))  # (delta, delt
 # that raised or gave a non-finite value (its kind and arguments), whether a signal stopped the
 # law, and a count of calls between two looks for a signal.
 (REC_FAULT, REC_WHICH, REC_DELTA, REC_DELTADOT, REC_MODE, REC_K, REC_DAMPING, REC_ALPHA, REC_STOP,
- REC_CALLS) = range(10)
-N_RECORD = 10
-NO_FAULT, RAISED, NOT_A_NUMBER, INFINITE = 0, 1, 2, 3
+ REC_CALLS, REC_VALUE) = range(11)
+N_RECORD = 11
+NO_FAULT, RAISED, NOT_A_NUMBER, INFINITE, BEYOND_RANGE = 0, 1, 2, 3, 4
+#: The largest force magnitude a user law may return, N: far above any physical contact force, and
+#: far below the float range that a force times masses, steps and tolerances must stay in (a force of
+#: 1e300 N is finite, but the run's step size collapsed on it with no word of the law).
+FORCE_LIMIT = 1e100
 #: Calls of a user law between two looks for Ctrl-C or SIGTERM (a ``poll``, about 0.3 us): a law
 #: whose every call is slow still stops within a fraction of a second.
 POLL_CALLS = 64
@@ -150,6 +154,8 @@ class NativeLaw:
                 function(*args)
             except Exception as exc:  # noqa: BLE001 (the user's code: report whatever it raised)
                 what = f"raised {type(exc).__name__}" + (f" ({exc})" if str(exc) else "")
+        elif kind == BEYOND_RANGE:
+            what = f"returned {float(r[REC_VALUE]):.6g} N, beyond the finite physical range |P| <= {FORCE_LIMIT:g} N,"
         else:
             what = "returned nan" if kind == NOT_A_NUMBER else "returned an infinity"
         return f"law {name!r}: its {label} {what} at delta = {delta:.6g} m (deltadot = {deltadot:.6g} m/s)"
@@ -314,6 +320,8 @@ def _compile(force, partials, potential, filippov, record) -> tuple:
                 fault = RAISED
             if fault == NO_FAULT and not math.isfinite(value):
                 fault = NOT_A_NUMBER if math.isnan(value) else INFINITE
+            elif fault == NO_FAULT and which == 0 and abs(value) > FORCE_LIMIT:
+                fault = BEYOND_RANGE
             if fault != NO_FAULT:
                 if slot_load(at, REC_FAULT) == NO_FAULT:
                     slot_store(at, REC_WHICH, float(which))
@@ -323,6 +331,7 @@ def _compile(force, partials, potential, filippov, record) -> tuple:
                     slot_store(at, REC_K, K)
                     slot_store(at, REC_DAMPING, damping)
                     slot_store(at, REC_ALPHA, alpha)
+                    slot_store(at, REC_VALUE, value)
                     slot_store(at, REC_FAULT, float(fault))
                 return math.nan
             if not filippov or which == 3:
