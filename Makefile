@@ -6,7 +6,7 @@ STAMP := $(VENV)/.installed
 QUICK ?=
 JOBS ?= 2
 
-.PHONY: test test-numba-range docs reproduce lint benchmarks stress peers clean
+.PHONY: test test-sdist test-numba-range docs reproduce lint benchmarks stress peers clean
 
 $(BIN)/python:
 	$(PYTHON) -m venv $(VENV)
@@ -51,6 +51,11 @@ NUMBA_RANGE_TESTS ?= tests/test_integrate.py tests/test_laws.py tests/test_cache
 	.venv-numba-$*/bin/python -m pip install --quiet --upgrade pip
 	.venv-numba-$*/bin/python -m pip install --quiet $(NUMBA_$(shell echo $* | tr a-z A-Z)) -e . pytest hypothesis
 	touch $@
+
+# The whole quick subset of the suite and the docs build, run from an unpacked sdist (make test runs a
+# sample of it: every test file, and every quick test of the files that read figures, studies and docs).
+test-sdist: $(STAMP)
+	PHASEIMPACT_SDIST_ALL=1 $(BIN)/python -m pytest -q tests/test_packaging.py -k sdist_has_every
 
 test-numba-range: .venv-numba-oldest/.installed .venv-numba-newest/.installed
 	@for end in oldest newest; do \
