@@ -737,6 +737,11 @@ def as_laminate(plate, h: float) -> Laminate:
     -------
     Laminate
 
+    Raises
+    ------
+    TypeError
+        For a plate that is neither.
+
     Examples
     --------
     >>> from phaseimpact.model.laminate import as_laminate
