@@ -317,8 +317,8 @@ def regime_report(params, plate, geometry) -> dict:
                else "the plate's edge takes part in the contact")
         name = {"plate": "the spring-mass plate", "free": "the free plate mass"}.get(params.target, params.target)
         warning = (f"the impact is {regime} (M1/M_p = {ratio:.3g} {bound}, Olsson 2000): {why}, so {name} "
-                   f"(target {params.target}) is out of its range; "
-                   + ("the infinite plate is the model" if model == "infinite" else "the spring-mass plate is the model"))
+                   f"(target {params.target}) is out of its range; the "
+                   + ("infinite" if model == "infinite" else "spring-mass") + " plate is the model")
     return {"D_star": D_star, "plate_impedance": impedance,
             "zener_lambda": zener_lambda(params.M1, params.v, params.K, impedance), "plate_mass": M_p,
             "mass_ratio": ratio, "regime": regime, "regime_model": model, "regime_warning": warning}
