@@ -662,8 +662,9 @@ def load_case(name_or_path) -> Case:
     --------
     >>> from phaseimpact.case import load_case, seed_case
     >>> case = load_case("hail-laminate")
-    >>> print(f"{case.impact['v']:g} m/s, plate E = {case.plate.E:.3g} Pa, Y = {case.plate.yield_strength:.3g} Pa")
-    90 m/s, plate E = 1.67e+10 Pa, Y = 1.13e+08 Pa
+    >>> print(f"{case.impact['v']:g} m/s, {len(case.plate.plies)} plies, h = {case.geometry.h:g} m, "
+    ...       f"Y = {case.plate.yield_strength:.3g} Pa")
+    90 m/s, 5 plies, h = 0.005 m, Y = 1.13e+08 Pa
     >>> load_case("seed") == seed_case()
     True
     >>> load_case("nope")

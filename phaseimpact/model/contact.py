@@ -86,7 +86,7 @@ def hertz_scales(params: Parameters, plate_material: Material | None = None) -> 
     0.000108 s, 3.669e-05 m, 4836 N, 3.146e+09 Pa
     >>> case = load_case("hail-laminate")
     >>> print(f"{hertz_scales(case.parameters(), case.plate)['pressure_to_first_yield']:.3g}")
-    7.61
+    7.31
     """
     if not isinstance(params, Parameters):
         raise TypeError(f"params has the wrong type ({type(params).__name__}); allowed: Parameters")
