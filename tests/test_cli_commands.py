@@ -559,6 +559,7 @@ def test_params_reports_the_laminate_and_the_impact_regime():
     M1, M_p = 7850.0 * 4 / 3 * math.pi * 0.02**3, 7850.0 * math.pi * 0.1**2 * 0.005
     assert seed["mass_ratio"] == pytest.approx(M1 / M_p, rel=1e-12) and seed["plate_mass"] == pytest.approx(M_p)
     assert seed["mass_ratio"] == pytest.approx(0.2133, abs=1e-4) and seed["regime"] == "wave-controlled"
+    assert seed["M1"] / seed["M2"] == pytest.approx(0.853, abs=1e-3)  # docs/physics.md §8: against eq. 1's M2
     D = 2.1e11 * 0.005**3 / (12 * (1 - 0.3**2))
     assert seed["plate_impedance"] == pytest.approx(8 * math.sqrt(D * 7850.0 * 0.005), rel=1e-12)
     assert seed["zener_lambda"] == pytest.approx(M1**0.6 * 1.0**0.2 * seed["K"] ** 0.4 / seed["plate_impedance"],
