@@ -75,8 +75,15 @@ def run_params(args) -> int:
         if out["laminate"] is not None:
             print(f"  laminate: {len(case.plate.plies)} plies, h = {case.geometry.h:g} m; A (N/m), B (N), D (N m) in "
                   "the plate's axes (x, y, xy):")
-            for name in ("A", "B", "D"):
-                rows = "; ".join(" ".join(f"{x:.4g}" for x in row) for row in out["laminate"][name])
+            A = out["laminate"]["A"]
+            # rounding of the ply sums leaves ~1e-16 of the largest term where the layup gives zero:
+            # printed as 0 (B is on the scale of A h); --json keeps the sums as computed
+            scale_A = max(abs(x) for row in A for x in row)
+            for name, scale in (("A", scale_A), ("B", scale_A * case.geometry.h), ("D", None)):
+                matrix = out["laminate"][name]
+                scale = scale or max(abs(x) for row in matrix for x in row)
+                rows = "; ".join(" ".join(f"{x if abs(x) > 1e-12 * scale else 0.0:.4g}" for x in row)
+                                 for row in matrix)
                 print(f"  {name:>23} = [{rows}]")
         print(f"  regime: {out['regime']} by Olsson's mass criterion (M1 over the whole plate's mass "
               f"{_fmt(out['plate_mass'], 'kg')}: wave-controlled below 0.23, quasi-static above 2)")
