@@ -570,6 +570,8 @@ def test_params_reports_the_laminate_and_the_impact_regime():
     assert heavy["regime"] == "quasi-static" and heavy["regime_warning"] is None
     middle = run_json(["params", "--set", "R1=0.03"])  # 0.888 kg: boundary-controlled
     assert middle["regime"] == "boundary-controlled" and middle["regime_warning"] is None
+    free = run_json(["params", "--set", "R1=0.03", "--target", "free"])  # a free mass where the edge takes part
+    assert free["regime_warning"].endswith("target free) is out of its range; the spring-mass plate is the model")
     hail = run_json(["params", "--case", "hail-laminate"])
     A, B, Dm = (np.array(hail["laminate"][k]) for k in ("A", "B", "D"))
     assert A[0, 0] == pytest.approx(4 * 1e-3 * 2.87e10 / (1 - 0.5**2 * 1.66 / 2.87) + 1e-3 * 1.11e10 / (1 - 0.25),
