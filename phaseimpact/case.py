@@ -23,6 +23,21 @@ A case file has this schema (SI units; ``[projectile]`` and ``[plate]`` take the
                    # printed), restitution (1e-6 <= e <= 1, default none), law_file (a Python
                    # file defining the law with phaseimpact.define_law, relative to the case file)
 
+A laminate plate gives ``[[plate.ply]]`` tables instead of ``E, nu, rho`` (``[plate]`` then takes
+only ``yield_strength``), listed from the impacted face down, each with ``E1, E2, G12`` (Pa),
+``nu12``, ``rho`` (kg/m^3), ``angle`` (degrees), ``thickness`` (m) and optionally ``G13, G23`` (Pa,
+both or neither: Abrate's bending-shear stiffness). ``geometry.h`` is then the plies' total
+thickness: leave it out, or give that same number (docs/physics.md §8)::
+
+    [[plate.ply]]
+    E1 = 2.87e10
+    E2 = 1.66e10
+    G12 = 8.4e9
+    nu12 = 0.5
+    rho = 1940.0
+    angle = 0.0
+    thickness = 0.001
+
 Unknown keys, missing keys, wrong types and values out of range raise ``ValueError`` naming the
 dotted key, its value and the allowed range; so does an ``[impact]`` value its law never reads
 (``kappa`` with ``abrate``, ``restitution`` with ``paper``...), which would be silently ignored.
@@ -41,6 +56,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 from importlib import resources
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -55,6 +71,7 @@ from .parameters import (
     Geometry,
     Material,
     Parameters,
+    _replace_material,
     dotted_overrides,
     is_number,
     parameters_with,
@@ -64,6 +81,9 @@ from .parameters import (
     validate_geometry,
     validate_material,
 )
+
+if TYPE_CHECKING:
+    from .model.laminate import Laminate
 
 __all__ = [
     "Case",
@@ -174,16 +194,59 @@ def _material_from(table, body: str) -> Material:
     return Material(**values)
 
 
-def _geometry_from(table) -> Geometry:
+def _laminate_from(table) -> Laminate:
+    """A ``[plate]`` table with ``[[plate.ply]]`` tables: the plies, from the impacted face down."""
+    from .model.laminate import PLY_FIELDS, Laminate, Ply, validate_ply
+
+    for key in table:
+        if key not in ("ply", "yield_strength"):
+            raise ValueError(f"plate.{key} = {table[key]!r} does not go with [[plate.ply]]; allowed in [plate] with "
+                             "plies: ply, yield_strength (a laminate's moduli and density are set per ply)")
+    plies = table["ply"]
+    if not isinstance(plies, list) or not plies:
+        raise _wrong_type("plate.ply", plies, "a non-empty array of tables ([[plate.ply]])")
+    built = []
+    for i, ply in enumerate(plies):
+        prefix = f"plate.ply[{i}]."
+        if not isinstance(ply, Mapping):
+            raise _wrong_type(prefix.rstrip("."), ply, "a table with keys " + ", ".join(PLY_FIELDS))
+        values = {key: _number(prefix + key, value) if key in PLY_FIELDS else value for key, value in ply.items()}
+        validate_ply(values, prefix)
+        built.append(Ply(**values))
+    strength = table.get("yield_strength")
+    if strength is not None:
+        strength = _number("plate.yield_strength", strength)
+    try:
+        return Laminate(tuple(built), yield_strength=strength)
+    except ValueError as exc:
+        raise ValueError(f"plate.ply: {exc}" if str(exc).startswith("G13") else f"plate.{exc}") from None
+
+
+def _plate_from(table) -> Material | Laminate:
+    if isinstance(table, Mapping) and "ply" in table:
+        return _laminate_from(table)
+    return _material_from(table, "plate")
+
+
+def _geometry_from(table, thickness: float | None = None) -> Geometry:
+    """A ``[geometry]`` table; with a laminate's ``thickness`` (m), ``h`` may be left out and must
+    otherwise equal it."""
     if not isinstance(table, Mapping):
         raise _wrong_type("geometry", table, "a table with keys a, h, R1, R2")
     _check_keys(table, _GEOMETRY_KEYS, "geometry")
     for key in _GEOMETRY_KEYS:
-        if key not in table:
+        if key not in table and not (key == "h" and thickness is not None):
             raise _missing(f"geometry.{key}", "a finite number > 0 (m)")
     values = {key: _number(f"geometry.{key}", value) for key, value in table.items()}
+    if thickness is not None:
+        _require_ply_thickness(values.setdefault("h", thickness), thickness, "geometry.h")
     validate_geometry(values, "geometry.")
     return Geometry(**values)
+
+
+def _require_ply_thickness(h: float, thickness: float, name: str) -> None:
+    require(name, h, f"the plies' total thickness {thickness!r} m (leave h out: it is their sum)",
+            math.isclose(h, thickness, rel_tol=1e-12))
 
 
 def _impact_from(table) -> dict:
@@ -261,10 +324,13 @@ class Case:
         One line saying what the case is.
     source : str
         Where the numbers come from; assumed values are marked as assumed.
-    projectile, plate : Material
-        Materials of the spherical projectile and of the target plate.
+    projectile : Material
+        Material of the spherical projectile.
+    plate : Material or Laminate
+        Material of the target plate, or its plies (:class:`~phaseimpact.model.laminate.Laminate`,
+        ``[[plate.ply]]`` in a file).
     geometry : Geometry
-        ``a, h, R1, R2`` (m).
+        ``a, h, R1, R2`` (m); for a laminate ``h`` is the plies' total thickness.
     impact : dict
         ``v`` (m/s), ``kappa`` (N s/m^2.5), ``target``, ``law``, ``contact`` and ``restitution``
         (``None`` when not given); defaults are filled in for the optional keys. Not hashable.
@@ -291,7 +357,7 @@ class Case:
     description: str = ""
     source: str = ""
     projectile: Material
-    plate: Material
+    plate: Material | Laminate
     geometry: Geometry
     impact: dict = field(default_factory=lambda: {"v": 1.0})
 
@@ -301,9 +367,14 @@ class Case:
         require("name", self.name, "a non-empty string on one line",
                 bool(self.name.strip()) and len(self.name.splitlines()) == 1)
         require("description", self.description, "one line (no line break)", len(self.description.splitlines()) <= 1)
-        for key, cls in (("projectile", Material), ("plate", Material), ("geometry", Geometry)):
+        from .model.laminate import Laminate
+
+        for key, cls in (("projectile", Material), ("plate", Material | Laminate), ("geometry", Geometry)):
             if not isinstance(getattr(self, key), cls):
-                raise _wrong_type(key, getattr(self, key), f"a {cls.__name__}")
+                raise _wrong_type(key, getattr(self, key), "a Material or a Laminate" if key == "plate"
+                                  else f"a {cls.__name__}")
+        if isinstance(self.plate, Laminate):
+            _require_ply_thickness(self.geometry.h, self.plate.thickness, "geometry.h")
         object.__setattr__(self, "impact", _impact_from(self.impact))
 
     def parameters(self, **overrides) -> Parameters:
@@ -387,8 +458,11 @@ class Case:
         ({'E': 210000000000.0, 'nu': 0.3, 'rho': 7850.0},
          {'v': 1.0, 'kappa': 0.0, 'target': 'plate', 'law': 'paper', 'contact': 'printed'})
         """
-        def material(m: Material) -> dict:
-            return {k: v for k, v in dataclasses.asdict(m).items() if v is not None}
+        def material(m: Material | Laminate) -> dict:
+            if isinstance(m, Material):
+                return {k: v for k, v in dataclasses.asdict(m).items() if v is not None}
+            plies = [{k: v for k, v in dataclasses.asdict(p).items() if v is not None} for p in m.plies]
+            return {**({} if m.yield_strength is None else {"yield_strength": m.yield_strength}), "ply": plies}
 
         return {
             "name": self.name,
@@ -434,7 +508,10 @@ class Case:
         data = self.as_dict()
         lines = [f"{key} = {_toml_value(data[key])}" for key in ("name", "description", "source")]
         for table in _TABLES:
-            lines += ["", f"[{table}]"] + [f"{k} = {_toml_value(v)}" for k, v in data[table].items()]
+            scalars = {k: v for k, v in data[table].items() if k != "ply"}
+            lines += ["", f"[{table}]"] + [f"{k} = {_toml_value(v)}" for k, v in scalars.items()]
+            for ply in data[table].get("ply", ()):
+                lines += ["", f"[[{table}.ply]]"] + [f"{k} = {_toml_value(v)}" for k, v in ply.items()]
         return "\n".join(lines) + "\n"
 
     def save(self, path) -> Path:
@@ -528,13 +605,15 @@ def case_from_dict(data, origin: str = "<dict>") -> Case:
                 impact_table["law"] = single_law(names, path, "impact.law")
         impact = _impact_from(impact_table)
         _check_read_by_law(impact)
+        projectile, plate = _material_from(data["projectile"], "projectile"), _plate_from(data["plate"])
+        thickness = None if isinstance(plate, Material) else plate.thickness
         return Case(
             name=text.get("name", Path(origin).stem if origin != "<dict>" else "case"),
             description=text.get("description", ""),
             source=text.get("source", ""),
-            projectile=_material_from(data["projectile"], "projectile"),
-            plate=_material_from(data["plate"], "plate"),
-            geometry=_geometry_from(data["geometry"]),
+            projectile=projectile,
+            plate=plate,
+            geometry=_geometry_from(data["geometry"], thickness),
             impact=impact,
         )
     except ValueError as exc:
@@ -583,8 +662,9 @@ def load_case(name_or_path) -> Case:
     --------
     >>> from phaseimpact.case import load_case, seed_case
     >>> case = load_case("hail-laminate")
-    >>> print(f"{case.impact['v']:g} m/s, plate E = {case.plate.E:.3g} Pa, Y = {case.plate.yield_strength:.3g} Pa")
-    90 m/s, plate E = 1.67e+10 Pa, Y = 1.13e+08 Pa
+    >>> print(f"{case.impact['v']:g} m/s, {len(case.plate.plies)} plies, h = {case.geometry.h:g} m, "
+    ...       f"Y = {case.plate.yield_strength:.3g} Pa")
+    90 m/s, 5 plies, h = 0.005 m, Y = 1.13e+08 Pa
     >>> load_case("seed") == seed_case()
     True
     >>> load_case("nope")
@@ -780,8 +860,8 @@ def apply_settings(case: Case, settings) -> Case:
     else:
         pairs = [parse_setting(text) for text in settings]
     values = {
-        "projectile": dataclasses.asdict(case.projectile),
-        "plate": dataclasses.asdict(case.plate),
+        "projectile": {},  # the changes of each material
+        "plate": {},
         "geometry": dataclasses.asdict(case.geometry),
         "impact": dict(case.impact),
     }
@@ -793,14 +873,14 @@ def apply_settings(case: Case, settings) -> Case:
             values["impact"][name] = value
         else:
             values["geometry"][name] = value
-    for body in ("projectile", "plate"):
-        validate_material(values[body], f"{body}.")
+    projectile, plate = (_replace_material(getattr(case, body), f"{body}.", values[body]) if values[body]
+                         else getattr(case, body) for body in ("projectile", "plate"))
     validate_geometry(values["geometry"])
     require_in("v", values["impact"]["v"], V_RANGE, "m/s")
     return dataclasses.replace(
         case,
-        projectile=Material(**values["projectile"]),
-        plate=Material(**values["plate"]),
+        projectile=projectile,
+        plate=plate,
         geometry=Geometry(**values["geometry"]),
         impact=values["impact"],
     )

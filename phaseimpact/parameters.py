@@ -423,8 +423,13 @@ def derive_parameters(
 
     Parameters
     ----------
-    projectile, plate : Material
-        Materials of the ball and of the plate.
+    projectile : Material
+        Material of the ball.
+    plate : Material or Laminate
+        Material of the plate, or a :class:`~phaseimpact.model.laminate.Laminate` (docs/physics.md
+        §8: its areal density, ``K`` with its top ply's half-space compliance, ``Kb`` from its
+        bending stiffness, or Abrate's ``Kbs`` when its plies give ``G13, G23``, ``Km`` from ``A``);
+        ``geometry.h`` must then be the plies' total thickness.
     geometry : Geometry
         Plate radius and thickness, projectile and target radii.
     membrane : {"printed", "shivakumar"}
@@ -458,22 +463,57 @@ def derive_parameters(
     p_y = 4.4e+08 Pa
     """
     require_choice("membrane", membrane, MEMBRANE_FORMULAS)
-    g, E, nu = geometry, plate.E, plate.nu
+    g = geometry
+    if isinstance(plate, Material):
+        E, nu = plate.E, plate.nu
+        areal_density = plate.rho * g.h
+        plate_compliance = (1 - nu**2) / E  # eq. 4
+        Kb = 4.0 * math.pi * E * g.h**3 / (3.0 * (1 - nu**2) * g.a**2)  # eq. 5a with h^3
+        km_denominator = (1 - nu**2) if membrane == "printed" else (1 - nu)
+        Km = (353 - 191 * nu) * math.pi * E * g.h / (648 * km_denominator * g.a**2)  # eq. 5b
+    else:  # a laminate (docs/physics.md §8); imported late: model.laminate builds on this module
+        from .model import laminate as lam
+
+        if not isinstance(plate, lam.Laminate):
+            raise TypeError(f"plate has the wrong type ({type(plate).__name__}); allowed: Material or Laminate")
+        require("h", g.h, f"the plies' total thickness {plate.thickness!r} m (h of a laminate is the sum of its "
+                "plies)", math.isclose(g.h, plate.thickness, rel_tol=1e-12))
+        areal_density = plate.areal_density
+        plate_compliance = lam.top_ply_compliance(plate)
+        Kb = lam.bending_stiffness(plate, g.a)
+        Km = lam.membrane_stiffness(plate, g.a, membrane)
     M1 = projectile.rho * 4.0 / 3.0 * math.pi * g.R1**3
-    M2 = 0.25 * plate.rho * math.pi * g.a**2 * g.h  # a quarter of the plate takes part
-    eta = (1 - projectile.nu**2) / projectile.E + (1 - nu**2) / E  # eq. 4
+    M2 = 0.25 * math.pi * g.a**2 * areal_density  # a quarter of the plate takes part
+    eta = (1 - projectile.nu**2) / projectile.E + plate_compliance  # eq. 4
     R = g.effective_radius
     K = 4.0 * math.sqrt(R) / (3.0 * eta)  # eq. 3 with eta restored
-    Kb = 4.0 * math.pi * E * g.h**3 / (3.0 * (1 - nu**2) * g.a**2)  # eq. 5a with h^3
-    km_denominator = (1 - nu**2) if membrane == "printed" else (1 - nu)
-    Km = (353 - 191 * nu) * math.pi * E * g.h / (648 * km_denominator * g.a**2)  # eq. 5b
+    if not isinstance(plate, Material) and plate.has_shear:
+        Kb = _bending_shear(plate, g.a, R, K, M1 * M2 / (M1 + M2), v)
     strengths = [m.yield_strength for m in (projectile, plate) if m.yield_strength is not None]
     p_y = FIRST_YIELD_FACTOR * min(strengths) if strengths else None
     return Parameters(M1=M1, M2=M2, K=K, Kb=Kb, Km=Km, alpha=alpha, kappa=kappa, v=v, target=target, R=R,
                       limiting_pressure=p_y)
 
 
-def _replace_material(material: Material, prefix: str, changes: Mapping) -> Material:
+def _bending_shear(laminate, a: float, R: float, K: float, reduced_mass: float, v: float) -> float:
+    """Abrate's ``Kbs`` (docs/physics.md §8): the shear stiffness's load spread over the Hertz contact
+    radius ``c = sqrt(R delta)`` at the undamped impact's largest indentation ``delta`` (eq. 3, the
+    plate target's reduced mass), so that ``Kb`` then depends on the impact speed."""
+    from .model import laminate as lam
+
+    c = math.sqrt(R * (5.0 * reduced_mass * v**2 / (4.0 * K)) ** 0.4)
+    require("contact radius", c, f"c < a = {a:g} m (the shear stiffness of plies with G13, G23 spreads the load "
+            "over the Hertz contact radius at the peak; give no G13, G23 for bending alone)", c < a)
+    return lam.bending_shear_stiffness(lam.bending_stiffness(laminate, a), lam.shear_stiffness(laminate, a, c))
+
+
+def _replace_material(material, prefix: str, changes: Mapping):
+    if not isinstance(material, Material):  # a laminate: only its strength is one number
+        bad = [name for name in changes if name != "yield_strength"]
+        if bad:
+            raise ValueError(f"{prefix}{bad[0]} = {changes[bad[0]]!r} does not apply to a laminate plate; allowed: "
+                             f"{prefix}yield_strength (its moduli and density are set per ply, [[plate.ply]])")
+        return dataclasses.replace(material, **changes)
     values = {**dataclasses.asdict(material), **changes}
     validate_material(values, prefix)  # so that the message names e.g. "plate_E", not "E"
     return Material(**values)

@@ -276,3 +276,112 @@ def test_bad_settings_raise_naming_the_setting(setting, expected):
         seed_case().with_settings([setting])
     for part in expected:
         assert part in str(info.value), (part, str(info.value))
+
+
+# ---------------------------------------------------------------------------------------------
+# Laminate plates: [[plate.ply]] (issue 40 item 1)
+# ---------------------------------------------------------------------------------------------
+
+STEEL_PLY = {"E1": 2.1e11, "E2": 2.1e11, "G12": 2.1e11 / 2.6, "nu12": 0.3, "rho": 7850.0}
+
+
+def _laminate_toml(plies, geometry="a = 0.1\nR1 = 0.02\nR2 = 2000.0", plate_extra="") -> str:
+    text = "[projectile]\nE = 2.1e11\nnu = 0.3\nrho = 7850.0\n\n[plate]\n" + plate_extra + "\n"
+    for ply in plies:
+        text += "\n[[plate.ply]]\n" + "\n".join(f"{k} = {v!r}" for k, v in ply.items()) + "\n"
+    return text + f"\n[geometry]\n{geometry}\n\n[impact]\nv = 1.0\n"
+
+
+def _load_text(tmp_path, text):
+    path = tmp_path / "lam.toml"
+    path.write_text(text, encoding="utf-8")
+    return load_case(path)
+
+
+@pytest.mark.parametrize("angles", [(0.0,), (0.0, 30.0), (0.0, 45.0, -45.0, 90.0)])
+def test_isotropic_plies_in_a_case_file_give_the_seed_numbers(tmp_path, angles):
+    """A steel plate given as plies (any number, any angles) keeps eq. 3-5's numbers to 1e-12."""
+    plies = [{**STEEL_PLY, "angle": t, "thickness": 0.005 / len(angles)} for t in angles]
+    case = _load_text(tmp_path, _laminate_toml(plies))
+    assert case.geometry.h == pytest.approx(0.005, rel=1e-15)
+    seed, laminate = seed_parameters(v=1.0), case.parameters()
+    for name in ("M1", "M2", "K", "Kb", "Km", "R"):
+        assert math.isclose(getattr(laminate, name), getattr(seed, name), rel_tol=1e-12), name
+    shivakumar = case.parameters(membrane="shivakumar").Km
+    assert math.isclose(shivakumar, seed_parameters(v=1.0, membrane="shivakumar").Km, rel_tol=1e-12)
+
+
+def test_shear_moduli_switch_on_abrates_bending_shear_stiffness(tmp_path):
+    """With G13, G23: 1/Kbs = 1/Kb + 1/Ks, Ks = 2 pi k G h / (1/2 + ln(a/c)) at the Hertz contact
+    radius c = sqrt(R delta), delta = (5 m v^2 / (4 K))^(2/5) (closed forms here)."""
+    G = STEEL_PLY["G12"]
+    case = _load_text(tmp_path, _laminate_toml([{**STEEL_PLY, "G13": G, "G23": G, "angle": 0.0, "thickness": 0.005}]))
+    p, seed = case.parameters(v=3.0), seed_parameters(v=3.0)
+    mass = seed.M1 * seed.M2 / (seed.M1 + seed.M2)
+    c = math.sqrt(seed.R * (5 * mass * 3.0**2 / (4 * seed.K)) ** 0.4)
+    Ks = 2 * math.pi * (5 / 6) * G * 0.005 / (0.5 + math.log(0.1 / c))
+    assert math.isclose(p.Kb, 1 / (1 / seed.Kb + 1 / Ks), rel_tol=1e-12)
+    assert p.Kb < seed.Kb and case.parameters(v=30.0).Kb > p.Kb  # a wider contact: less shear deflection
+
+
+def test_laminate_case_file_errors_name_the_key(tmp_path):
+    ply = {**STEEL_PLY, "angle": 0.0, "thickness": 0.0025}
+    cases = [
+        (_laminate_toml([ply, ply], geometry="a = 0.1\nh = 0.006\nR1 = 0.02\nR2 = 2000.0"),
+         "geometry.h = 0.006 is out of range; allowed: the plies' total thickness 0.005 m"),
+        (_laminate_toml([ply], plate_extra="E = 2.1e11"), "plate.E = 210000000000.0 does not go with"),
+        (_laminate_toml([ply, {k: v for k, v in ply.items() if k != "E1"}]), r"plate.ply\[1\]: missing E1"),
+        (_laminate_toml([ply, {**ply, "angle": 400.0}]), r"plate.ply\[1\].angle = 400.0 is out of range"),
+        (_laminate_toml([ply, {**ply, "angle": "up"}]), r"plate.ply\[1\].angle = 'up' has the wrong type"),
+        (_laminate_toml([{**ply, "G13": 8e10, "G23": 8e10}, ply]),
+         "plate.ply: G13 = .* given for every ply or for none"),
+        (_laminate_toml([ply], plate_extra="yield_strength = -1.0"), "plate.yield_strength = -1.0 is out of range"),
+    ]
+    for text, message in cases:
+        with pytest.raises(ValueError, match=message):
+            _load_text(tmp_path, text)
+    case = _load_text(tmp_path, _laminate_toml([ply, ply], geometry="a = 0.1\nh = 0.005\nR1 = 0.02\nR2 = 2000.0"))
+    assert case.geometry.h == 0.005  # the same h, given: accepted
+
+
+def test_laminate_case_round_trips_and_takes_settings(tmp_path):
+    case = load_case("hail-laminate")
+    assert load_case(case.save(tmp_path / "again.toml")) == case
+    assert case_from_dict(json.loads(json.dumps(case.as_dict()))) == case
+    stronger = case.with_settings(["plate.yield_strength=2e8", "v=50"])
+    assert stronger.plate.yield_strength == 2e8 and stronger.plate.plies == case.plate.plies
+    with pytest.raises(ValueError, match=r"plate.E = 10000000000.0 does not apply to a laminate plate; allowed: "
+                                         "plate.yield_strength"):
+        case.with_settings(["plate.E=1e10"])
+    with pytest.raises(ValueError, match="geometry.h = 0.006 is out of range"):
+        case.with_settings(["h=0.006"])
+    with pytest.raises(ValueError, match="h = 0.006 is out of range; allowed: the plies' total thickness"):
+        case.parameters(h=0.006)
+    with pytest.raises(ValueError, match="plate_E = 10000000000.0 does not apply to a laminate plate"):
+        case.parameters(plate_E=1e10)
+
+
+@pytest.mark.parametrize("name", ["sand-laminate", "hail-laminate"])
+def test_laminate_cases_state_the_isotropic_approximations_error(name):
+    """The numbers each laminate case's source quotes: the isotropic approximation it used before
+    (E = E3 = 16.7 GPa, nu = 0.17, derived here through the isotropic path) against its plies."""
+    from phaseimpact.model.laminate import bending_stiffness
+    from phaseimpact.parameters import derive_parameters
+
+    case = load_case(name)
+    assert isinstance(case.plate.plies, tuple) and len(case.plate.plies) == 5 and case.geometry.h == 0.005
+    old = derive_parameters(case.projectile, Material(E=1.67e10, nu=0.17, rho=1940.0), case.geometry, v=90.0)
+    new = case.parameters()
+    bending = bending_stiffness(case.plate, case.geometry.a)
+    quoted = [f"Kb = {old.Kb:.3e} N/m", f"K = {old.K:.3e} N/m^1.5", f"Km = {old.Km:.3e} N/m^3",
+              f"Kb = {bending:.3e} N/m ({bending / old.Kb:.2f} times)",
+              f"Kbs = {new.Kb:.3e} N/m ({new.Kb / old.Kb:.2f} times",
+              f"K = {new.K:.3e} N/m^1.5 ({new.K / old.K:.3f} times",
+              f"Km = {new.Km:.3e} N/m^3 ({new.Km / old.Km:.2f} times"]
+    source = case.source.replace("e+0", "e").replace("e+1", "e1")
+    for text in quoted:
+        assert text.replace("e+0", "e").replace("e+1", "e1") in source, text
+    assert math.isclose(new.M2, old.M2, rel_tol=1e-12)  # same areal density
+    if name == "sand-laminate":
+        c = hertz_scales(new)["contact_radius"]
+        assert f"{c * 1e6:.0f} µm contact radius" in source

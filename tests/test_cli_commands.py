@@ -550,3 +550,35 @@ def test_shell_completion_knows_every_command_and_option(shell):
             for option in action.option_strings:
                 if option.startswith("--"):
                     assert option in out, (name, option)
+
+
+def test_params_reports_the_laminate_and_the_impact_regime():
+    """Issue 40 items 2-3: A/B/D of a laminate case, Zener's lambda, Olsson's mass ratio and regime
+    (closed forms here), and the warning when the target model does not fit the regime."""
+    seed = run_json(["params"])
+    M1, M_p = 7850.0 * 4 / 3 * math.pi * 0.02**3, 7850.0 * math.pi * 0.1**2 * 0.005
+    assert seed["mass_ratio"] == pytest.approx(M1 / M_p, rel=1e-12) and seed["plate_mass"] == pytest.approx(M_p)
+    assert seed["mass_ratio"] == pytest.approx(0.2133, abs=1e-4) and seed["regime"] == "wave-controlled"
+    assert seed["M1"] / seed["M2"] == pytest.approx(0.853, abs=1e-3)  # docs/physics.md §8: against eq. 1's M2
+    D = 2.1e11 * 0.005**3 / (12 * (1 - 0.3**2))
+    assert seed["plate_impedance"] == pytest.approx(8 * math.sqrt(D * 7850.0 * 0.005), rel=1e-12)
+    assert seed["zener_lambda"] == pytest.approx(M1**0.6 * 1.0**0.2 * seed["K"] ** 0.4 / seed["plate_impedance"],
+                                                 rel=1e-12)
+    assert seed["laminate"] is None and "infinite plate is the model" in seed["regime_warning"]
+    assert run_json(["params", "--target", "rigid"])["regime_warning"] is None
+    heavy = run_json(["params", "--set", "R1=0.05"])  # 4.11 kg on 1.23 kg: quasi-static, the plate fits
+    assert heavy["regime"] == "quasi-static" and heavy["regime_warning"] is None
+    middle = run_json(["params", "--set", "R1=0.03"])  # 0.888 kg: boundary-controlled
+    assert middle["regime"] == "boundary-controlled" and middle["regime_warning"] is None
+    free = run_json(["params", "--set", "R1=0.03", "--target", "free"])  # a free mass where the edge takes part
+    assert free["regime_warning"].endswith("target free) is out of its range; the spring-mass plate is the model")
+    hail = run_json(["params", "--case", "hail-laminate"])
+    A, B, Dm = (np.array(hail["laminate"][k]) for k in ("A", "B", "D"))
+    assert A[0, 0] == pytest.approx(4 * 1e-3 * 2.87e10 / (1 - 0.5**2 * 1.66 / 2.87) + 1e-3 * 1.11e10 / (1 - 0.25),
+                                    rel=1e-12)  # Q11 t summed: four triax plies, one biax
+    assert np.abs(B).max() < 1e-9 * A.max()  # symmetric layup
+    olsson = math.sqrt(Dm[0, 0] * Dm[1, 1] * ((Dm[0, 1] + 2 * Dm[2, 2]) / math.sqrt(Dm[0, 0] * Dm[1, 1]) + 1) / 2)
+    assert hail["laminate"]["D_star"] == pytest.approx(olsson, rel=1e-12)
+    assert hail["regime"] == "wave-controlled" and hail["regime_warning"].startswith("the impact is wave-controlled")
+    code, text, _ = run(["params", "--case", "hail-laminate"])
+    assert code == 0 and "laminate: 5 plies, h = 0.005 m" in text and "regime warning: the impact is" in text

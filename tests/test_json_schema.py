@@ -37,6 +37,7 @@ def outputs(tmp_path_factory):
         "cases": ["cases"],
         "params": ["params", "--case", "sand-gelcoat"],
         "params:thornton": ["params", "--case", "sand-gelcoat", "--law", "thornton"],
+        "params:laminate": ["params", "--case", "hail-laminate"],
         "simulate": ["simulate", "--kappa", "2e12"],
         "simulate:thornton": ["simulate", "--case", "sand-gelcoat", "--law", "thornton", "--t-end", "1e-5"],
         "simulate:out": ["simulate", "--kappa", "2e12", "--out", tmp / "run.nc"],
@@ -86,6 +87,9 @@ def test_every_json_output_validates_against_the_schema(outputs):
 def test_the_variants_print_their_conditional_keys(outputs):
     """The variants are there for keys only some inputs give: they must still give them."""
     assert outputs["params:thornton"]["law"] == "thornton" and outputs["params:thornton"]["yield_velocity"] > 0
+    assert outputs["params"]["laminate"] is None and set(outputs["params:laminate"]["laminate"]) == {"A", "B", "D",
+                                                                                                    "D_star"}
+    assert "ply" in outputs["params:laminate"]["case"]["plate"] and outputs["params:laminate"]["regime_warning"]
     assert "yield_velocity" in outputs["simulate:thornton"] and "exponents" in outputs["critical"]
     assert outputs["critical:not-found"]["kappa_c_status"] == "not-found"
     assert {"first_split", "boundaries"} <= set(outputs["sweep:paper"])

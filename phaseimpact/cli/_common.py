@@ -328,7 +328,8 @@ PARAM_UNITS = {"M1": "kg", "M2": "kg", "K": "N/m^1.5", "Kb": "N/m", "Km": "N/m^3
                "v": "m/s", "R": "m", "contact_time": "s", "plate_period": "s", "indentation": "m", "peak_force": "N",
                "contact_radius": "m", "peak_pressure": "Pa", "first_yield_pressure": "Pa",
                "pressure_to_first_yield": "", "hertz_mass": "kg", "limiting_pressure": "Pa",
-               "yield_velocity": "m/s"}
+               "yield_velocity": "m/s", "plate_impedance": "N s/m", "zener_lambda": "", "plate_mass": "kg",
+               "mass_ratio": ""}
 
 
 def _check_figure_target(path: str, force: bool) -> None:

@@ -56,6 +56,7 @@ def run_params(args) -> int:
     # reaches p_y = 1.6 Y of the weaker body (null without a yield strength)
     out["limiting_pressure"] = p.limiting_pressure
     out["yield_velocity"] = p.yield_velocity
+    out.update(_laminate_and_regime(p, case))
     out["case"] = case.as_dict()
     if args.json:
         _print_json(args, out)
@@ -63,14 +64,47 @@ def run_params(args) -> int:
         print(f"case {case.name}: {case.description}" if case.description else f"case {case.name}")
         print(f"  {'law':>23} = {law.label()}")
         for k, value in out.items():
-            if k in ("case", "validity", "target", "hertz_mass_is", "kappa_unit", *_law_fields(setup)):
+            if k in ("case", "validity", "target", "hertz_mass_is", "kappa_unit", "laminate", "regime",
+                     "regime_warning", *_law_fields(setup)):
                 continue
             unit = out["kappa_unit"] or KAPPA_UNIT if k == "kappa" else PARAM_UNITS.get(k, "")
             print(f"  {k:>23} = {_fmt(value, unit)}".rstrip())
         print(f"  {'target':>23} = {p.target}")
         print(f"  Hertz scales (contact_time ... peak_pressure) use hertz_mass, the {out['hertz_mass_is']}")
         print(f"  validity: {out['validity']}")
+        if out["laminate"] is not None:
+            print(f"  laminate: {len(case.plate.plies)} plies, h = {case.geometry.h:g} m; A (N/m), B (N), D (N m) in "
+                  "the plate's axes (x, y, xy):")
+            A = out["laminate"]["A"]
+            # rounding of the ply sums leaves ~1e-16 of the largest term where the layup gives zero:
+            # printed as 0 (B is on the scale of A h); --json keeps the sums as computed
+            scale_A = max(abs(x) for row in A for x in row)
+            for name, scale in (("A", scale_A), ("B", scale_A * case.geometry.h), ("D", None)):
+                matrix = out["laminate"][name]
+                scale = scale or max(abs(x) for row in matrix for x in row)
+                rows = "; ".join(" ".join(f"{x if abs(x) > 1e-12 * scale else 0.0:.4g}" for x in row)
+                                 for row in matrix)
+                print(f"  {name:>23} = [{rows}]")
+        print(f"  regime: {out['regime']} by Olsson's mass criterion (M1 over the whole plate's mass "
+              f"{_fmt(out['plate_mass'], 'kg')}: wave-controlled below 0.23, quasi-static above 2)")
+        if out["regime_warning"]:
+            print(f"  regime warning: {out['regime_warning']}")
     return EXIT_OK
+
+
+def _laminate_and_regime(p, case) -> dict:
+    """The laminate's stiffness matrices (null for an isotropic plate) and which plate model the
+    impact calls for (docs/physics.md §8)."""
+    from ..model.laminate import Laminate
+    from ..model.regime import regime_report
+
+    report = regime_report(p, case.plate, case.geometry)
+    laminate = None
+    if isinstance(case.plate, Laminate):
+        A, B, D = case.plate.abd()
+        laminate = {"A": A.tolist(), "B": B.tolist(), "D": D.tolist(), "D_star": report["D_star"]}
+    return {"laminate": laminate, **{k: report[k] for k in ("plate_impedance", "zener_lambda", "plate_mass",
+                                                            "mass_ratio", "regime", "regime_warning")}}
 
 
 def add_check_law(p) -> None:

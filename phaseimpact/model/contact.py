@@ -12,6 +12,7 @@ from __future__ import annotations
 import math
 
 from ..parameters import FIRST_YIELD_FACTOR, Geometry, Material, Parameters, require_nonnegative
+from .laminate import Laminate
 
 __all__ = [
     "CONTACT_RATIO_LIMIT",
@@ -54,7 +55,7 @@ def hertz_scales(params: Parameters, plate_material: Material | None = None) -> 
     ----------
     params : Parameters
         Uses ``M1, M2, K, Kb, alpha, v, target`` and the effective radius ``R`` (m).
-    plate_material : Material, optional
+    plate_material : Material or Laminate, optional
         If it gives a ``yield_strength``, the result also holds ``first_yield_pressure``
         (``1.6 Y``, Pa) and ``pressure_to_first_yield`` (``p0 / 1.6 Y``).
 
@@ -85,13 +86,13 @@ def hertz_scales(params: Parameters, plate_material: Material | None = None) -> 
     0.000108 s, 3.669e-05 m, 4836 N, 3.146e+09 Pa
     >>> case = load_case("hail-laminate")
     >>> print(f"{hertz_scales(case.parameters(), case.plate)['pressure_to_first_yield']:.3g}")
-    7.61
+    7.31
     """
     if not isinstance(params, Parameters):
         raise TypeError(f"params has the wrong type ({type(params).__name__}); allowed: Parameters")
-    if plate_material is not None and not isinstance(plate_material, Material):
-        raise TypeError(f"plate_material has the wrong type ({type(plate_material).__name__}); allowed: Material "
-                        "or None")
+    if plate_material is not None and not isinstance(plate_material, Material | Laminate):
+        raise TypeError(f"plate_material has the wrong type ({type(plate_material).__name__}); allowed: Material, "
+                        "Laminate or None")
     delta = params.hertz_indentation
     force = params.K * delta**params.alpha
     out = {
@@ -183,11 +184,17 @@ def _strength_reasons(plate_material: Material | None, projectile_material: Mate
     """A yield strength above the material's Young's modulus: no solid yields there (metals at about
     E/1000, the strongest ceramics near E/10), so it is a typo or a unit slip (and leaves thornton elastic)."""
     implausible = [f"yield strength {m.yield_strength:.3g} Pa of the {role} exceeds its Young's modulus "
-                   f"E = {m.E:.3g} Pa" for role, m in (("target", plate_material), ("projectile", projectile_material))
-                   if m is not None and m.yield_strength is not None and m.yield_strength > m.E]
+                   f"E = {_modulus(m):.3g} Pa" for role, m in (("target", plate_material),
+                                                               ("projectile", projectile_material))
+                   if m is not None and m.yield_strength is not None and m.yield_strength > _modulus(m)]
     if not implausible:
         return []
     return ["; ".join(implausible) + ": no solid yields above E (check the value and its unit, Pa)"]
+
+
+def _modulus(m: Material | Laminate) -> float:
+    """Young's modulus under the contact: a laminate's top ply's through-thickness ``E2``."""
+    return m.plies[0].E2 if isinstance(m, Laminate) else m.E
 
 
 def _plate_reasons(g: Geometry, target: str) -> list:
@@ -211,7 +218,7 @@ def validity(params: Parameters, plate_material: Material | None,
     ----------
     params : Parameters
         With the effective radius ``R``.
-    plate_material : Material or None
+    plate_material : Material, Laminate or None
         Its ``yield_strength`` ``Y`` (Pa), if given, is checked: ``p0 <= 1.6 Y``.
     projectile_material : Material, optional
         The same check for the projectile (a hailstone crushes before the plate yields).
@@ -380,7 +387,7 @@ def validity_for_force(force: float, params: Parameters, plate_material: Materia
         Peak contact force, N (>= 0).
     params : Parameters
         With the effective radius ``R`` (m).
-    plate_material : Material or None
+    plate_material : Material, Laminate or None
         Its ``yield_strength`` ``Y`` (Pa), if given, is checked: ``p0 <= 1.6 Y``.
     projectile_material : Material, optional
         The same check for the projectile.

@@ -28,12 +28,23 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..parameters import DENSITY_RANGE, LENGTH_RANGE, MODULUS_RANGE, is_number, require, require_choice, require_in
+from ..parameters import (
+    DENSITY_RANGE,
+    LENGTH_RANGE,
+    MODULUS_RANGE,
+    STRENGTH_RANGE,
+    Material,
+    is_number,
+    require,
+    require_choice,
+    require_in,
+)
 
 __all__ = [
     "Ply", "Laminate", "validate_ply", "transformed_stiffness", "lekhnitskii_rigidity", "isotropic_part",
     "bending_stiffness", "membrane_stiffness", "shear_stiffness", "bending_shear_stiffness",
-    "yang_sun_compliance", "transversely_isotropic_compliance", "MEMBRANE_FORMULAS", "SHEAR_FACTOR",
+    "yang_sun_compliance", "transversely_isotropic_compliance", "top_ply_compliance", "as_laminate",
+    "MEMBRANE_FORMULAS", "SHEAR_FACTOR",
 ]
 
 #: ``Km`` as eq. 5b prints it (``1 - nu^2``) or as in Shivakumar's table (``1 - nu``).
@@ -242,6 +253,10 @@ class Laminate:
     ----------
     plies : tuple of Ply
         At least one; either every ply gives ``G13, G23`` or none does.
+    yield_strength : float or None
+        The laminate's through-thickness compressive strength, Pa (:data:`~phaseimpact.parameters.STRENGTH_RANGE`),
+        if known: it drives the validity check of elastic Hertz contact, as a
+        :class:`~phaseimpact.parameters.Material`'s does.
 
     Examples
     --------
@@ -258,6 +273,7 @@ class Laminate:
     """
 
     plies: tuple
+    yield_strength: float | None = None
 
     def __post_init__(self):
         plies = tuple(self.plies) if isinstance(self.plies, list | tuple) else None
@@ -266,6 +282,11 @@ class Laminate:
         shear = {p.has_shear for p in plies}
         require("G13", [p.G13 for p in plies], "given for every ply or for none", len(shear) == 1)
         object.__setattr__(self, "plies", plies)
+        if self.yield_strength is not None:
+            low, high = STRENGTH_RANGE
+            require("yield_strength", self.yield_strength, f"{low:g} <= yield_strength <= {high:g} (Pa), or absent",
+                    _finite(self.yield_strength) and low <= self.yield_strength <= high)
+            object.__setattr__(self, "yield_strength", float(self.yield_strength))
 
     @property
     def thickness(self) -> float:
@@ -658,3 +679,78 @@ def transversely_isotropic_compliance(E_p: float, nu_p: float, E_t: float, nu_tp
     M = 2 * math.sqrt((C11 * C33 - C13**2) / (C11 * (1 / G_t + 2 / (math.sqrt(C11 * C33) + C13))))
     return 1.0 / M
 
+
+
+def top_ply_compliance(laminate: Laminate) -> float:
+    """The half-space term of the contact compliance ``eta`` (eq. 4) of a laminate's impacted face.
+
+    :func:`transversely_isotropic_compliance` of the top ply taken as a solid transversely isotropic
+    about the surface normal (docs/physics.md §8): in the surface plane the rotation average of the
+    ply's ``Q`` (:func:`isotropic_part`: ``nu_p = U4/U1``, ``E_p = U1 (1 - nu_p^2)``); through the
+    thickness ``E_t = E2`` (the ply's ``E3``), ``nu_tp = nu12 E2/E1`` (its ``nu31``) and
+    ``G_t = sqrt(G13 G23)``, or ``G12`` without them (the ply's ``G13`` by its transverse isotropy).
+    Chosen over Yang and Sun's ``1/E2`` (:func:`yang_sun_compliance`) because it is exact for an
+    isotropic face, ``(1 - nu^2)/E``: a plate given as isotropic plies keeps eq. 3's ``K``.
+
+    Parameters
+    ----------
+    laminate : Laminate
+
+    Returns
+    -------
+    float
+        1/Pa.
+
+    Raises
+    ------
+    ValueError
+        Naming ``plate.ply[0]`` when its constants give no positive-definite half-space.
+
+    Examples
+    --------
+    >>> from phaseimpact.model.laminate import Laminate, Ply, top_ply_compliance
+    >>> steel = Laminate((Ply.isotropic(2.1e11, 0.3, 7850.0, 0.005),))
+    >>> print(f"{top_ply_compliance(steel) * 2.1e11:.12f}")
+    0.910000000000
+    """
+    ply = laminate.plies[0]
+    U1, U4 = isotropic_part(ply.reduced_stiffness())
+    nu_p = U4 / U1
+    G_t = math.sqrt(ply.G13 * ply.G23) if ply.has_shear else ply.G12
+    try:
+        return transversely_isotropic_compliance(U1 * (1 - nu_p**2), nu_p, ply.E2, ply.nu12 * ply.E2 / ply.E1, G_t)
+    except ValueError as exc:
+        raise ValueError(f"plate.ply[0] (the impacted ply) as a half-space: {exc}") from None
+
+
+def as_laminate(plate, h: float) -> Laminate:
+    """A plate as a :class:`Laminate`: itself, or an isotropic :class:`~phaseimpact.parameters.Material`
+    as one ply of thickness ``h`` (its ``yield_strength`` kept).
+
+    Parameters
+    ----------
+    plate : Laminate or Material
+    h : float
+        Plate thickness, m (read for a Material only).
+
+    Returns
+    -------
+    Laminate
+
+    Raises
+    ------
+    TypeError
+        For a plate that is neither.
+
+    Examples
+    --------
+    >>> from phaseimpact.model.laminate import as_laminate
+    >>> from phaseimpact.parameters import STEEL
+    >>> print(f"{as_laminate(STEEL, 0.005).abd()[2][0, 0]:.6g} N m")
+    2403.85 N m
+    """
+    if isinstance(plate, Laminate):
+        return plate
+    if not isinstance(plate, Material):
+        raise TypeError(f"plate has the wrong type ({type(plate).__name__}); allowed: Material or Laminate")
+    return Laminate((Ply.isotropic(plate.E, plate.nu, plate.rho, h),), yield_strength=plate.yield_strength)

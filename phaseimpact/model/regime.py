@@ -20,7 +20,7 @@ from ..parameters import LENGTH_RANGE, is_number, require, require_in
 
 __all__ = [
     "olsson_rigidity", "infinite_plate_impedance", "zener_lambda", "plate_mass", "mass_ratio", "impact_regime",
-    "model_for_regime", "REGIMES", "SMALL_MASS_RATIO", "LARGE_MASS_RATIO",
+    "model_for_regime", "regime_report", "REGIMES", "SMALL_MASS_RATIO", "LARGE_MASS_RATIO",
 ]
 
 #: Olsson's (2000) bounds on the impactor/plate mass ratio: below the first the response is
@@ -261,3 +261,64 @@ def model_for_regime(regime: str) -> str:
     if regime not in _MODELS:
         raise ValueError(f"regime = {regime!r} is out of range; allowed: one of {', '.join(REGIMES)}")
     return _MODELS[regime]
+
+
+def regime_report(params, plate, geometry) -> dict:
+    """Which plate model an impact calls for, as ``params`` reports it (docs/physics.md §8).
+
+    Parameters
+    ----------
+    params : Parameters
+        ``M1``, ``K``, ``v`` and ``target`` are read.
+    plate : Material or Laminate
+        The plate (a Material is taken as one isotropic ply of thickness ``geometry.h``).
+    geometry : Geometry
+        ``a`` and ``h`` are read.
+
+    Returns
+    -------
+    dict
+        ``D_star`` (Olsson's rigidity of the reduced bending stiffness, N m), ``plate_impedance``
+        (N s/m), ``zener_lambda``, ``plate_mass`` (the whole plate, kg), ``mass_ratio``, ``regime``
+        (one of :data:`REGIMES`), ``regime_model`` (``"infinite"`` or ``"plate"``) and
+        ``regime_warning``: a sentence when ``params.target`` is a model that does not fit the
+        regime, else None. A rigid target is not judged by the mass ratio (it is the ``lambda -> 0``
+        limit of the infinite plate: see ``zener_lambda``).
+
+    Examples
+    --------
+    The seed (a 20 mm steel ball, 0.263 kg, on a 1.233 kg plate) is just below Olsson's 0.23:
+
+    >>> from phaseimpact.model.regime import regime_report
+    >>> from phaseimpact.parameters import STEEL, Geometry, seed_parameters
+    >>> r = regime_report(seed_parameters(v=1.0), STEEL, Geometry())
+    >>> print(f"{r['mass_ratio']:.3f} {r['regime']}, lambda = {r['zener_lambda']:.3g}")
+    0.213 wave-controlled, lambda = 2.49
+    >>> print(r["regime_warning"])
+    the impact is wave-controlled (M1/M_p = 0.213 < 0.23, Olsson 2000): the plate's flexural waves do not reach
+    its edge during the contact, so the spring-mass plate (target plate) is out of its range; the infinite plate is
+    the model
+    """
+    from .laminate import as_laminate
+
+    laminate = as_laminate(plate, geometry.h)
+    D_star = olsson_rigidity(laminate.reduced_bending_stiffness())
+    impedance = infinite_plate_impedance(D_star, laminate.areal_density)
+    M_p = plate_mass(laminate.areal_density, geometry.a)
+    ratio = mass_ratio(params.M1, M_p)
+    regime = impact_regime(ratio)
+    model = model_for_regime(regime)
+    warning = None
+    if params.target not in (model, "rigid"):
+        bound = (f"< {SMALL_MASS_RATIO:g}" if regime == REGIMES[0] else
+                 f"> {LARGE_MASS_RATIO:g}" if regime == REGIMES[2] else
+                 f"between {SMALL_MASS_RATIO:g} and {LARGE_MASS_RATIO:g}")
+        why = ("the plate's flexural waves do not reach its edge during the contact" if model == "infinite"
+               else "the plate's edge takes part in the contact")
+        name = {"plate": "the spring-mass plate", "free": "the free plate mass"}.get(params.target, params.target)
+        warning = (f"the impact is {regime} (M1/M_p = {ratio:.3g} {bound}, Olsson 2000): {why}, so {name} "
+                   f"(target {params.target}) is out of its range; the "
+                   + ("infinite" if model == "infinite" else "spring-mass") + " plate is the model")
+    return {"D_star": D_star, "plate_impedance": impedance,
+            "zener_lambda": zener_lambda(params.M1, params.v, params.K, impedance), "plate_mass": M_p,
+            "mass_ratio": ratio, "regime": regime, "regime_model": model, "regime_warning": warning}
