@@ -534,7 +534,7 @@ def test_an_ascii_standard_output_gets_escapes_not_an_error():
 
 def test_plot_of_an_unreadable_file_says_permission_denied(tmp_path, monkeypatch):
     """nb-plot-unreadable: not 'not a readable HDF5 file (truncated, damaged or foreign)'."""
-    from phaseimpact import archive
+    from phaseimpact.archive import _files  # where an archive is first opened
 
     path = tmp_path / "s.nc"
     path.write_bytes(b"\x89HDF\r\n\x1a\n" + bytes(100))
@@ -547,7 +547,7 @@ def test_plot_of_an_unreadable_file_says_permission_denied(tmp_path, monkeypatch
                 raise PermissionError(13, "Permission denied", str(path))
             return real_open(name, flags, *args, **kwargs)
 
-        monkeypatch.setattr(archive.os, "open", denied)
+        monkeypatch.setattr(_files.os, "open", denied)
     code, _, err = run(["plot", str(path), "--out", str(tmp_path / "p.png")])
     assert code == 2 and err.strip() == f"phaseimpact: error: archive {str(path)!r} cannot be read: Permission denied"
 

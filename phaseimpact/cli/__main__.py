@@ -1,7 +1,8 @@
 """``python -m phaseimpact.cli``: the console script ``phaseimpact``."""
 
-import sys
+if __name__ == "__main__":  # a module scan that imports the package must not run it
+    import sys
 
-from . import main
+    from . import main
 
-sys.exit(main())
+    sys.exit(main())

@@ -519,7 +519,7 @@ class LawEntry:
         form's memory branch keeps (:data:`FORMS`); sets the law's flag :data:`MEMORY`.
     plastic : bool
         The contact yields (Thornton): pressure, contact radius and validity are read from the
-        elastic-plastic model (:func:`phaseimpact.case.plastic_contact`), not from Hertz.
+        elastic-plastic model (:func:`phaseimpact.model.contact.plastic_contact`), not from Hertz.
 
     Examples
     --------
