@@ -318,19 +318,19 @@ def test_engine_kernels_are_compiled_without_reference_counting():
     time of a trajectory)."""
     from numba.core.registry import CPUDispatcher
 
-    from phaseimpact.integrate import _dop853_stages, dop853, driver, events, radau5
+    from phaseimpact.integrate import _dop853_stages, dop853, driver, events, phase, radau5, rk4, rootfind
     from phaseimpact.model import laws
     from phaseimpact.model import rhs as rhs_module
 
     counted = set()
-    for module in (laws, rhs_module, events, _dop853_stages, dop853, radau5, driver):
+    for module in (laws, rhs_module, events, _dop853_stages, dop853, radau5, phase, rootfind, driver, rk4):
         for name, obj in vars(module).items():
             if isinstance(obj, CPUDispatcher) and obj.py_func.__module__ == module.__name__:
                 assert "_nrt" in obj.targetoptions, f"{module.__name__}.{name} is not declared through _jit"
                 if obj.targetoptions["_nrt"]:
                     counted.add(name)
-    assert counted == {"run", "_run", "run_block", "run_rk4", "_open_logs", "_grow", "_push_event", "_push_sample",
-                       "_summarize", "workspace"}
+    assert counted == {"run", "_run", "run_block", "run_rk4", "open_logs", "_grow", "push_event", "push_sample",
+                       "summarize", "workspace"}
 
 
 def _python_calls_of_compiled_functions():
@@ -420,7 +420,7 @@ def test_no_kernel_returns_an_array():
     from numba.core import types
     from numba.core.registry import CPUDispatcher
 
-    from phaseimpact.integrate import _dop853_stages, dop853, driver, events, radau5
+    from phaseimpact.integrate import _dop853_stages, dop853, driver, events, phase, radau5, rk4, rootfind
     from phaseimpact.model import laws
     from phaseimpact.model import rhs as rhs_module
 
@@ -439,7 +439,7 @@ def test_no_kernel_returns_an_array():
 
     assert any(holds_array(t) for t in return_types(driver._grow))  # the check sees an array return
     checked = 0
-    for module in (laws, rhs_module, events, _dop853_stages, dop853, radau5, driver):
+    for module in (laws, rhs_module, events, _dop853_stages, dop853, radau5, phase, rootfind, driver, rk4):
         for name, obj in vars(module).items():
             if isinstance(obj, CPUDispatcher) and obj.py_func.__module__ == module.__name__ \
                     and not obj.targetoptions["_nrt"]:

@@ -24,6 +24,7 @@ import pytest
 from phaseimpact import _signals, archive, seed_parameters, simulate, simulate_many
 from phaseimpact.integrate import api
 from phaseimpact.integrate import driver as d
+from phaseimpact.integrate.rk4 import run_rk4
 from phaseimpact.model import as_law, pack
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -60,7 +61,7 @@ def test_a_byte_in_the_pipe_stops_a_compiled_run_at_its_next_look(pipe):
     # the RK4 loop looks too
     code, c, y0, t_end, *_ = _run_args(seed_parameters(v=1.0, kappa=3e9), "hunt-crossley", 2e-3)
     os.write(pipe, b"\x02")
-    stopped = d.run_rk4(code, c, y0, t_end, d.SAVE_SUMMARY, np.empty(0), api.MAX_STEPS, 1e-8, 1)[0]  # 2e5 steps
+    stopped = run_rk4(code, c, y0, t_end, d.SAVE_SUMMARY, np.empty(0), api.MAX_STEPS, 1e-8, 1)[0]  # 2e5 steps
     assert d.STATUSES[int(stopped[d.S_STATUS])] == "interrupted" and stopped[d.S_NSTEPS] == d.POLL_STEPS
 
 

@@ -20,6 +20,7 @@ from . import driver as d
 from . import radau5
 from .events import EVENT_KINDS
 from .result import Columns, Trajectory
+from .rk4 import run_rk4
 
 __all__ = ["simulate", "simulate_many", "Scales", "scales", "INTEGRATORS", "RTOL_RANGE"]
 
@@ -383,7 +384,7 @@ def simulate(params: Parameters, law: ContactLaw | str = "paper", t_end: float |
         if native is not None:
             native.reset()
         if rk4_step:
-            out = d.run_rk4(law.code, c, y0, horizon, save_kind, times, int(max_steps), rk4_step, int(every))
+            out = run_rk4(law.code, c, y0, horizon, save_kind, times, int(max_steps), rk4_step, int(every))
         else:
             out = d.run(law.code, c, y0, horizon, rtol, default_atol if atol is None else _atol(params, rtol, atol),
                         s.max_step, settle, stop_kind, stop_count, save_kind, times, int(max_steps), MAX_EVENTS,

@@ -2,17 +2,17 @@
 
 Between events the right-hand side of the current mode is smooth and a stepper advances it:
 adaptive DOP853 (:mod:`.dop853`), Radau IIA for the rest of a phase whose DOP853 steps stay at
-their stability limit (:mod:`.radau5`); or, in an entry of its own (:func:`run_rk4`), the seed's
-fixed-step RK4 (eq. 8 read literally, no events resolved, so its chattering across ``deltadot = 0``
-stays visible).
+their stability limit (:mod:`.radau5`); or, in an entry of its own (:mod:`.rk4`), the seed's
+fixed-step RK4.
 After each step the event table (:mod:`.events`) is checked for crossings (:func:`_advance`
-steps while none fires); each crossing is located by Brent's method on the step's dense output
-(Radau's roots then polished on steps: :func:`_locate_events`); recorded events are logged
+steps while none fires); each crossing is located on the step's dense output (:mod:`.rootfind`;
+Radau's roots then polished on steps: :func:`_locate_events`); recorded events are logged
 (:func:`_record`), and at the first event that changes the phase the state is taken from a
 fresh step that ends exactly at the root, the transition is applied and the run restarts there
 in the new mode (:func:`_restart`). :func:`run` holds the loop and the run's logs.
 
-Scratch vectors are rows of a few arrays with named rows (``Y_*``, ``G_*``, ``U_*``, ``RK_*``).
+Scratch vectors are rows of a few arrays with named rows (``Y_*``, ``G_*``, ``U_*``); the kernels of
+one phase (its states, dense output, event values) are in :mod:`.phase`.
 
 Everything here is scalars and small arrays (numba's subset); strings, objects and messages are
 made outside (:mod:`.api`). The same source runs uncompiled with ``NUMBA_DISABLE_JIT=1``.
@@ -26,10 +26,9 @@ import numpy as np
 
 from .._jit import allocating, kernel
 from .._signals import interrupted
-from ..model.laws import PLAIN, STUCK, dent_depth
+from ..model.laws import STUCK
 from ..model.rhs import (
     FLIGHT,
-    M2_,
     RIGID_,
     SPRINGS_,
     V1,
@@ -44,7 +43,6 @@ from ..model.rhs import (
     relative_slip,
     rhs,
     rhs_integration,
-    spring_force,
     stick_margin,
     stuck_pair_energy,
 )
@@ -72,12 +70,23 @@ from .events import (
     crossed,
     departure_sign,
     energy_limit_of,
-    event_value,
-    event_values,
     initial_mode,
     restarts,
     transition,
 )
+from .phase import (
+    TIME,
+    copy_values,
+    dense,
+    event_at,
+    fresh_step,
+    integration_state,
+    phase_events,
+    phase_tolerances,
+    physical,
+    regularised,
+)
+from .rootfind import brent, locate, polish_root, s_at_time
 
 # Run status (numerical health) and why the run stopped.
 SUCCESS, STEP_SIZE_COLLAPSE, TOO_MANY_STEPS, NON_FINITE, INTERRUPTED = range(5)
@@ -107,8 +116,6 @@ N_SMP_COLUMNS = 8
  S_FIRST_STICK_MARGIN, S_FIRST_STICK_T, S_NSTEPS, S_NFEV, S_MODE) = range(19)
 N_SUMMARY = 19
 
-TIME = 5  # the physical time in the integration state u
-
 # Named rows of a run's scratch arrays (an allocation costs about 30 ns, a row of one array nothing).
 # Physical states (5 numbers): the rate at the state, a step's end state and rate, the state and rate
 # at a root, and at a trial point of the root finders.
@@ -124,43 +131,22 @@ U_U, U_FU, U_NEW, U_FU_NEW, U_ROOT, U_FU_ROOT, U_TRIAL, U_TMP, U_ATOL = range(9)
 U_STAGES = 9
 U_DENSE = U_STAGES + N_STAGES
 N_U_ROWS = U_DENSE + N_DENSE
-# RK4 (5 numbers): the rate at the state, a stage's argument, the step's end and its rate, the stages.
-RK_F, RK_TMP, RK_Y_NEW, RK_F_NEW, RK_K = range(5)
-N_RK_ROWS = RK_K + 4
 # The running extremes of a run (``stats``), kept up to date by the kernels that take steps.
 STAT_MAX_FORCE, STAT_MAX_INDENTATION = 0, 1
 N_STATS = 2
 #: Event kinds (``events.EVENT_KINDS``): the length of a run's counts.
 N_KINDS = len(EVENT_KINDS)
-TIME_COLUMN = N_EVENTS  # a pseudo event column: the physical time minus a target
 #: Smallest step reduction after a rejection when the observed order is used (else MIN_FACTOR).
 OBSERVED_MIN_FACTOR = 0.01
-#: Absolute tolerance of ``deltadot`` in a slip, relative to that of the velocities (which is
-#: rtol times the impact speed). A slip's own speed near the critical damping is 1e-7 to 1e-12 of
-#: the impact speed, and its sign decides whether the slip re-sticks. 1e-3 is the largest power of
-#: ten that counts the seed case at v = 7 m/s, kappa = 4.16865e11 right (4 stick phases; 1e-2 gives
-#: 2); it costs a stiff creep far above kappa_c about five times the Radau steps (161 -> 777).
-SLIP_SPEED_SCALE = 1e-3
 _TINY = np.finfo(np.float64).tiny
 _EPS = np.finfo(np.float64).eps
-
-
-# Copies go element by element on purpose: a slice or row assignment makes numba compile its
-# shape-mismatch error messages (string formatting), which was half of the first-ever compile.
-# The length comes from dst, not from an argument: a constant argument (5, N_STATE) would
-# compile a copy of the function for each value.
-@kernel
-def _copy(src, dst):
-    """``dst[:] = src[:len(dst)]``."""
-    for j in range(dst.shape[0]):
-        dst[j] = src[j]
 
 
 @allocating
 def _grow(a, n):
     """``a`` in an array twice as long, its first ``n`` rows kept."""
     b = np.empty((max(2 * a.shape[0], 16),) + a.shape[1:], a.dtype)
-    _copy(a.ravel(), b.ravel()[:n * (a.size // max(a.shape[0], 1))])
+    copy_values(a.ravel(), b.ravel()[:n * (a.size // max(a.shape[0], 1))])
     return b
 
 
@@ -177,7 +163,7 @@ def _write_event(ev, n, t, kind, mode, y, force):
 
 
 @allocating
-def _push_event(ev, n, t, kind, mode, y, force):
+def push_event(ev, n, t, kind, mode, y, force):
     """Append an event to the log ``ev`` (columns ``EV_*``, grown by doubling); returns the log
     and its new length."""
     if n == ev.shape[0]:
@@ -187,7 +173,7 @@ def _push_event(ev, n, t, kind, mode, y, force):
 
 
 @allocating
-def _push_sample(smp, n, t, y, mode, force):
+def push_sample(smp, n, t, y, mode, force):
     """Append a sample to ``smp`` (columns ``SMP_*``, grown by doubling); returns the samples and
     their new length."""
     if n == smp.shape[0]:
@@ -199,245 +185,6 @@ def _push_sample(smp, n, t, y, mode, force):
     row[SMP_FORCE] = force
     row[SMP_MODE] = mode
     return smp, n + 1
-
-
-@kernel
-def _regularised(side):
-    """A contact phase integrated in w = sqrt(|delta|) and dt = w ds (side +-1)."""
-    return side == 1 or side == -1
-
-
-@kernel
-def _physical_state(code, mode, side, u, y):
-    """Physical state ``y`` at the integration state ``u``."""
-    y[X1] = u[X1] if not _regularised(side) else u[X2] + side * u[0] * u[0]
-    for j in range(1, 5):
-        y[j] = u[j]
-    if relative_slip(code, mode, side):
-        y[V1] = u[V1] + u[V2]
-
-
-@kernel
-def _physical(code, c, mode, side, u, y, f):
-    """Physical state ``y`` and ``dy/dt`` (``f``) at the integration state ``u``; returns the force."""
-    _physical_state(code, mode, side, u, y)
-    return rhs(code, c, y, mode, f)
-
-
-@kernel
-def _integration_state(code, mode, side, y, t, u):
-    """The integration state of a phase on ``side`` (see :func:`~phaseimpact.model.rhs.rhs_integration`)."""
-    u[X1] = y[X1] if not _regularised(side) else math.sqrt(abs(y[X1] - y[X2]))
-    for j in range(1, 5):
-        u[j] = y[j]
-    if relative_slip(code, mode, side):
-        u[V1] = y[V1] - y[V2]
-    u[TIME] = t
-
-
-@kernel(inline="always")  # in the root finders' loops: a call costs more than it
-def _dense(c, side, F, u0, s0, h, s, out):
-    """The integration state at ``s`` inside the step ``[s0, s0 + h]`` from ``u0``: the flight's
-    closed form, or the interpolant ``F`` of the step (:func:`_interpolant`)."""
-    if side == FLIGHT:
-        flight.state_at(c, F, u0, s0, s, out)
-    else:
-        dop853.dense_eval(F, u0, s0, h, s, out)
-
-
-@kernel
-def _phase_tolerances(code, mode, side, atol, out):
-    """Absolute tolerances of the integration state: ``atol`` is (x1, x2, v1, v2, W, t, w).
-
-    A :func:`relative_slip` phase controls ``deltadot`` relative to itself: its absolute
-    tolerance is that of the velocities times :data:`SLIP_SPEED_SCALE`.
-
-    The work ``W`` is a quadrature along the motion that feeds nothing back: it is left out of the
-    step control (an infinite tolerance), as ODE codes do with quadratures. Controlled, it chose
-    nearly every rejected step inside contact while the motion itself was far more accurate.
-    """
-    out[0] = atol[0] if not _regularised(side) else atol[6]
-    for j in range(1, 6):
-        out[j] = atol[j]
-    out[WORK] = math.inf
-    if relative_slip(code, mode, side):
-        out[V1] = atol[V1] * SLIP_SPEED_SCALE
-
-
-@kernel
-def _events(code, c, mode, side, energy_limit, u, y, f, force, g):
-    """Event values at ``u`` (physical ``y``, ``f``, ``force``) into ``g``."""
-    event_values(code, c, y, f, force, mode, energy_limit, g)
-    if _regularised(side) and dent_depth(code, c) == 0.0:  # past a dent the gap is not w: its value from y
-        g[DELTA] = side * u[0]  # delta = side w^2 keeps its sign through its root; w changes sign there
-    if relative_slip(code, mode, side):
-        g[DELTADOT] = u[V1]  # as integrated: x1dot - x2dot of the physical state has lost its digits
-
-
-@kernel
-def _event_at(code, c, mode, side, energy_limit, target, column, F, u0, s0, h, s, us, ys, fs):
-    """Event function ``column`` at ``s`` on the dense output of the step; the pseudo column
-    ``TIME_COLUMN`` is the physical time minus ``target`` (horizon and output times of a
-    regularised phase, where ``t`` is a component of the state). The physical state is left in
-    ``ys``; the right-hand side (``fs``) is evaluated only for the force's rate, the one event that
-    reads it."""
-    _dense(c, side, F, u0, s0, h, s, us)
-    if column == TIME_COLUMN:
-        return us[TIME] - target
-    if column == DELTA and _regularised(side) and dent_depth(code, c) == 0.0:
-        return side * us[0]  # delta = side w^2 keeps its sign through its root; w changes sign there
-    if column == DELTADOT and relative_slip(code, mode, side):
-        return us[V1]
-    if column == FORCE_RATE:
-        force = _physical(code, c, mode, side, us, ys, fs)
-    else:
-        _physical_state(code, mode, side, us, ys)
-        force = math.nan
-    return event_value(code, c, ys, fs, force, mode, energy_limit, column)
-
-
-@kernel
-def _brent(code, c, mode, side, energy_limit, target, column, F, u0, s0, h, xa, xb, fa, fb, us, ys, fs):
-    """Zero of event ``column`` in ``[xa, xb]`` (signs of ``fa``, ``fb`` differ): scipy's brentq."""
-    xpre, xcur, fpre, fcur = xa, xb, fa, fb
-    xblk = fblk = spre = scur = 0.0
-    xtol = 4.0 * _EPS * max(abs(xa), abs(xb))
-    for _ in range(200):
-        if fpre != 0 and fcur != 0 and (fpre < 0) != (fcur < 0):
-            xblk, fblk = xpre, fpre
-            spre = scur = xcur - xpre
-        if abs(fblk) < abs(fcur):
-            xpre, xcur, xblk = xcur, xblk, xcur
-            fpre, fcur, fblk = fcur, fblk, fcur
-        tol = 0.5 * (xtol + 4.0 * _EPS * abs(xcur))
-        sbis = 0.5 * (xblk - xcur)
-        if fcur == 0 or abs(sbis) < tol:
-            return xcur
-        if abs(spre) > tol and abs(fcur) < abs(fpre):
-            if xpre == xblk:
-                stry = -fcur * (xcur - xpre) / (fcur - fpre)
-            else:
-                dpre = (fpre - fcur) / (xpre - xcur)
-                dblk = (fblk - fcur) / (xblk - xcur)
-                stry = -fcur * (fblk * dblk - fpre * dpre) / (dblk * dpre * (fblk - fpre))
-            if 2.0 * abs(stry) < min(abs(spre), 3.0 * abs(sbis) - tol):
-                spre, scur = scur, stry
-            else:
-                spre = scur = sbis
-        else:
-            spre = scur = sbis
-        xpre, fpre = xcur, fcur
-        xcur += scur if abs(scur) > tol else (tol if sbis > 0 else -tol)
-        fcur = _event_at(code, c, mode, side, energy_limit, target, column, F, u0, s0, h, xcur, us, ys, fs)
-    return xcur
-
-
-@kernel
-def _flight_rate(c, column, y):
-    """The time derivative of event ``column`` in a flight, where ``delta``, ``deltadot`` and the
-    reach test are the events that can fire (NaN for the others)."""
-    if column == DELTA:
-        return y[V1] - y[V2]
-    if column == DELTADOT:
-        return 0.0 if c[RIGID_] > 0 else spring_force(c, y[X2]) / c[M2_]  # -x2'', the projectile uniform
-    if column == REACH:
-        return -y[V1]  # -(x1 + A), the reach A constant in a flight
-    return math.nan
-
-
-@kernel
-def _flight_root(code, c, mode, side, energy_limit, column, F, u0, s0, h, a, b, fa, fb, us, ys, fs):
-    """Zero of event ``column`` in ``[a, b]`` (signs of ``fa``, ``fb`` differ) of a flight: Newton's
-    method on the closed form with the event's exact rate, kept inside the bracket (bisection
-    where it would leave it). Three or four evaluations where Brent's method on the same bracket
-    takes ten or more, each an elliptic function."""
-    # converged when the Newton correction is below 1e-14 of the bracket: the next one would be
-    # below rounding (quadratic convergence); the event values' own rounding keeps the correction
-    # from shrinking to machine epsilon of s
-    tol = 1e-14 * (b - a) + 4.0 * _EPS * abs(b)
-    x = a - fa * (b - a) / (fb - fa)
-    for _ in range(100):
-        g = _event_at(code, c, mode, side, energy_limit, 0.0, column, F, u0, s0, h, x, us, ys, fs)
-        if g == 0:
-            return x
-        left = (g < 0) == (fa < 0)
-        if left:
-            a, fa = x, g
-        else:
-            b, fb = x, g
-        rate = _flight_rate(c, column, ys)
-        step = g / rate if rate != 0 else math.inf
-        inward = step < 0 if left else step > 0  # towards the bracket's other end, where the root is
-        if b - a <= tol or (inward and abs(step) <= tol):
-            return x
-        x -= step
-        if not (a < x < b):
-            x = 0.5 * (a + b)
-    return x
-
-
-@kernel
-def _locate(code, c, mode, side, energy_limit, column, F, u0, s0, h, s1, g_start, g_end, us, ys, fs):
-    """The first zero of event ``column`` in ``[s0, s1]`` on the dense output.
-
-    A run that restarts on this event's zero (``g_start`` a signed tiny number) may leave it
-    and come back within one step, as a brief slip does near a grazing stick break: the dense
-    output is then sampled to find where the function has left zero, and the return is
-    bracketed from there.
-    """
-    expected = 1.0 if g_start > 0 else -1.0
-    a, ga, b, gb = s0, g_start, s1, g_end
-    g0 = _event_at(code, c, mode, side, energy_limit, 0.0, column, F, u0, s0, h, s0, us, ys, fs)
-    if g0 * expected <= 0 and side == FLIGHT and column == DELTA:
-        # a flight step holds at most one extremum of delta (flight.py): if delta left zero and
-        # came back, it was away at that extremum, the zero of deltadot
-        d0 = _event_at(code, c, mode, side, energy_limit, 0.0, np.int64(DELTADOT), F, u0, s0, h, s0, us, ys, fs)
-        d1 = _event_at(code, c, mode, side, energy_limit, 0.0, np.int64(DELTADOT), F, u0, s0, h, s1, us, ys, fs)
-        if not d0 * d1 < 0:
-            return -math.inf
-        a = _flight_root(code, c, mode, side, energy_limit, np.int64(DELTADOT), F, u0, s0, h, s0, s1, d0, d1, us, ys,
-                         fs)
-        ga = _event_at(code, c, mode, side, energy_limit, 0.0, column, F, u0, s0, h, a, us, ys, fs)
-        if ga * expected <= 0:
-            return -math.inf
-    elif g0 * expected <= 0:
-        found_away = False
-        prev = s0
-        for i in range(1, 33):
-            s = s0 + (s1 - s0) * i / 32.0
-            gv = _event_at(code, c, mode, side, energy_limit, 0.0, column, F, u0, s0, h, s, us, ys, fs)
-            if not found_away:
-                if gv * expected > 0:
-                    found_away = True
-                    a, ga = s, gv
-            elif gv * expected <= 0:
-                a, b, gb = prev, s, gv
-                ga = _event_at(code, c, mode, side, energy_limit, 0.0, column, F, u0, s0, h, a, us, ys, fs)
-                break
-            prev = s
-        if not found_away:
-            return -math.inf  # the excursion is below what the step resolves: the caller shrinks it
-    if gb == 0 or ga * gb > 0:
-        return b
-    if side == FLIGHT and not math.isnan(_flight_rate(c, column, ys)):
-        return _flight_root(code, c, mode, side, energy_limit, column, F, u0, s0, h, a, b, ga, gb, us, ys, fs)
-    return _brent(code, c, mode, side, energy_limit, 0.0, column, F, u0, s0, h, a, b, ga, gb, us, ys, fs)
-
-
-@kernel
-def _s_at_time(code, c, mode, side, F, u0, s0, h, time, us, ys, fs):
-    """Where on the step the physical time is ``time`` (it lies within the step): ``s`` itself in
-    a plain phase, a root of ``t(s)`` on the dense output in a regularised one."""
-    if not _regularised(side):
-        return time
-    s1 = s0 + h
-    fa = u0[TIME] - time
-    if fa >= 0:
-        return s0
-    fb = _event_at(code, c, mode, side, 0.0, time, np.int64(TIME_COLUMN), F, u0, s0, h, s1, us, ys, fs)
-    if fb <= 0:
-        return s1
-    return _brent(code, c, mode, side, 0.0, time, np.int64(TIME_COLUMN), F, u0, s0, h, s0, s1, fa, fb, us, ys, fs)
 
 
 _ADV_END, _ADV_STEP, _ADV_COLLAPSE, _ADV_LIMIT = range(4)
@@ -514,7 +261,7 @@ def _advance(code, c, mode, side, s, t_end, u, fu, y, f, force, h_abs, rtol, ato
     h = 0.0
     h_next = h_abs
     force_new = force
-    s_bound = t_end if not _regularised(side) else math.inf  # a plain phase ends on the horizon
+    s_bound = t_end if not regularised(side) else math.inf  # a plain phase ends on the horizon
     while u[TIME] < t_end:
         if steps >= steps_left:
             return _ADV_LIMIT, s, h, h_abs, h_next, force, force_new, steps, evaluations
@@ -528,7 +275,7 @@ def _advance(code, c, mode, side, s, t_end, u, fu, y, f, force, h_abs, rtol, ato
             ok, h_next, spent = True, flight_step, 0
         else:
             # a regularised phase advances the time by w ds: its cap on the time step is one on s
-            h_abs = min(h_abs, max_step if not _regularised(side) else max_step / max(abs(u[0]), w_floor))
+            h_abs = min(h_abs, max_step if not regularised(side) else max_step / max(abs(u[0]), w_floor))
             if radau5.due(stiff):  # entered from an accepted state, so that every step has one method
                 evaluations += radau5.enter(code, c, mode, side, u, fu, rtol, atol, stiff)
             if radau5.active(stiff):
@@ -542,7 +289,7 @@ def _advance(code, c, mode, side, s, t_end, u, fu, y, f, force, h_abs, rtol, ato
             return _ADV_COLLAPSE, s, h, h_next, h_next, force, force_new, steps, evaluations
         h = s_new - s
         steps += 1
-        if not _regularised(side):
+        if not regularised(side):
             u_new[TIME] = s_new  # t' = 1: the time is s itself, without the sum's rounding
             for j in range(5):
                 y_new[j] = u_new[j]
@@ -551,23 +298,23 @@ def _advance(code, c, mode, side, s, t_end, u, fu, y, f, force, h_abs, rtol, ato
                 y_new[V1] = u_new[V1] + u_new[V2]
                 f_new[V1] = fu_new[V1] + fu_new[V2]
         else:
-            force_new = _physical(code, c, mode, side, u_new, y_new, f_new)
+            force_new = physical(code, c, mode, side, u_new, y_new, f_new)
             evaluations += 1
         if side != FLIGHT and not radau5.active(stiff):
             radau5.watch(stiff, h * damping_rate(code, c, u_new, mode, side))
-        _events(code, c, mode, side, energy_limit, u_new, y_new, f_new, force_new, g_new)
+        phase_events(code, c, mode, side, energy_limit, u_new, y_new, f_new, force_new, g_new)
         any_fired = False
         for col in range(N_EVENTS):
             fired[col] = crossed(col, g_old, g_new)
             any_fired = any_fired or fired[col]
-        if any_fired or u_new[TIME] >= next_sample or (_regularised(side) and u_new[TIME] >= t_end):
+        if any_fired or u_new[TIME] >= next_sample or (regularised(side) and u_new[TIME] >= t_end):
             return _ADV_STEP, s, h, h_abs, h_next, force, force_new, steps, evaluations
         s = s_new
-        _copy(u_new, u)
-        _copy(fu_new, fu)
-        _copy(y_new, y)
-        _copy(f_new, f)
-        _copy(g_new, g_old)
+        copy_values(u_new, u)
+        copy_values(fu_new, fu)
+        copy_values(y_new, y)
+        copy_values(f_new, f)
+        copy_values(g_new, g_old)
         force = force_new
         h_abs = h_next
         stats[STAT_MAX_FORCE] = max(stats[STAT_MAX_FORCE], force)
@@ -575,71 +322,12 @@ def _advance(code, c, mode, side, s, t_end, u, fu, y, f, force, h_abs, rtol, ato
     return _ADV_END, s, h, h_abs, h_next, force, force_new, steps, evaluations
 
 
-# inlined at numba level, like the two below: with their flight branch LLVM stopped inlining
-# these small dispatchers into the run, which cost runs without a flight 5-9 %
-@kernel(inline="always")
-def _fresh_step(code, c, mode, side, s, u, fu, h, K, u_new, fu_new, stiff):
-    """A step of exactly ``h`` from ``(s, u)`` with the phase's current method (the state at a
-    root, a stop or the horizon); returns the evaluations spent."""
-    if side == FLIGHT:
-        flight.state_at(c, K, u, s, s + h, u_new)  # K: the flight's invariants
-        rhs_integration(code, c, u_new, mode, side, fu_new)
-        return 0
-    if radau5.active(stiff):
-        return radau5.fixed_step(code, c, mode, side, s, u, fu, h, stiff, u_new, fu_new)
-    dop853.step(code, c, mode, side, u, fu, h, K, u_new, fu_new)
-    return 12
-
-
-@kernel
-def _polish_root(code, c, mode, side, energy_limit, column, s, u, fu, s_end, g_start, g_end, x, K, u_r, fu_r, stiff,
-                 ys, fs, gs):
-    """Refine the root ``x`` of event ``column`` (found on the step's interpolant) on steps from
-    ``s`` that end at the trial points (Illinois' regula falsi in ``[s, s_end]``).
-
-    Radau's collocation polynomial is of order 3 between its end points: where an event crosses
-    slowly (a creep coming to rest) its root could lie several per cent of the phase away. The
-    end point of a step carries the method's full order. Returns ``(root, evaluations)``.
-    """
-    evaluations = 0
-    a, fa, b, fb = s, g_start, s_end, g_end
-    if not (fa * fb < 0 and a < x < b):
-        return x, evaluations
-    best, f_best = x, math.inf
-    kept = 0
-    for _ in range(40):
-        evaluations += _fresh_step(code, c, mode, side, s, u, fu, x - s, K, u_r, fu_r, stiff)
-        force = _physical(code, c, mode, side, u_r, ys, fs)
-        _events(code, c, mode, side, energy_limit, u_r, ys, fs, force, gs)
-        fx = gs[column]
-        if abs(fx) < f_best:
-            best, f_best = x, abs(fx)
-        if fx == 0:
-            break
-        if (fx < 0) == (fa < 0):
-            a, fa = x, fx
-            if kept == -1:
-                fb *= 0.5  # the same end kept twice: Illinois' halving keeps the secant moving
-            kept = -1
-        else:
-            b, fb = x, fx
-            if kept == 1:
-                fa *= 0.5
-            kept = 1
-        if b - a <= 1e-12 * (s_end - s) + 4.0 * _EPS * abs(b):
-            break
-        x = (a * fb - b * fa) / (fb - fa)
-        if not (a < x < b):
-            x = 0.5 * (a + b)
-    return best, evaluations
-
-
 @kernel(inline="always")
 def _interpolant(code, c, mode, side, u, fu, u_new, fu_new, h, K, F, tmp, stiff):
-    """The last step's interpolant into ``F`` (a flight's invariants, see :func:`_dense`); returns the
+    """The last step's interpolant into ``F`` (a flight's invariants, see :func:`dense`); returns the
     evaluations spent."""
     if side == FLIGHT:
-        _copy(K[0], F[0])  # the flight's invariants
+        copy_values(K[0], F[0])  # the flight's invariants
         return 0
     if radau5.active(stiff):
         radau5.dense_coefficients(stiff, F)
@@ -656,10 +344,10 @@ def _phase_step(code, c, mode, side, u, fu, rtol, atol, t_end, max_step, w_floor
         return 0.0  # the phase starts on the horizon (an event at t_end): no step follows
     if side == FLIGHT:
         return interval  # closed form: its steps only bracket events (see _advance)
-    if _regularised(side):
+    if regularised(side):
         interval /= max(abs(u[0]), w_floor)
     return dop853.initial_step(code, c, mode, side, u, fu, rtol, atol, interval,
-                               max_step if not _regularised(side) else max_step / max(abs(u[0]), w_floor), tmp, f1)
+                               max_step if not regularised(side) else max_step / max(abs(u[0]), w_floor), tmp, f1)
 
 
 @kernel
@@ -678,7 +366,7 @@ def _locate_events(code, c, mode, side, settle, energy_limit, s, h, s_horizon, u
     unresolved = False
     for col in range(N_EVENTS):
         if fired[col]:
-            roots[col] = _locate(code, c, mode, side, energy_limit, col, F, u, s, h, s_new, g_old[col], g_new[col],
+            roots[col] = locate(code, c, mode, side, energy_limit, col, F, u, s, h, s_new, g_old[col], g_new[col],
                                  us, ys, fs)
             if roots[col] == -math.inf:
                 if h > 1e3 * (np.nextafter(s, np.inf) - s):
@@ -692,17 +380,17 @@ def _locate_events(code, c, mode, side, settle, energy_limit, s, h, s_horizon, u
     if fired[DELTADOT] and not fired[DELTA]:
         # an extreme of delta inside the step on the other side of zero: a contact (or
         # separation) and its return both fell inside the step
-        d_ext = _event_at(code, c, mode, side, energy_limit, 0.0, np.int64(DELTA), F, u, s, h, roots[DELTADOT], us, ys,
+        d_ext = event_at(code, c, mode, side, energy_limit, 0.0, np.int64(DELTA), F, u, s, h, roots[DELTADOT], us, ys,
                           fs)
         if d_ext * g_old[DELTA] < 0:
             fired[DELTA] = True
-            roots[DELTA] = _brent(code, c, mode, side, energy_limit, 0.0, np.int64(DELTA), F, u, s, h, s,
+            roots[DELTA] = brent(code, c, mode, side, energy_limit, 0.0, np.int64(DELTA), F, u, s, h, s,
                                   roots[DELTADOT], g_old[DELTA], d_ext, us, ys, fs)
     for col in range(N_EVENTS):
         if fired[col] and (restarts(code, col, mode, settle) or col == ENERGY) and roots[col] < s_restart:
             restart_col, s_restart = col, roots[col]
     if restart_col >= 0 and radau5.active(stiff):
-        s_restart, spent = _polish_root(code, c, mode, side, energy_limit, restart_col, s, u, fu, s_new,
+        s_restart, spent = polish_root(code, c, mode, side, energy_limit, restart_col, s, u, fu, s_new,
                                         g_old[restart_col], g_new[restart_col], s_restart, K, u_r, fu_r, stiff, ys,
                                         fs, gs)
         evaluations += spent
@@ -728,14 +416,14 @@ def _record(code, c, mode, side, settle, stop_kind, stop_count, s, h, s_restart,
             break
         fired[best] = False
         if radau5.active(stiff):  # the state from a step to the root: the polynomial is of order 3
-            evaluations += _fresh_step(code, c, mode, side, s, u, fu, roots[best] - s, K, us, fu_r, stiff)
+            evaluations += fresh_step(code, c, mode, side, s, u, fu, roots[best] - s, K, us, fu_r, stiff)
         else:
-            _dense(c, side, F, u, s, h, roots[best], us)
-        f_ev = _physical(code, c, mode, side, us, ys, fs)
+            dense(c, side, F, u, s, h, roots[best], us)
+        f_ev = physical(code, c, mode, side, us, ys, fs)
         kind = FORCE_PEAK if best == FORCE_RATE else REVERSAL
         if best == REACH:
             kind = SETTLED  # recorded only: the run goes on
-        t_ev = us[TIME] if _regularised(side) else roots[best]
+        t_ev = us[TIME] if regularised(side) else roots[best]
         _write_event(ev, n_ev, t_ev, kind, mode, ys, f_ev)
         n_ev += 1
         counts[kind] += 1
@@ -758,25 +446,25 @@ def _restart(code, c, settle, column, mode, side, s, s_restart, h_next, u, fu, u
     evaluations = 0
     h_r = s_restart - s
     if h_r > 0:
-        evaluations += _fresh_step(code, c, mode, side, s, u, fu, h_r, K, u_r, fu_r, stiff)
+        evaluations += fresh_step(code, c, mode, side, s, u, fu, h_r, K, u_r, fu_r, stiff)
     else:
-        _copy(u, u_r)
-    t = s_restart if not _regularised(side) else u_r[TIME]
-    _physical(code, c, mode, side, u_r, y_r, f_r)
+        copy_values(u, u_r)
+    t = s_restart if not regularised(side) else u_r[TIME]
+    physical(code, c, mode, side, u_r, y_r, f_r)
     if column == STICK_BREAK and c[SPRINGS_] > 0 and c[RIGID_] == 0:
         onto_stuck_orbit(c, pair_energy, y_r)
     kind, mode, action = transition(code, c, column, y_r, mode, settle)
     if kind == STICK:
         pair_energy = stuck_pair_energy(c, y_r)
-    _copy(y_r, y)
+    copy_values(y_r, y)
     force = rhs(code, c, y, mode, f)
     new_side = contact_side(code, c, y, mode)
-    _integration_state(code, mode, new_side, y, t, u)
-    s = t if not _regularised(new_side) else 0.0
+    integration_state(code, mode, new_side, y, t, u)
+    s = t if not regularised(new_side) else 0.0
     rhs_integration(code, c, u, mode, new_side, fu)
     evaluations += 2
     radau5.reset(stiff)  # a new phase starts explicit
-    _phase_tolerances(code, mode, new_side, atol, atol_u)
+    phase_tolerances(code, mode, new_side, atol, atol_u)
     if new_side != side:  # the independent variable changes: a fresh initial step
         side = new_side
         h_abs = _phase_step(code, c, mode, side, u, fu, rtol, atol_u, t_end, max_step, w_floor, tmp, f_tmp)
@@ -789,7 +477,7 @@ def _restart(code, c, settle, column, mode, side, s, s_restart, h_next, u, fu, u
 
 
 @allocating
-def _open_logs(y, mode, force, save_kind, times):
+def open_logs(y, mode, force, save_kind, times):
     """The event log and the samples of a run from ``y`` at t = 0 (its contact when it starts on one,
     its first samples). Returns ``(ev, n_ev, smp, n_s, counts, i_time)``: ``counts`` per event kind,
     ``i_time`` the next output time (``SAVE_TIMES``)."""
@@ -802,92 +490,15 @@ def _open_logs(y, mode, force, save_kind, times):
     counts = np.zeros(N_KINDS, np.int64)
     i_time = 0
     if y[X1] == y[X2] and y[V1] > y[V2]:
-        ev, n_ev = _push_event(ev, n_ev, 0.0, np.int64(CONTACT), mode, y, force)
+        ev, n_ev = push_event(ev, n_ev, 0.0, np.int64(CONTACT), mode, y, force)
         counts[CONTACT] += 1
     if save_kind == SAVE_STEPS:
-        smp, n_s = _push_sample(smp, n_s, 0.0, y, mode, force)
+        smp, n_s = push_sample(smp, n_s, 0.0, y, mode, force)
     if save_kind == SAVE_TIMES:
         while i_time < times.shape[0] and times[i_time] <= 0.0:
-            smp, n_s = _push_sample(smp, n_s, times[i_time], y, mode, force)
+            smp, n_s = push_sample(smp, n_s, times[i_time], y, mode, force)
             i_time += 1
     return ev, n_ev, smp, n_s, counts, i_time
-
-
-@allocating(python=True, nogil=True)
-def run_rk4(code, c, y0, t_end, save_kind, times, max_steps, rk4_step, rk4_every):
-    """The seed's classic RK4: eq. 8's plain right-hand side, fixed steps ``rk4_step``, nothing
-    resolved (a contact or separation is logged where ``delta`` changed sign, its time interpolated
-    linearly); with ``save_kind`` steps, every ``rk4_every``-th step is kept. Returns what
-    :func:`run` does. An entry of its own, not a branch of :func:`run`: the first compile of a run
-    that does not ask for it leaves it out."""
-    y = y0.copy()
-    t = 0.0
-    mode = np.int64(PLAIN)
-    rows = np.empty((N_RK_ROWS, 5))
-    tmp = rows[RK_TMP]
-    y_new = rows[RK_Y_NEW]
-    f_new = rows[RK_F_NEW]
-    k1 = rows[RK_K]
-    k2 = rows[RK_K + 1]
-    k3 = rows[RK_K + 2]
-    k4 = rows[RK_K + 3]
-    force = rhs(code, c, y, mode, rows[RK_F])
-    nfev = 1
-    nsteps = 0
-    energy_limit = energy_limit_of(code, c, y0)
-    ev, n_ev, smp, n_s, counts, _ = _open_logs(y, mode, force, save_kind, times)
-    max_force = force
-    max_indentation = y[X1] - y[X2]
-    status = SUCCESS
-    reason = HORIZON
-    while t < t_end:
-        if nsteps >= max_steps:
-            status, reason = TOO_MANY_STEPS, FAILED_STOP
-            break
-        if nsteps % POLL_STEPS == 0 and nsteps > 0 and interrupted():
-            status, reason = INTERRUPTED, FAILED_STOP
-            break
-        h = min(rk4_step, t_end - t)
-        rhs(code, c, y, mode, k1)
-        for j in range(5):
-            tmp[j] = y[j] + 0.5 * h * k1[j]
-        rhs(code, c, tmp, mode, k2)
-        for j in range(5):
-            tmp[j] = y[j] + 0.5 * h * k2[j]
-        rhs(code, c, tmp, mode, k3)
-        for j in range(5):
-            tmp[j] = y[j] + h * k3[j]
-        rhs(code, c, tmp, mode, k4)
-        finite = True
-        for j in range(5):
-            y_new[j] = y[j] + h / 6.0 * (k1[j] + 2.0 * k2[j] + 2.0 * k3[j] + k4[j])
-            finite = finite and math.isfinite(y_new[j])
-        nfev += 4
-        nsteps += 1
-        if not finite:
-            status, reason = NON_FINITE, FAILED_STOP
-            break
-        force_new = rhs(code, c, y_new, mode, f_new)
-        d_old = y[X1] - y[X2]
-        d_new = y_new[X1] - y_new[X2]
-        if (d_old <= 0 < d_new) or (d_old > 0 >= d_new):
-            kind = CONTACT if d_new > 0 else SEPARATION
-            t_cross = t + h * d_old / (d_old - d_new)  # linear: RK4 resolves no event
-            ev, n_ev = _push_event(ev, n_ev, t_cross, kind, mode, y_new, force_new)
-            counts[kind] += 1
-        t += h
-        for j in range(5):
-            y[j] = y_new[j]
-        max_force = max(max_force, force_new)
-        max_indentation = max(max_indentation, d_new)
-        if save_kind == SAVE_STEPS and (nsteps % rk4_every == 0 or t >= t_end):
-            smp, n_s = _push_sample(smp, n_s, t, y, mode, force_new)
-        if energy(code, c, y) > energy_limit:
-            reason = RUNAWAY_STOP
-            break
-    summary = _summarize(code, c, y0, y, mode, status, reason, t, max_force, max_indentation, counts,
-                         n_ev, ev, nsteps, nfev)
-    return summary, ev[:n_ev], smp[:n_s], y
 
 
 @allocating(python=True, nogil=True)  # runs side by side in threads (phaseimpact.train's orbit diagrams)
@@ -900,7 +511,7 @@ def run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count,
     phase turns stiff) with events: steps while nothing happens (:func:`_advance`), then on the
     step where something did, the events located (:func:`_locate_events`), the recorded ones
     logged (:func:`_record`) and the run restarted at the first that changes the phase
-    (:func:`_restart`). The seed's RK4 is :func:`run_rk4`.
+    (:func:`_restart`). The seed's RK4 is :func:`.rk4.run_rk4`.
 
     The loop is :func:`_run`, which :func:`run_block` calls too: a first compile makes the two
     entries from it (:func:`phaseimpact.integrate.precompile.warmup` compiles both ahead).
@@ -930,7 +541,7 @@ def _run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count
     nfev = 1
     nsteps = 0
     energy_limit = energy_limit_of(code, c, y0)
-    ev, n_ev, smp, n_s, counts, i_time = _open_logs(y, mode, force, save_kind, times)
+    ev, n_ev, smp, n_s, counts, i_time = open_logs(y, mode, force, save_kind, times)
     max_force = force
     max_indentation = y[X1] - y[X2]
     status = SUCCESS
@@ -961,13 +572,13 @@ def _run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count
     # figure gets a sample every sixteenth of the target's period
     flight_step = math.inf if save_kind != SAVE_STEPS else max_step / 2
     side = contact_side(code, c, y, mode)
-    _integration_state(code, mode, side, y, 0.0, u)
-    _phase_tolerances(code, mode, side, atol, atol_u)
+    integration_state(code, mode, side, y, 0.0, u)
+    phase_tolerances(code, mode, side, atol, atol_u)
     s = 0.0
     rhs_integration(code, c, u, mode, side, fu)
     nfev += 1
     quiet = np.int64(DELTA)
-    _events(code, c, mode, side, energy_limit, u, y, f, force, g_old)
+    phase_events(code, c, mode, side, energy_limit, u, y, f, force, g_old)
     _quiet_start(quiet, y, mode, g_old)
     h_abs = _phase_step(code, c, mode, side, u, fu, rtol, atol_u, t_end, max_step, w_floor, tmp6, fu_new)
     nfev += 1
@@ -1019,10 +630,10 @@ def _run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count
         restart_col = np.int64(-1)
         s_restart = math.inf
         s_horizon = math.inf
-        if _regularised(side) and u_new[TIME] >= t_end:
+        if regularised(side) and u_new[TIME] >= t_end:
             nfev += _interpolant(code, c, mode, side, u, fu, u_new, fu_new, h, K6, F6, tmp6, stiff)
             have_dense = True
-            s_horizon = _s_at_time(code, c, mode, side, F6, u, s, h, t_end, us, ys, fs)
+            s_horizon = s_at_time(code, c, mode, side, F6, u, s, h, t_end, us, ys, fs)
         if any_fired:
             if not have_dense:
                 nfev += _interpolant(code, c, mode, side, u, fu, u_new, fu_new, h, K6, F6, tmp6, stiff)
@@ -1045,40 +656,40 @@ def _run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count
         if stop_record >= 0:
             # stopped at a recorded event: the state there from a fresh step that ends at it
             if stop_record > s:
-                nfev += _fresh_step(code, c, mode, side, s, u, fu, stop_record - s, K6, u_r, fu_r, stiff)
-                _copy(u_r, u)
-                if not _regularised(side):
+                nfev += fresh_step(code, c, mode, side, s, u, fu, stop_record - s, K6, u_r, fu_r, stiff)
+                copy_values(u_r, u)
+                if not regularised(side):
                     u[TIME] = stop_record
-            force = _physical(code, c, mode, side, u, y, f)
+            force = physical(code, c, mode, side, u, y, f)
             reason = ASKED_STOP
             break
         if save_kind == SAVE_TIMES:
             # samples up to where this step's motion stands: its end, the restart or the horizon
             t_seg = u_new[TIME]
             if restart_col >= 0:
-                _dense(c, side, F6, u, s, h, s_restart, us)
-                t_seg = s_restart if not _regularised(side) else us[TIME]
+                dense(c, side, F6, u, s, h, s_restart, us)
+                t_seg = s_restart if not regularised(side) else us[TIME]
             elif s_horizon < math.inf:
                 t_seg = t_end
             while i_time < times.shape[0] and times[i_time] <= t_seg:
                 if not have_dense:
                     nfev += _interpolant(code, c, mode, side, u, fu, u_new, fu_new, h, K6, F6, tmp6, stiff)
                     have_dense = True
-                s_i = _s_at_time(code, c, mode, side, F6, u, s, h, times[i_time], us, ys, fs)
-                _dense(c, side, F6, u, s, h, s_i, us)
-                f_i = _physical(code, c, mode, side, us, ys, fs)
-                smp, n_s = _push_sample(smp, n_s, times[i_time], ys, mode, f_i)
+                s_i = s_at_time(code, c, mode, side, F6, u, s, h, times[i_time], us, ys, fs)
+                dense(c, side, F6, u, s, h, s_i, us)
+                f_i = physical(code, c, mode, side, us, ys, fs)
+                smp, n_s = push_sample(smp, n_s, times[i_time], ys, mode, f_i)
                 i_time += 1
         if restart_col < 0 and s_horizon < math.inf:
             # a regularised phase reaches the horizon inside the step: the state there from a fresh step
-            nfev += _fresh_step(code, c, mode, side, s, u, fu, s_horizon - s, K6, u_r, fu_r, stiff)
-            _copy(u_r, u)
+            nfev += fresh_step(code, c, mode, side, s, u, fu, s_horizon - s, K6, u_r, fu_r, stiff)
+            copy_values(u_r, u)
             u[TIME] = t_end  # without the root finder's residue
-            force = _physical(code, c, mode, side, u, y, f)
+            force = physical(code, c, mode, side, u, y, f)
             max_force = max(max_force, force)
             max_indentation = max(max_indentation, y[X1] - y[X2])
             if save_kind == SAVE_STEPS:
-                smp, n_s = _push_sample(smp, n_s, t_end, y, mode, force)
+                smp, n_s = push_sample(smp, n_s, t_end, y, mode, force)
             break
         if restart_col >= 0:
             kind, mode, action, side, s, t, h_abs, force, pair_energy, spent = _restart(
@@ -1087,15 +698,15 @@ def _run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count
             nfev += spent
             if kind == SILENT:  # a restart only (the pair at its centre): nothing to log
                 quiet = restart_col
-                _events(code, c, mode, side, energy_limit, u, y, f, force, g_old)
+                phase_events(code, c, mode, side, energy_limit, u, y, f, force, g_old)
                 _quiet_start(quiet, y, mode, g_old)
                 continue
-            ev, n_ev = _push_event(ev, n_ev, t, kind, mode, y, force)
+            ev, n_ev = push_event(ev, n_ev, t, kind, mode, y, force)
             counts[kind] += 1
             max_force = max(max_force, force)
             max_indentation = max(max_indentation, y[X1] - y[X2])
             if save_kind == SAVE_STEPS:
-                smp, n_s = _push_sample(smp, n_s, t, y, mode, force)
+                smp, n_s = push_sample(smp, n_s, t, y, mode, force)
             if action == STOP_SETTLED:
                 reason = SETTLED_STOP
                 break
@@ -1106,34 +717,34 @@ def _run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count
                 reason = ASKED_STOP
                 break
             quiet = restart_col
-            _events(code, c, mode, side, energy_limit, u, y, f, force, g_old)
+            phase_events(code, c, mode, side, energy_limit, u, y, f, force, g_old)
             _quiet_start(quiet, y, mode, g_old)
             continue
         # the whole step stands
         s = s_new
-        _copy(u_new, u)
-        _copy(fu_new, fu)
-        _copy(y_new, y)
-        _copy(f_new, f)
+        copy_values(u_new, u)
+        copy_values(fu_new, fu)
+        copy_values(y_new, y)
+        copy_values(f_new, f)
         force = force_new
-        _copy(g_new, g_old)
+        copy_values(g_new, g_old)
         h_abs = h_next
         max_force = max(max_force, force)
         max_indentation = max(max_indentation, y[X1] - y[X2])
         if save_kind == SAVE_STEPS:
-            smp, n_s = _push_sample(smp, n_s, u[TIME], y, mode, force)
+            smp, n_s = push_sample(smp, n_s, u[TIME], y, mode, force)
 
     if radau5.failed(stiff):  # a step to a root did not converge: what follows it is not the motion
         status, reason = STEP_SIZE_COLLAPSE, FAILED_STOP
     t = u[TIME]
 
-    summary = _summarize(code, c, y0, y, mode, status, reason, t, max_force, max_indentation, counts,
+    summary = summarize(code, c, y0, y, mode, status, reason, t, max_force, max_indentation, counts,
                          n_ev, ev, nsteps, nfev)
     return summary, ev[:n_ev], smp[:n_s], y
 
 
 @allocating
-def _summarize(code, c, y0, y, mode, status, reason, t_stop, max_force, max_indentation, counts,
+def summarize(code, c, y0, y, mode, status, reason, t_stop, max_force, max_indentation, counts,
                n_ev, ev, nsteps, nfev):
     """The summary vector of a run (indices ``S_*``); undefined entries are NaN."""
     s = np.full(N_SUMMARY, np.nan)
@@ -1233,12 +844,12 @@ def run_block(code, C, Y0, t_end, rtol, ATOL, max_step, settle, stop_kind, stop_
             break
         # the run reads its own copies: a row of the shared batch arrays would share their reference
         # count, which run (an allocating function) updates, between the threads (a contended cache line)
-        _copy(C[i], c)
-        _copy(Y0[i], y0)
-        _copy(ATOL[i], atol)
+        copy_values(C[i], c)
+        copy_values(Y0[i], y0)
+        copy_values(ATOL[i], atol)
         s, events, _, _ = _run(code, c, y0, t_end[i], rtol, atol, max_step[i], settle, stop_kind, stop_count,
                                np.int64(SAVE_SUMMARY), empty, max_steps, max_events, stiff_after)
-        _copy(s, summary[i])
+        copy_values(s, summary[i])
         permanent = s[S_OUTCOME] == PERMANENT_STICK
         st_count[i] = stick_points(events, s[S_T_STOP], permanent, st_t[i], st_delta[i], st_dwell[i])
         if s[S_STATUS] == INTERRUPTED:
