@@ -118,9 +118,9 @@ N_SUMMARY = 19
 
 # Named rows of a run's scratch arrays (an allocation costs about 30 ns, a row of one array nothing).
 # Physical states (5 numbers): the rate at the state, a step's end state and rate, the state and rate
-# at a root, and at a trial point of the root finders.
-Y_F, Y_NEW, Y_F_NEW, Y_ROOT, Y_F_ROOT, Y_TRIAL, Y_F_TRIAL = range(7)
-N_Y_ROWS = 7
+# at a root, and of the root finders; the run's state, its start and its first stick.
+Y_F, Y_NEW, Y_F_NEW, Y_ROOT, Y_F_ROOT, Y_TRIAL, Y_F_TRIAL, Y_STATE, Y_START, Y_FIRST_STICK = range(10)
+N_Y_ROWS = 10
 # Event values (N_EVENTS numbers): at a trial point, before and after the step, the roots.
 G_TRIAL, G_OLD, G_NEW, G_ROOTS = range(4)
 N_G_ROWS = 4
@@ -143,7 +143,7 @@ _EPS = np.finfo(np.float64).eps
 
 
 @allocating
-def _grow(a, n):
+def grow(a, n):
     """``a`` in an array twice as long, its first ``n`` rows kept."""
     b = np.empty((max(2 * a.shape[0], 16),) + a.shape[1:], a.dtype)
     copy_values(a.ravel(), b.ravel()[:n * (a.size // max(a.shape[0], 1))])
@@ -160,31 +160,6 @@ def _write_event(ev, n, t, kind, mode, y, force):
     for j in range(5):
         row[EV_Y + j] = y[j]
     row[EV_FORCE] = force
-
-
-@allocating
-def push_event(ev, n, t, kind, mode, y, force):
-    """Append an event to the log ``ev`` (columns ``EV_*``, grown by doubling); returns the log
-    and its new length."""
-    if n == ev.shape[0]:
-        ev = _grow(ev, n)
-    _write_event(ev, n, t, kind, mode, y, force)
-    return ev, n + 1
-
-
-@allocating
-def push_sample(smp, n, t, y, mode, force):
-    """Append a sample to ``smp`` (columns ``SMP_*``, grown by doubling); returns the samples and
-    their new length."""
-    if n == smp.shape[0]:
-        smp = _grow(smp, n)
-    row = smp[n]
-    row[SMP_T] = t
-    for j in range(5):
-        row[SMP_Y + j] = y[j]
-    row[SMP_FORCE] = force
-    row[SMP_MODE] = mode
-    return smp, n + 1
 
 
 _ADV_END, _ADV_STEP, _ADV_COLLAPSE, _ADV_LIMIT = range(4)
@@ -351,14 +326,18 @@ def _phase_step(code, c, mode, side, u, fu, rtol, atol, t_end, max_step, w_floor
 
 
 @kernel
-def _locate_events(code, c, mode, side, settle, energy_limit, s, h, s_horizon, u, fu, g_old, g_new, fired, roots, K,
-                   F, u_r, fu_r, stiff, us, ys, fs, gs):
-    """Locate the events that fired in the step ``[s, s + h]`` on its interpolant ``F``: their roots
-    into ``roots`` (``fired`` cleared where the crossing did not happen or falls after the horizon
-    ``s_horizon``), and the first root that restarts the run (polished on steps when the step was
-    Radau's). Returns ``(unresolved, restart_col, s_restart, evaluations)``: ``unresolved`` when an
-    event left and re-crossed zero inside the step (the caller retries a smaller step);
-    ``restart_col`` -1 when no event restarts the run."""
+def _locate_events(code, ws, s_horizon):
+    """Locate the events that fired in the step ``[s, s + h]`` (record ``R_S``, ``R_H``) on its
+    interpolant: their roots into row ``G_ROOTS`` (``fired`` cleared where the crossing did not
+    happen or falls after the horizon ``s_horizon``), and the first root that restarts the run
+    (polished on steps when the step was Radau's). Returns ``(unresolved, restart_col, s_restart,
+    evaluations)``: ``unresolved`` when an event left and re-crossed zero inside the step (the
+    caller retries a smaller step); ``restart_col`` -1 when no event restarts the run."""
+    real, ints, c, g, ur, yr, fired, stiff = (ws[W_REAL], ws[W_INT], ws[W_C], ws[W_G], ws[W_U], ws[W_Y], ws[W_FIRED],
+                                              ws[W_STIFF])
+    mode, side, energy_limit, s, h = ints[I_MODE], ints[I_SIDE], real[R_ENERGY_LIMIT], real[R_S], real[R_H]
+    g_old, g_new, roots = g[G_OLD], g[G_NEW], g[G_ROOTS]
+    u, F, us, ys, fs = ur[U_U], ur[U_DENSE:], ur[U_TRIAL], yr[Y_TRIAL], yr[Y_F_TRIAL]
     s_new = s + h
     evaluations = 0
     restart_col = np.int64(-1)
@@ -367,7 +346,7 @@ def _locate_events(code, c, mode, side, settle, energy_limit, s, h, s_horizon, u
     for col in range(N_EVENTS):
         if fired[col]:
             roots[col] = locate(code, c, mode, side, energy_limit, col, F, u, s, h, s_new, g_old[col], g_new[col],
-                                 us, ys, fs)
+                                us, ys, fs)
             if roots[col] == -math.inf:
                 if h > 1e3 * (np.nextafter(s, np.inf) - s):
                     unresolved = True
@@ -381,29 +360,32 @@ def _locate_events(code, c, mode, side, settle, energy_limit, s, h, s_horizon, u
         # an extreme of delta inside the step on the other side of zero: a contact (or
         # separation) and its return both fell inside the step
         d_ext = event_at(code, c, mode, side, energy_limit, 0.0, np.int64(DELTA), F, u, s, h, roots[DELTADOT], us, ys,
-                          fs)
+                         fs)
         if d_ext * g_old[DELTA] < 0:
             fired[DELTA] = True
             roots[DELTA] = brent(code, c, mode, side, energy_limit, 0.0, np.int64(DELTA), F, u, s, h, s,
-                                  roots[DELTADOT], g_old[DELTA], d_ext, us, ys, fs)
+                                 roots[DELTADOT], g_old[DELTA], d_ext, us, ys, fs)
     for col in range(N_EVENTS):
-        if fired[col] and (restarts(code, col, mode, settle) or col == ENERGY) and roots[col] < s_restart:
+        if fired[col] and (restarts(code, col, mode, ints[I_SETTLE] != 0) or col == ENERGY) and roots[col] < s_restart:
             restart_col, s_restart = col, roots[col]
     if restart_col >= 0 and radau5.active(stiff):
-        s_restart, spent = polish_root(code, c, mode, side, energy_limit, restart_col, s, u, fu, s_new,
-                                        g_old[restart_col], g_new[restart_col], s_restart, K, u_r, fu_r, stiff, ys,
-                                        fs, gs)
+        s_restart, spent = polish_root(code, c, mode, side, energy_limit, restart_col, s, u, ur[U_FU], s_new,
+                                       g_old[restart_col], g_new[restart_col], s_restart, ur[U_STAGES:U_DENSE],
+                                       ur[U_ROOT], ur[U_FU_ROOT], stiff, ys, fs, g[G_TRIAL])
         evaluations += spent
     return False, restart_col, s_restart, evaluations
 
 
 @kernel
-def _record(code, c, mode, side, settle, stop_kind, stop_count, s, h, s_restart, fired, roots, u, fu, F, K, us, fu_r,
-            stiff, ys, fs, ev, n_ev, counts, stats):
+def _record(code, ws, ev, s_restart):
     """Log the recorded events (force peaks, reversals, reach) that fired in the step up to
-    ``s_restart``, in time order, into ``ev`` (which has a free row for each event column); the
-    running extremes ``stats`` follow them. Returns ``(n_ev, stop_record, evaluations)``:
-    ``stop_record`` is the root of the event the run was asked to stop at (-1 if none)."""
+    ``s_restart``, in time order (:func:`log_event`; ``ev`` has a free row for each event column);
+    the running extremes follow them. Returns ``(stop_record, evaluations)``: ``stop_record`` is the
+    root of the event the run was asked to stop at (-1 if none)."""
+    ints, c, ur, yr, fired, stiff, counts, stats = (ws[W_INT], ws[W_C], ws[W_U], ws[W_Y], ws[W_FIRED], ws[W_STIFF],
+                                                    ws[W_COUNTS], ws[W_STATS])
+    mode, side, settle, s, h = ints[I_MODE], ints[I_SIDE], ints[I_SETTLE] != 0, ws[W_REAL][R_S], ws[W_REAL][R_H]
+    roots, u, us, ys, fs = ws[W_G][G_ROOTS], ur[U_U], ur[U_TRIAL], yr[Y_TRIAL], yr[Y_F_TRIAL]
     evaluations = 0
     stop_record = -1.0
     while True:
@@ -416,368 +398,498 @@ def _record(code, c, mode, side, settle, stop_kind, stop_count, s, h, s_restart,
             break
         fired[best] = False
         if radau5.active(stiff):  # the state from a step to the root: the polynomial is of order 3
-            evaluations += fresh_step(code, c, mode, side, s, u, fu, roots[best] - s, K, us, fu_r, stiff)
+            evaluations += fresh_step(code, c, mode, side, s, u, ur[U_FU], roots[best] - s, ur[U_STAGES:U_DENSE], us,
+                                      ur[U_FU_ROOT], stiff)
         else:
-            dense(c, side, F, u, s, h, roots[best], us)
+            dense(c, side, ur[U_DENSE:], u, s, h, roots[best], us)
         f_ev = physical(code, c, mode, side, us, ys, fs)
         kind = FORCE_PEAK if best == FORCE_RATE else REVERSAL
         if best == REACH:
             kind = SETTLED  # recorded only: the run goes on
         t_ev = us[TIME] if regularised(side) else roots[best]
-        _write_event(ev, n_ev, t_ev, kind, mode, ys, f_ev)
-        n_ev += 1
-        counts[kind] += 1
+        log_event(ws, ev, t_ev, kind, mode, ys, f_ev)
         stats[STAT_MAX_FORCE] = max(stats[STAT_MAX_FORCE], f_ev)
         stats[STAT_MAX_INDENTATION] = max(stats[STAT_MAX_INDENTATION], ys[X1] - ys[X2])
-        if kind == stop_kind and counts[kind] >= stop_count:
+        if kind == ints[I_STOP_KIND] and counts[kind] >= ints[I_STOP_COUNT]:
             stop_record = roots[best]
             break
-    return n_ev, stop_record, evaluations
+    return stop_record, evaluations
 
 
 @kernel
-def _restart(code, c, settle, column, mode, side, s, s_restart, h_next, u, fu, u_r, fu_r, y_r, f_r, y, f, K, stiff,
-             rtol, atol, atol_u, t_end, max_step, w_floor, tmp, f_tmp, pair_energy):
+def _restart(code, ws, column, s_restart):
     """Restart the run at the root ``s_restart`` of event ``column``: the state there from a fresh
     step that ends there (the stages beyond the root belong to the continuation, not to the
-    motion), the transition, and the new phase in ``u``, ``fu``, ``y``, ``f``, ``atol_u`` (``K``: a
-    flight's invariants). Returns ``(kind, mode, action, side, s, t, h_abs, force, pair_energy,
-    evaluations)``."""
+    motion), the transition, and the new phase in the record (mode, side, ``s``, first step, force)
+    and in rows ``U_U``, ``U_FU``, ``Y_STATE``, ``Y_F``, ``U_ATOL`` (``U_STAGES``: a flight's
+    invariants). Returns ``(kind, action, t)``."""
+    real, ints, c, ur, yr, stiff = ws[W_REAL], ws[W_INT], ws[W_C], ws[W_U], ws[W_Y], ws[W_STIFF]
+    mode, side, s = ints[I_MODE], ints[I_SIDE], real[R_S]
+    u, fu, u_r, K = ur[U_U], ur[U_FU], ur[U_ROOT], ur[U_STAGES:U_DENSE]
+    y, f, y_r = yr[Y_STATE], yr[Y_F], yr[Y_ROOT]
     evaluations = 0
     h_r = s_restart - s
     if h_r > 0:
-        evaluations += fresh_step(code, c, mode, side, s, u, fu, h_r, K, u_r, fu_r, stiff)
+        evaluations += fresh_step(code, c, mode, side, s, u, fu, h_r, K, u_r, ur[U_FU_ROOT], stiff)
     else:
         copy_values(u, u_r)
     t = s_restart if not regularised(side) else u_r[TIME]
-    physical(code, c, mode, side, u_r, y_r, f_r)
+    physical(code, c, mode, side, u_r, y_r, yr[Y_F_ROOT])
     if column == STICK_BREAK and c[SPRINGS_] > 0 and c[RIGID_] == 0:
-        onto_stuck_orbit(c, pair_energy, y_r)
-    kind, mode, action = transition(code, c, column, y_r, mode, settle)
+        onto_stuck_orbit(c, real[R_PAIR_ENERGY], y_r)
+    kind, mode, action = transition(code, c, column, y_r, mode, ints[I_SETTLE] != 0)
     if kind == STICK:
-        pair_energy = stuck_pair_energy(c, y_r)
+        real[R_PAIR_ENERGY] = stuck_pair_energy(c, y_r)
     copy_values(y_r, y)
-    force = rhs(code, c, y, mode, f)
+    real[R_FORCE] = rhs(code, c, y, mode, f)
     new_side = contact_side(code, c, y, mode)
     integration_state(code, mode, new_side, y, t, u)
     s = t if not regularised(new_side) else 0.0
     rhs_integration(code, c, u, mode, new_side, fu)
     evaluations += 2
     radau5.reset(stiff)  # a new phase starts explicit
-    phase_tolerances(code, mode, new_side, atol, atol_u)
+    phase_tolerances(code, mode, new_side, ws[W_ATOL], ur[U_ATOL])
     if new_side != side:  # the independent variable changes: a fresh initial step
         side = new_side
-        h_abs = _phase_step(code, c, mode, side, u, fu, rtol, atol_u, t_end, max_step, w_floor, tmp, f_tmp)
+        h_abs = _phase_step(code, c, mode, side, u, fu, real[R_RTOL], ur[U_ATOL], real[R_T_END], real[R_MAX_STEP],
+                            real[R_W_FLOOR], ur[U_TMP], ur[U_FU_NEW])
         evaluations += 1
     else:
-        h_abs = max(h_next, h_r)
+        h_abs = max(real[R_H_NEXT], h_r)
     if side == FLIGHT:
         flight.coefficients(c, u, s, K)
-    return kind, mode, action, side, s, t, h_abs, force, pair_energy, evaluations
+    ints[I_MODE], ints[I_SIDE], ints[I_NFEV] = mode, side, ints[I_NFEV] + evaluations
+    real[R_S], real[R_H_ABS] = s, h_abs
+    return kind, action, t
 
 
-@allocating
-def open_logs(y, mode, force, save_kind, times):
-    """The event log and the samples of a run from ``y`` at t = 0 (its contact when it starts on one,
-    its first samples). Returns ``(ev, n_ev, smp, n_s, counts, i_time)``: ``counts`` per event kind,
-    ``i_time`` the next output time (``SAVE_TIMES``)."""
-    # Integer constants passed to compiled callees go as np.int64: a literal argument would compile
-    # a second copy of the callee (and of everything it calls) specialised on that value.
-    ev = np.empty((64, N_EV_COLUMNS))
-    n_ev = np.int64(0)
-    smp = np.empty((256 if save_kind != SAVE_SUMMARY else 1, N_SMP_COLUMNS))
-    n_s = np.int64(0)
-    counts = np.zeros(N_KINDS, np.int64)
-    i_time = 0
+# ------------------------------------------------------------------------------------------------
+# One run: its record and workspace, its logs, the loop
+# ------------------------------------------------------------------------------------------------
+# A run's whole state lives in a workspace (:func:`workspace`): fixed-size arrays made once per
+# thread and chunk of runs (:func:`run_block`) or once per trajectory (:func:`run`), never inside
+# the per-point kernels (:func:`_start`, :func:`_loop`, :func:`summarize`), which allocate nothing:
+# the form a GPU thread needs too. Members of the workspace tuple (numba indexes a tuple's members
+# of different types by constants):
+(W_REAL, W_INT, W_C, W_ATOL, W_Y, W_G, W_FIRED, W_U, W_STATS, W_COUNTS, W_SUMMARY, W_STICKS, W_STIFF) = range(13)
+# The run's record: its scalars (W_REAL) ...
+(R_S, R_H, R_H_ABS, R_H_NEXT, R_FORCE, R_FORCE_NEW, R_T_END, R_RTOL, R_MAX_STEP, R_STIFF_AFTER, R_FLIGHT_STEP,
+ R_W_FLOOR, R_ENERGY_LIMIT, R_PAIR_ENERGY, R_T_STOP, R_CONTACT_T, R_CONTACT_SPEED, R_CONTACT_DURATION, R_RESTITUTION,
+ R_STICK_T, R_T_RUN) = range(21)
+N_REAL = 21
+# ... and its integers (W_INT): phase, counters, options, log lengths (I_N_EV counts the events
+# also when no log is kept: I_LOGGING 0) and the stick points (I_N_STICK of them, those from
+# I_OPEN_STICK on still waiting for their slip).
+(I_MODE, I_SIDE, I_NSTEPS, I_NFEV, I_NEXT_POLL, I_TIME_INDEX, I_N_EV, I_N_S, I_STATUS, I_REASON, I_SETTLE,
+ I_STOP_KIND, I_STOP_COUNT, I_SAVE_KIND, I_MAX_STEPS, I_MAX_EVENTS, I_N_STICK, I_OPEN_STICK, I_LOGGING,
+ I_HAVE_DENSE) = range(20)
+N_INT = 20
+N_ATOL = 7  # absolute tolerances of (x1, x2, v1, v2, W, t, w)
+# Rows of the stick points (W_STICKS): time, depth and dwell of each stick phase.
+ST_T, ST_DELTA, ST_DWELL = range(3)
+#: What :func:`_loop` returns: the run ended, or its logs must grow before it goes on.
+RUN_DONE, RUN_LOG_FULL = range(2)
+
+
+@allocating(python=True)
+def workspace(n_coef, capacity):
+    """The arrays of one run (members ``W_*``), reused run after run; ``capacity`` stick points."""
+    return (np.empty(N_REAL), np.zeros(N_INT, np.int64), np.empty(n_coef), np.empty(N_ATOL),
+            np.empty((N_Y_ROWS, 5)), np.empty((N_G_ROWS, N_EVENTS)), np.zeros(N_EVENTS, np.bool_),
+            np.empty((N_U_ROWS, N_STATE)), np.empty(N_STATS), np.zeros(N_KINDS, np.int64), np.empty(N_SUMMARY),
+            np.empty((3, capacity)), radau5.workspace(0.0))
+
+
+@kernel
+def _set_options(ws, t_end, rtol, max_step, settle, stop_kind, stop_count, save_kind, max_steps, stiff_after):
+    """A run's options into its record (see :func:`run`)."""
+    real, ints = ws[W_REAL], ws[W_INT]
+    real[R_T_END], real[R_RTOL], real[R_MAX_STEP], real[R_STIFF_AFTER] = t_end, rtol, max_step, stiff_after
+    ints[I_SETTLE], ints[I_STOP_KIND], ints[I_STOP_COUNT] = settle, stop_kind, stop_count
+    ints[I_SAVE_KIND], ints[I_MAX_STEPS] = save_kind, max_steps
+
+
+@kernel
+def log_event(ws, ev, t, kind, mode, y, force):
+    """An event of the run: counted, written into the log ``ev`` when the run keeps one (it has a
+    free row: :func:`_room`), and followed by the summary (the first contact's duration and
+    restitution, the first stick, the escape) and the stick points."""
+    real, ints, sticks = ws[W_REAL], ws[W_INT], ws[W_STICKS]
+    if ints[I_LOGGING] != 0:
+        _write_event(ev, ints[I_N_EV], t, kind, mode, y, force)
+    ints[I_N_EV] += 1
+    ws[W_COUNTS][kind] += 1
+    if kind == CONTACT and math.isnan(real[R_CONTACT_T]):
+        real[R_CONTACT_T], real[R_CONTACT_SPEED] = t, y[V1] - y[V2]
+    elif kind == SEPARATION and not math.isnan(real[R_CONTACT_T]) and math.isnan(real[R_CONTACT_DURATION]):
+        real[R_CONTACT_DURATION] = t - real[R_CONTACT_T]
+        if real[R_CONTACT_SPEED] != 0:
+            real[R_RESTITUTION] = -(y[V1] - y[V2]) / real[R_CONTACT_SPEED]
+    n = ints[I_N_STICK]
+    if kind == STICK:
+        if n == 0:
+            real[R_STICK_T] = t
+            copy_values(y, ws[W_Y][Y_FIRST_STICK])
+        if n < sticks.shape[1]:
+            sticks[ST_T, n], sticks[ST_DELTA, n] = t, y[X1] - y[X2]
+        ints[I_N_STICK] = n + 1
+    if kind == SEPARATION and n > 0 and math.isnan(real[R_T_RUN]):
+        real[R_T_RUN] = t
+    if kind == SLIP:
+        _close_sticks(ws, t)
+
+
+@kernel
+def _close_sticks(ws, end):
+    """The stick phases still waiting for their end (a slip, the run's end) end at ``end``."""
+    ints, sticks = ws[W_INT], ws[W_STICKS]
+    for j in range(ints[I_OPEN_STICK], min(ints[I_N_STICK], sticks.shape[1])):
+        sticks[ST_DWELL, j] = end - sticks[ST_T, j]
+    ints[I_OPEN_STICK] = ints[I_N_STICK]
+
+
+@kernel
+def add_sample(ws, smp, t, y, mode, force):
+    """Append a sample to ``smp`` (columns ``SMP_*``; it has a free row: :func:`_room`)."""
+    n = ws[W_INT][I_N_S]
+    row = smp[n]
+    row[SMP_T] = t
+    for j in range(5):
+        row[SMP_Y + j] = y[j]
+    row[SMP_FORCE] = force
+    row[SMP_MODE] = mode
+    ws[W_INT][I_N_S] = n + 1
+
+
+@kernel
+def _room(ws, ev, smp, times):
+    """Whether the logs hold what one more pass of the loop may add: an event per column and the
+    restart's, two samples (steps) or every output time left (times)."""
+    ints = ws[W_INT]
+    samples = 0
+    if ints[I_SAVE_KIND] == SAVE_STEPS:
+        samples = 2
+    elif ints[I_SAVE_KIND] == SAVE_TIMES:
+        samples = times.shape[0] - ints[I_TIME_INDEX]
+    return ints[I_N_EV] + N_EVENTS + 1 <= ev.shape[0] and ints[I_N_S] + samples <= smp.shape[0]
+
+
+@kernel
+def open_logs(ws, ev, smp, times, force):
+    """The logs and the summary's trackers of a run from row ``Y_STATE`` at t = 0 in mode
+    ``I_MODE``: its contact when it starts on one, its first samples, the running extremes."""
+    real, ints, y = ws[W_REAL], ws[W_INT], ws[W_Y][Y_STATE]
+    mode = ints[I_MODE]
+    for k in (I_N_EV, I_N_S, I_N_STICK, I_OPEN_STICK, I_TIME_INDEX, I_NSTEPS):
+        ints[k] = 0
+    ints[I_STATUS], ints[I_REASON] = SUCCESS, HORIZON
+    for k in (R_CONTACT_T, R_CONTACT_SPEED, R_CONTACT_DURATION, R_RESTITUTION, R_STICK_T, R_T_RUN):
+        real[k] = math.nan
+    counts = ws[W_COUNTS]
+    for k in range(counts.shape[0]):
+        counts[k] = 0
     if y[X1] == y[X2] and y[V1] > y[V2]:
-        ev, n_ev = push_event(ev, n_ev, 0.0, np.int64(CONTACT), mode, y, force)
-        counts[CONTACT] += 1
-    if save_kind == SAVE_STEPS:
-        smp, n_s = push_sample(smp, n_s, 0.0, y, mode, force)
-    if save_kind == SAVE_TIMES:
-        while i_time < times.shape[0] and times[i_time] <= 0.0:
-            smp, n_s = push_sample(smp, n_s, times[i_time], y, mode, force)
-            i_time += 1
-    return ev, n_ev, smp, n_s, counts, i_time
+        log_event(ws, ev, 0.0, np.int64(CONTACT), mode, y, force)
+    if ints[I_SAVE_KIND] == SAVE_STEPS:
+        add_sample(ws, smp, 0.0, y, mode, force)
+    if ints[I_SAVE_KIND] == SAVE_TIMES:
+        while ints[I_TIME_INDEX] < times.shape[0] and times[ints[I_TIME_INDEX]] <= 0.0:
+            add_sample(ws, smp, times[ints[I_TIME_INDEX]], y, mode, force)
+            ints[I_TIME_INDEX] += 1
+    ws[W_STATS][STAT_MAX_FORCE] = force
+    ws[W_STATS][STAT_MAX_INDENTATION] = y[X1] - y[X2]
 
 
-@allocating(python=True, nogil=True)  # runs side by side in threads (phaseimpact.train's orbit diagrams)
-def run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count, save_kind, times,
-        max_steps, max_events, stiff_after):
-    """Integrate one trajectory. See :func:`phaseimpact.integrate.simulate` for the meaning.
-
-    Returns ``(summary, events, samples, y_final)``: the event log (columns ``EV_*``) and the
-    samples (columns ``SMP_*``) trimmed to their lengths. Adaptive DOP853 (Radau IIA where a
-    phase turns stiff) with events: steps while nothing happens (:func:`_advance`), then on the
-    step where something did, the events located (:func:`_locate_events`), the recorded ones
-    logged (:func:`_record`) and the run restarted at the first that changes the phase
-    (:func:`_restart`). The seed's RK4 is :func:`.rk4.run_rk4`.
-
-    The loop is :func:`_run`, which :func:`run_block` calls too: a first compile makes the two
-    entries from it (:func:`phaseimpact.integrate.precompile.warmup` compiles both ahead).
-    """
-    return _run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count, save_kind, times,
-                max_steps, max_events, stiff_after)
-
-
-@allocating
-def _run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count, save_kind, times,
-         max_steps, max_events, stiff_after):
-    """:func:`run`'s loop."""
-    c = c.copy()  # the run's own: a law's memory is written into it (model.laws.remember)
-    y = y0.copy()
-    t = 0.0
+@kernel
+def _start(code, ws, ev, smp, times):
+    """A run from the start state (row ``Y_START``), coefficients (``W_C``, the run's own: a law's
+    memory is written into them, model.laws.remember), tolerances (``W_ATOL``) and options of its
+    workspace, at t = 0: its mode, logs, phase and first step."""
+    real, ints, c, yr, ur = ws[W_REAL], ws[W_INT], ws[W_C], ws[W_Y], ws[W_U]
+    y, f, u, fu, atol_u = yr[Y_STATE], yr[Y_F], ur[U_U], ur[U_FU], ur[U_ATOL]
+    copy_values(yr[Y_START], y)
     mode = initial_mode(code, c, y)
-    # scratch vectors as rows of three arrays (layouts Y_*, G_*, U_*)
-    rows5 = np.empty((N_Y_ROWS, 5))
-    f = rows5[Y_F]
-    y_new = rows5[Y_NEW]
-    f_new = rows5[Y_F_NEW]
-    y_r = rows5[Y_ROOT]
-    f_r = rows5[Y_F_ROOT]
-    ys = rows5[Y_TRIAL]
-    fs = rows5[Y_F_TRIAL]
     force = rhs(code, c, y, mode, f)
-    nfev = 1
-    nsteps = 0
-    energy_limit = energy_limit_of(code, c, y0)
-    ev, n_ev, smp, n_s, counts, i_time = open_logs(y, mode, force, save_kind, times)
-    max_force = force
-    max_indentation = y[X1] - y[X2]
-    status = SUCCESS
-    reason = HORIZON
-    rows7 = np.empty((N_G_ROWS, N_EVENTS))
-    gs = rows7[G_TRIAL]
-    g_old = rows7[G_OLD]
-    g_new = rows7[G_NEW]
-    roots = rows7[G_ROOTS]
-    fired = np.zeros(N_EVENTS, np.bool_)
-
+    ints[I_MODE], ints[I_NFEV] = mode, 1
+    energy_limit = energy_limit_of(code, c, y)
+    open_logs(ws, ev, smp, times, force)
+    fired = ws[W_FIRED]
+    for k in range(N_EVENTS):
+        fired[k] = False
     # Plain phases integrate u = (x1, x2, v1, v2, W, t) in s = t; regularised contact phases
     # (side = +-1) integrate u = (w, x2, v1, v2, W, t) in s with dt = w ds (model.rhs.rhs_integration).
-    rows6 = np.empty((N_U_ROWS, N_STATE))
-    u = rows6[U_U]
-    fu = rows6[U_FU]
-    u_new = rows6[U_NEW]
-    fu_new = rows6[U_FU_NEW]
-    u_r = rows6[U_ROOT]
-    fu_r = rows6[U_FU_ROOT]
-    us = rows6[U_TRIAL]
-    tmp6 = rows6[U_TMP]
-    atol_u = rows6[U_ATOL]
-    K6 = rows6[U_STAGES:U_DENSE]  # DOP853's stages (a flight's invariants)
-    F6 = rows6[U_DENSE:]  # the step's interpolant
-    w_floor = atol[6] / rtol  # the scale of w = sqrt(|delta|)
+    rtol, t_end, max_step = real[R_RTOL], real[R_T_END], real[R_MAX_STEP]
+    w_floor = ws[W_ATOL][6] / rtol  # the scale of w = sqrt(|delta|)
     # a flight's steps only bracket events, between the target's passes through its centre; a
     # figure gets a sample every sixteenth of the target's period
-    flight_step = math.inf if save_kind != SAVE_STEPS else max_step / 2
+    real[R_FLIGHT_STEP] = math.inf if ints[I_SAVE_KIND] != SAVE_STEPS else max_step / 2
     side = contact_side(code, c, y, mode)
     integration_state(code, mode, side, y, 0.0, u)
-    phase_tolerances(code, mode, side, atol, atol_u)
-    s = 0.0
+    phase_tolerances(code, mode, side, ws[W_ATOL], atol_u)
     rhs_integration(code, c, u, mode, side, fu)
-    nfev += 1
-    quiet = np.int64(DELTA)
+    g_old = ws[W_G][G_OLD]
     phase_events(code, c, mode, side, energy_limit, u, y, f, force, g_old)
-    _quiet_start(quiet, y, mode, g_old)
-    h_abs = _phase_step(code, c, mode, side, u, fu, rtol, atol_u, t_end, max_step, w_floor, tmp6, fu_new)
-    nfev += 1
+    _quiet_start(np.int64(DELTA), y, mode, g_old)
+    h_abs = _phase_step(code, c, mode, side, u, fu, rtol, atol_u, t_end, max_step, w_floor, ur[U_TMP], ur[U_FU_NEW])
     if side == FLIGHT:
-        flight.coefficients(c, u, s, K6)  # kept in K6 for the whole flight (it has no stages)
+        flight.coefficients(c, u, 0.0, ur[U_STAGES:U_DENSE])  # kept for the whole flight (it has no stages)
+    radau5.clear(ws[W_STIFF], real[R_STIFF_AFTER])
+    ints[I_SIDE], ints[I_NFEV], ints[I_NEXT_POLL] = side, 3, POLL_STEPS
+    real[R_S], real[R_H_ABS], real[R_FORCE], real[R_W_FLOOR] = 0.0, h_abs, force, w_floor
+    real[R_ENERGY_LIMIT], real[R_PAIR_ENERGY] = energy_limit, stuck_pair_energy(c, y)  # the pair's: read while stuck
 
-    stats = np.empty(N_STATS)  # the running extremes (STAT_*) inside the kernels
-    next_poll = np.int64(POLL_STEPS)  # _advance returns there (_ADV_LIMIT); resuming it changes no bit
-    stiff = radau5.workspace(stiff_after)
-    pair_energy = stuck_pair_energy(c, y)  # read while stuck only
-    while u[TIME] < t_end:
-        if nsteps >= max_steps or n_ev >= max_events:
-            status, reason = TOO_MANY_STEPS, FAILED_STOP
+
+@kernel
+def _loop(code, ws, ev, smp, times):
+    """The run's loop: steps while nothing happens (:func:`_take_steps`), then on the step where
+    something did, the events located and logged (:func:`_look_at_step`) and the run restarted,
+    stopped or the step accepted (:func:`_after_step`). Returns ``RUN_DONE``, or ``RUN_LOG_FULL``
+    when the run keeps logs (``I_LOGGING``) and they may not hold one more pass: the caller grows
+    them and calls again, and the run goes on exactly where it stood."""
+    real, ints, u, stiff = ws[W_REAL], ws[W_INT], ws[W_U][U_U], ws[W_STIFF]
+    while u[TIME] < real[R_T_END]:
+        if ints[I_LOGGING] != 0 and not _room(ws, ev, smp, times):
+            return RUN_LOG_FULL
+        if ints[I_NSTEPS] >= ints[I_MAX_STEPS] or ints[I_N_EV] >= ints[I_MAX_EVENTS]:
+            ints[I_STATUS], ints[I_REASON] = TOO_MANY_STEPS, FAILED_STOP
             break
-        if nsteps >= next_poll:
-            next_poll = nsteps + POLL_STEPS
+        if ints[I_NSTEPS] >= ints[I_NEXT_POLL]:
+            ints[I_NEXT_POLL] = ints[I_NSTEPS] + POLL_STEPS
             if interrupted():
-                status, reason = INTERRUPTED, FAILED_STOP
+                ints[I_STATUS], ints[I_REASON] = INTERRUPTED, FAILED_STOP
                 break
         if radau5.failed(stiff):
             break
-        next_sample = u[TIME] if save_kind == SAVE_STEPS else (
-            times[i_time] if save_kind == SAVE_TIMES and i_time < times.shape[0] else math.inf)
-        stats[STAT_MAX_FORCE], stats[STAT_MAX_INDENTATION] = max_force, max_indentation
-        result, s, h, h_abs, h_next, force, force_new, d_steps, d_fev = _advance(
-            code, c, mode, side, s, t_end, u, fu, y, f, force, h_abs, rtol, atol_u, max_step, flight_step, w_floor,
-            energy_limit, next_sample, min(max_steps, next_poll) - nsteps, g_old, g_new, fired, K6, u_new, fu_new,
-            y_new, f_new, stats, stiff)
-        max_force, max_indentation = stats[STAT_MAX_FORCE], stats[STAT_MAX_INDENTATION]
-        nsteps += d_steps
-        nfev += d_fev
+        result = _take_steps(code, ws, times)
         if result == _ADV_END:
             break
         if result == _ADV_COLLAPSE:
-            status, reason = STEP_SIZE_COLLAPSE, FAILED_STOP
+            ints[I_STATUS], ints[I_REASON] = STEP_SIZE_COLLAPSE, FAILED_STOP
             break
         if result == _ADV_LIMIT:
-            if nsteps < max_steps:
-                continue  # at next_poll
-            status, reason = TOO_MANY_STEPS, FAILED_STOP
+            if ints[I_NSTEPS] < ints[I_MAX_STEPS]:
+                continue  # at the next poll
+            ints[I_STATUS], ints[I_REASON] = TOO_MANY_STEPS, FAILED_STOP
             break
         # a step to look at (an event fired in it, a sample or the horizon falls in it); not accepted yet
-        s_new = s + h
-        any_fired = False
-        for col in range(N_EVENTS):
-            any_fired = any_fired or fired[col]
-        have_dense = False
-        stop_record = -1.0
-        restart_col = np.int64(-1)
-        s_restart = math.inf
-        s_horizon = math.inf
-        if regularised(side) and u_new[TIME] >= t_end:
-            nfev += _interpolant(code, c, mode, side, u, fu, u_new, fu_new, h, K6, F6, tmp6, stiff)
-            have_dense = True
-            s_horizon = s_at_time(code, c, mode, side, F6, u, s, h, t_end, us, ys, fs)
-        if any_fired:
-            if not have_dense:
-                nfev += _interpolant(code, c, mode, side, u, fu, u_new, fu_new, h, K6, F6, tmp6, stiff)
-                have_dense = True
-            unresolved, restart_col, s_restart, spent = _locate_events(
-                code, c, mode, side, settle, energy_limit, s, h, s_horizon, u, fu, g_old, g_new, fired, roots, K6, F6,
-                u_r, fu_r, stiff, us, ys, fs, gs)
-            nfev += spent
-            if unresolved:
-                h_abs = h / 32.0  # an event left and re-crossed zero inside the step: resolve it
-                continue
-            if n_ev + N_EVENTS > ev.shape[0]:
-                ev = _grow(ev, n_ev)  # a free row for each event _record may log
-            stats[STAT_MAX_FORCE], stats[STAT_MAX_INDENTATION] = max_force, max_indentation
-            n_ev, stop_record, spent = _record(code, c, mode, side, settle, stop_kind, stop_count, s, h, s_restart,
-                                               fired, roots, u, fu, F6, K6, us, fu_r, stiff, ys, fs, ev, n_ev, counts,
-                                               stats)
-            max_force, max_indentation = stats[STAT_MAX_FORCE], stats[STAT_MAX_INDENTATION]
-            nfev += spent
-        if stop_record >= 0:
-            # stopped at a recorded event: the state there from a fresh step that ends at it
-            if stop_record > s:
-                nfev += fresh_step(code, c, mode, side, s, u, fu, stop_record - s, K6, u_r, fu_r, stiff)
-                copy_values(u_r, u)
-                if not regularised(side):
-                    u[TIME] = stop_record
-            force = physical(code, c, mode, side, u, y, f)
-            reason = ASKED_STOP
+        restart_col, s_restart, s_horizon, stop_record = _look_at_step(code, ws, ev)
+        if restart_col == _RETRY:
+            continue  # an event left and re-crossed zero inside the step: a smaller one resolves it
+        if _after_step(code, ws, ev, smp, times, restart_col, s_restart, s_horizon, stop_record):
             break
-        if save_kind == SAVE_TIMES:
-            # samples up to where this step's motion stands: its end, the restart or the horizon
-            t_seg = u_new[TIME]
-            if restart_col >= 0:
-                dense(c, side, F6, u, s, h, s_restart, us)
-                t_seg = s_restart if not regularised(side) else us[TIME]
-            elif s_horizon < math.inf:
-                t_seg = t_end
-            while i_time < times.shape[0] and times[i_time] <= t_seg:
-                if not have_dense:
-                    nfev += _interpolant(code, c, mode, side, u, fu, u_new, fu_new, h, K6, F6, tmp6, stiff)
-                    have_dense = True
-                s_i = s_at_time(code, c, mode, side, F6, u, s, h, times[i_time], us, ys, fs)
-                dense(c, side, F6, u, s, h, s_i, us)
-                f_i = physical(code, c, mode, side, us, ys, fs)
-                smp, n_s = push_sample(smp, n_s, times[i_time], ys, mode, f_i)
-                i_time += 1
-        if restart_col < 0 and s_horizon < math.inf:
-            # a regularised phase reaches the horizon inside the step: the state there from a fresh step
-            nfev += fresh_step(code, c, mode, side, s, u, fu, s_horizon - s, K6, u_r, fu_r, stiff)
-            copy_values(u_r, u)
-            u[TIME] = t_end  # without the root finder's residue
-            force = physical(code, c, mode, side, u, y, f)
-            max_force = max(max_force, force)
-            max_indentation = max(max_indentation, y[X1] - y[X2])
-            if save_kind == SAVE_STEPS:
-                smp, n_s = push_sample(smp, n_s, t_end, y, mode, force)
-            break
-        if restart_col >= 0:
-            kind, mode, action, side, s, t, h_abs, force, pair_energy, spent = _restart(
-                code, c, settle, restart_col, mode, side, s, s_restart, h_next, u, fu, u_r, fu_r, y_r, f_r, y, f, K6,
-                stiff, rtol, atol, atol_u, t_end, max_step, w_floor, tmp6, fu_new, pair_energy)
-            nfev += spent
-            if kind == SILENT:  # a restart only (the pair at its centre): nothing to log
-                quiet = restart_col
-                phase_events(code, c, mode, side, energy_limit, u, y, f, force, g_old)
-                _quiet_start(quiet, y, mode, g_old)
-                continue
-            ev, n_ev = push_event(ev, n_ev, t, kind, mode, y, force)
-            counts[kind] += 1
-            max_force = max(max_force, force)
-            max_indentation = max(max_indentation, y[X1] - y[X2])
-            if save_kind == SAVE_STEPS:
-                smp, n_s = push_sample(smp, n_s, t, y, mode, force)
-            if action == STOP_SETTLED:
-                reason = SETTLED_STOP
-                break
-            if action == STOP_RUNAWAY:
-                reason = RUNAWAY_STOP
-                break
-            if kind == stop_kind and counts[kind] >= stop_count:
-                reason = ASKED_STOP
-                break
-            quiet = restart_col
-            phase_events(code, c, mode, side, energy_limit, u, y, f, force, g_old)
-            _quiet_start(quiet, y, mode, g_old)
-            continue
-        # the whole step stands
-        s = s_new
-        copy_values(u_new, u)
-        copy_values(fu_new, fu)
-        copy_values(y_new, y)
-        copy_values(f_new, f)
-        force = force_new
-        copy_values(g_new, g_old)
-        h_abs = h_next
-        max_force = max(max_force, force)
-        max_indentation = max(max_indentation, y[X1] - y[X2])
-        if save_kind == SAVE_STEPS:
-            smp, n_s = push_sample(smp, n_s, u[TIME], y, mode, force)
-
     if radau5.failed(stiff):  # a step to a root did not converge: what follows it is not the motion
-        status, reason = STEP_SIZE_COLLAPSE, FAILED_STOP
-    t = u[TIME]
-
-    summary = summarize(code, c, y0, y, mode, status, reason, t, max_force, max_indentation, counts,
-                         n_ev, ev, nsteps, nfev)
-    return summary, ev[:n_ev], smp[:n_s], y
+        ints[I_STATUS], ints[I_REASON] = STEP_SIZE_COLLAPSE, FAILED_STOP
+    real[R_T_STOP] = u[TIME]
+    return RUN_DONE
 
 
-@allocating
-def summarize(code, c, y0, y, mode, status, reason, t_stop, max_force, max_indentation, counts,
-               n_ev, ev, nsteps, nfev):
-    """The summary vector of a run (indices ``S_*``); undefined entries are NaN."""
-    s = np.full(N_SUMMARY, np.nan)
+_RETRY = -2  # _look_at_step: the step is to be retried smaller
+
+
+@kernel
+def _take_steps(code, ws, times):
+    """Steps of the current phase while nothing happens (:func:`_advance`); returns its result."""
+    real, ints, yr, g, ur = ws[W_REAL], ws[W_INT], ws[W_Y], ws[W_G], ws[W_U]
+    u = ur[U_U]
+    save_kind, i_time, nsteps = ints[I_SAVE_KIND], ints[I_TIME_INDEX], ints[I_NSTEPS]
+    next_sample = u[TIME] if save_kind == SAVE_STEPS else (
+        times[i_time] if save_kind == SAVE_TIMES and i_time < times.shape[0] else math.inf)
+    result, s, h, h_abs, h_next, force, force_new, d_steps, d_fev = _advance(
+        code, ws[W_C], ints[I_MODE], ints[I_SIDE], real[R_S], real[R_T_END], u, ur[U_FU], yr[Y_STATE], yr[Y_F],
+        real[R_FORCE], real[R_H_ABS], real[R_RTOL], ur[U_ATOL], real[R_MAX_STEP], real[R_FLIGHT_STEP],
+        real[R_W_FLOOR], real[R_ENERGY_LIMIT], next_sample, min(ints[I_MAX_STEPS], ints[I_NEXT_POLL]) - nsteps,
+        g[G_OLD], g[G_NEW], ws[W_FIRED], ur[U_STAGES:U_DENSE], ur[U_NEW], ur[U_FU_NEW], yr[Y_NEW], yr[Y_F_NEW],
+        ws[W_STATS], ws[W_STIFF])
+    real[R_S], real[R_H], real[R_H_ABS], real[R_H_NEXT], real[R_FORCE], real[R_FORCE_NEW] = (
+        s, h, h_abs, h_next, force, force_new)
+    ints[I_NSTEPS], ints[I_NFEV] = nsteps + d_steps, ints[I_NFEV] + d_fev
+    return result
+
+
+@kernel
+def _look_at_step(code, ws, ev):
+    """The step :func:`_advance` left: where a regularised phase reaches the horizon in it, the
+    events that fired located and the recorded ones logged. Returns ``(restart_col, s_restart,
+    s_horizon, stop_record)`` (see :func:`_locate_events`, :func:`_record`; inf where none);
+    ``restart_col`` is ``_RETRY`` when the step must be retried smaller."""
+    real, ints, c, ur, yr, fired = ws[W_REAL], ws[W_INT], ws[W_C], ws[W_U], ws[W_Y], ws[W_FIRED]
+    mode, side, s, h = ints[I_MODE], ints[I_SIDE], real[R_S], real[R_H]
+    u, F = ur[U_U], ur[U_DENSE:]
+    any_fired = False
+    for col in range(N_EVENTS):
+        any_fired = any_fired or fired[col]
+    have_dense = False
+    stop_record = -1.0
+    restart_col = np.int64(-1)
+    s_restart = math.inf
+    s_horizon = math.inf
+    nfev = 0
+    if regularised(side) and ur[U_NEW][TIME] >= real[R_T_END]:
+        nfev += _step_interpolant(code, ws)
+        have_dense = True
+        s_horizon = s_at_time(code, c, mode, side, F, u, s, h, real[R_T_END], ur[U_TRIAL], yr[Y_TRIAL], yr[Y_F_TRIAL])
+    if any_fired:
+        if not have_dense:
+            nfev += _step_interpolant(code, ws)
+            have_dense = True
+        unresolved, restart_col, s_restart, spent = _locate_events(code, ws, s_horizon)
+        nfev += spent
+        if unresolved:
+            real[R_H_ABS] = h / 32.0
+            ints[I_NFEV] += nfev
+            return np.int64(_RETRY), s_restart, s_horizon, stop_record
+        stop_record, spent = _record(code, ws, ev, s_restart)
+        nfev += spent
+    ints[I_NFEV] += nfev
+    ints[I_HAVE_DENSE] = have_dense
+    return restart_col, s_restart, s_horizon, stop_record
+
+
+@kernel
+def _step_interpolant(code, ws):
+    """The interpolant of the step :func:`_advance` left into ``U_DENSE``; returns the evaluations."""
+    ints, ur = ws[W_INT], ws[W_U]
+    return _interpolant(code, ws[W_C], ints[I_MODE], ints[I_SIDE], ur[U_U], ur[U_FU], ur[U_NEW], ur[U_FU_NEW],
+                        ws[W_REAL][R_H], ur[U_STAGES:U_DENSE], ur[U_DENSE:], ur[U_TMP], ws[W_STIFF])
+
+
+@kernel
+def _after_step(code, ws, ev, smp, times, restart_col, s_restart, s_horizon, stop_record):
+    """After :func:`_look_at_step`: stop at a recorded event, take the samples in the step, stop on
+    the horizon, restart at an event, or accept the whole step. Returns True when the run ends."""
+    real, ints, c, ur, yr, stiff = ws[W_REAL], ws[W_INT], ws[W_C], ws[W_U], ws[W_Y], ws[W_STIFF]
+    mode, side, s = ints[I_MODE], ints[I_SIDE], real[R_S]
+    u, fu, u_r, K, y, f = ur[U_U], ur[U_FU], ur[U_ROOT], ur[U_STAGES:U_DENSE], yr[Y_STATE], yr[Y_F]
+    if stop_record >= 0:
+        # stopped at a recorded event: the state there from a fresh step that ends at it
+        if stop_record > s:
+            ints[I_NFEV] += fresh_step(code, c, mode, side, s, u, fu, stop_record - s, K, u_r, ur[U_FU_ROOT], stiff)
+            copy_values(u_r, u)
+            if not regularised(side):
+                u[TIME] = stop_record
+        real[R_FORCE] = physical(code, c, mode, side, u, y, f)
+        ints[I_REASON] = ASKED_STOP
+        return True
+    if ints[I_SAVE_KIND] == SAVE_TIMES:
+        _samples_in_step(code, ws, smp, times, restart_col, s_restart, s_horizon)
+    if restart_col < 0 and s_horizon < math.inf:
+        # a regularised phase reaches the horizon inside the step: the state there from a fresh step
+        ints[I_NFEV] += fresh_step(code, c, mode, side, s, u, fu, s_horizon - s, K, u_r, ur[U_FU_ROOT], stiff)
+        copy_values(u_r, u)
+        u[TIME] = real[R_T_END]  # without the root finder's residue
+        force = physical(code, c, mode, side, u, y, f)
+        real[R_FORCE] = force
+        _extremes(ws, force, y)
+        if ints[I_SAVE_KIND] == SAVE_STEPS:
+            add_sample(ws, smp, real[R_T_END], y, mode, force)
+        return True
+    if restart_col >= 0:
+        return _restart_and_log(code, ws, ev, smp, restart_col, s_restart)
+    # the whole step stands
+    real[R_S] = s + real[R_H]
+    copy_values(ur[U_NEW], u)
+    copy_values(ur[U_FU_NEW], fu)
+    copy_values(yr[Y_NEW], y)
+    copy_values(yr[Y_F_NEW], f)
+    copy_values(ws[W_G][G_NEW], ws[W_G][G_OLD])
+    force = real[R_FORCE_NEW]
+    real[R_FORCE], real[R_H_ABS] = force, real[R_H_NEXT]
+    _extremes(ws, force, y)
+    if ints[I_SAVE_KIND] == SAVE_STEPS:
+        add_sample(ws, smp, u[TIME], y, mode, force)
+    return False
+
+
+@kernel
+def _extremes(ws, force, y):
+    """The running extremes (``W_STATS``) after a state the run stands at."""
+    stats = ws[W_STATS]
+    stats[STAT_MAX_FORCE] = max(stats[STAT_MAX_FORCE], force)
+    stats[STAT_MAX_INDENTATION] = max(stats[STAT_MAX_INDENTATION], y[X1] - y[X2])
+
+
+@kernel
+def _samples_in_step(code, ws, smp, times, restart_col, s_restart, s_horizon):
+    """The output times in the step, up to where its motion stands: its end, the restart or the horizon."""
+    real, ints, c, ur, yr = ws[W_REAL], ws[W_INT], ws[W_C], ws[W_U], ws[W_Y]
+    mode, side, s, h = ints[I_MODE], ints[I_SIDE], real[R_S], real[R_H]
+    u, us, F, ys, fs = ur[U_U], ur[U_TRIAL], ur[U_DENSE:], yr[Y_TRIAL], yr[Y_F_TRIAL]
+    have_dense = ints[I_HAVE_DENSE] != 0
+    t_seg = ur[U_NEW][TIME]
+    if restart_col >= 0:
+        dense(c, side, F, u, s, h, s_restart, us)
+        t_seg = s_restart if not regularised(side) else us[TIME]
+    elif s_horizon < math.inf:
+        t_seg = real[R_T_END]
+    i_time = ints[I_TIME_INDEX]
+    while i_time < times.shape[0] and times[i_time] <= t_seg:
+        if not have_dense:
+            ints[I_NFEV] += _step_interpolant(code, ws)
+            have_dense = True
+        s_i = s_at_time(code, c, mode, side, F, u, s, h, times[i_time], us, ys, fs)
+        dense(c, side, F, u, s, h, s_i, us)
+        f_i = physical(code, c, mode, side, us, ys, fs)
+        add_sample(ws, smp, times[i_time], ys, mode, f_i)
+        i_time += 1
+    ints[I_TIME_INDEX] = i_time
+
+
+@kernel
+def _restart_and_log(code, ws, ev, smp, restart_col, s_restart):
+    """Restart at the event ``restart_col`` (:func:`_restart`), log it and stop where it says so;
+    returns True when the run ends."""
+    real, ints, yr = ws[W_REAL], ws[W_INT], ws[W_Y]
+    kind, action, t = _restart(code, ws, restart_col, s_restart)
+    mode, y, force = ints[I_MODE], yr[Y_STATE], real[R_FORCE]
+    if kind != SILENT:  # SILENT: a restart only (the pair at its centre): nothing to log
+        log_event(ws, ev, t, kind, mode, y, force)
+        _extremes(ws, force, y)
+        if ints[I_SAVE_KIND] == SAVE_STEPS:
+            add_sample(ws, smp, t, y, mode, force)
+        if action == STOP_SETTLED:
+            ints[I_REASON] = SETTLED_STOP
+            return True
+        if action == STOP_RUNAWAY:
+            ints[I_REASON] = RUNAWAY_STOP
+            return True
+        if kind == ints[I_STOP_KIND] and ws[W_COUNTS][kind] >= ints[I_STOP_COUNT]:
+            ints[I_REASON] = ASKED_STOP
+            return True
+    u, g_old = ws[W_U][U_U], ws[W_G][G_OLD]
+    phase_events(code, ws[W_C], mode, ints[I_SIDE], real[R_ENERGY_LIMIT], u, y, yr[Y_F], force, g_old)
+    _quiet_start(restart_col, y, mode, g_old)
+    return False
+
+
+@kernel
+def summarize(code, ws):
+    """The summary vector of the run (``W_SUMMARY``, indices ``S_*``; undefined entries NaN), and
+    the ends of its last stick phases."""
+    real, ints, c, yr, counts = ws[W_REAL], ws[W_INT], ws[W_C], ws[W_Y], ws[W_COUNTS]
+    s = ws[W_SUMMARY]
+    y0, y, mode, status, reason = yr[Y_START], yr[Y_STATE], ints[I_MODE], ints[I_STATUS], ints[I_REASON]
+    for k in range(N_SUMMARY):
+        s[k] = math.nan
     s[S_STATUS] = status
     s[S_REASON] = reason
-    s[S_T_STOP] = t_stop
-    s[S_MAX_FORCE] = max_force
-    s[S_MAX_INDENTATION] = max_indentation
+    s[S_T_STOP] = real[R_T_STOP]
+    s[S_MAX_FORCE] = ws[W_STATS][STAT_MAX_FORCE]
+    s[S_MAX_INDENTATION] = ws[W_STATS][STAT_MAX_INDENTATION]
     s[S_DISSIPATED] = energy(code, c, y0) - energy(code, c, y)
     s[S_LOOP_AREA] = y[WORK] - y0[WORK]
     s[S_N_STICK] = counts[STICK]
     s[S_N_CONTACTS] = counts[CONTACT]
-    s[S_NSTEPS] = nsteps
-    s[S_NFEV] = nfev
+    s[S_NSTEPS] = ints[I_NSTEPS]
+    s[S_NFEV] = ints[I_NFEV]
     s[S_MODE] = mode
-    first_contact = -1
-    first_stick = -1
-    for i in range(n_ev):
-        kind = int(ev[i, EV_KIND])
-        if kind == CONTACT and first_contact < 0:
-            first_contact = i
-        elif kind == SEPARATION and first_contact >= 0 and math.isnan(s[S_CONTACT_DURATION]):
-            s[S_CONTACT_DURATION] = ev[i, EV_T] - ev[first_contact, EV_T]
-            dd0 = ev[first_contact, EV_Y + V1] - ev[first_contact, EV_Y + V2]
-            if dd0 != 0:
-                s[S_RESTITUTION] = -(ev[i, EV_Y + V1] - ev[i, EV_Y + V2]) / dd0
-        if kind == STICK and first_stick < 0:
-            first_stick = i
-            s[S_FIRST_STICK_T] = ev[i, EV_T]
-            s[S_FIRST_STICK_DELTA] = ev[i, EV_Y + X1] - ev[i, EV_Y + X2]
-            s[S_FIRST_STICK_MARGIN] = stick_margin(code, c, ev[i, EV_Y:EV_Y + 5])
-        if kind == SEPARATION and first_stick >= 0 and math.isnan(s[S_T_RUN]):
-            s[S_T_RUN] = ev[i, EV_T]
+    s[S_CONTACT_DURATION] = real[R_CONTACT_DURATION]
+    s[S_RESTITUTION] = real[R_RESTITUTION]
+    if ints[I_N_STICK] > 0:
+        stuck = yr[Y_FIRST_STICK]
+        s[S_FIRST_STICK_T] = real[R_STICK_T]
+        s[S_FIRST_STICK_DELTA] = stuck[X1] - stuck[X2]
+        s[S_FIRST_STICK_MARGIN] = stick_margin(code, c, stuck)
+    s[S_T_RUN] = real[R_T_RUN]
     if status != SUCCESS:
         outcome = FAILED
     elif reason == RUNAWAY_STOP:
@@ -792,7 +904,7 @@ def summarize(code, c, y0, y, mode, status, reason, t_stop, max_force, max_inden
     else:
         outcome = BOUNDED
     s[S_OUTCOME] = outcome
-    return s
+    _close_sticks(ws, math.inf if outcome == PERMANENT_STICK else real[R_T_STOP])
 
 
 @kernel(python=True)
@@ -819,22 +931,61 @@ def stick_points(ev, t_stop, permanent, out_t, out_delta, out_dwell):
     return n
 
 
+@allocating
+def new_logs(save_kind, times):
+    """Empty logs for a run that keeps them: the event log and the samples."""
+    rows = 1 if save_kind == SAVE_SUMMARY else (256 if save_kind == SAVE_STEPS else times.shape[0] + 2)
+    return np.empty((64, N_EV_COLUMNS)), np.empty((rows, N_SMP_COLUMNS))
+
+
+@allocating(python=True, nogil=True)  # runs side by side in threads (phaseimpact.train's orbit diagrams)
+def run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count, save_kind, times,
+        max_steps, max_events, stiff_after):
+    """Integrate one trajectory. See :func:`phaseimpact.integrate.simulate` for the meaning.
+
+    Returns ``(summary, events, samples, y_final)``: the event log (columns ``EV_*``) and the
+    samples (columns ``SMP_*``) trimmed to their lengths. The per-point kernels of
+    :func:`run_block` in a workspace of its own, with logs that grow (by doubling) whenever
+    :func:`_loop` says they may not hold one more pass. The seed's RK4 is :func:`.rk4.run_rk4`.
+    """
+    ws = workspace(c.shape[0], 0)
+    copy_values(c, ws[W_C])
+    copy_values(y0, ws[W_Y][Y_START])
+    copy_values(atol, ws[W_ATOL])
+    _set_options(ws, t_end, rtol, max_step, settle, stop_kind, stop_count, save_kind, max_steps, stiff_after)
+    ints = ws[W_INT]
+    ints[I_MAX_EVENTS], ints[I_LOGGING] = max_events, 1
+    ev, smp = new_logs(save_kind, times)
+    _start(code, ws, ev, smp, times)
+    while _loop(code, ws, ev, smp, times) == RUN_LOG_FULL:
+        ev = grow(ev, ints[I_N_EV])
+        smp = grow(smp, ints[I_N_S])
+    summarize(code, ws)
+    return ws[W_SUMMARY].copy(), ev[:ints[I_N_EV]], smp[:ints[I_N_S]], ws[W_Y][Y_STATE].copy()
+
+
 @allocating(python=True, nogil=True)
 def run_block(code, C, Y0, t_end, rtol, ATOL, max_step, settle, stop_kind, stop_count, max_steps, max_events,
               stiff_after, start, stop, step, summary, st_t, st_delta, st_dwell, st_count):
     """Runs ``start, start + step, ...`` (below ``stop``) of a batch, without the GIL (callers run
     blocks in threads; each run's numbers depend on nothing else). Fills ``summary`` (n, N_SUMMARY)
     and the first ``capacity`` stick points of each run; ``st_count`` holds each run's full number
-    of stick points. Threads over blocks, not a compiled parallel loop: that would compile the
-    driver a second time. A thread's block is every ``step``-th run, not a contiguous range: the
-    cost of a run changes smoothly over a sweep or an atlas (many times over near kappa_c), so
-    interleaved blocks cost the same to within one run, where contiguous ones left a thread idle
-    while another finished an expensive stretch. On Ctrl-C or SIGTERM the rest of the block is
-    left with the status ``interrupted``."""
-    empty = np.empty(0)
-    c = np.empty(C.shape[1])
-    y0 = np.empty(Y0.shape[1])
-    atol = np.empty(ATOL.shape[1])
+    of stick points (more than ``capacity``: the caller runs it again with room for them all).
+    Threads over blocks, not a compiled parallel loop: that would compile the driver a second
+    time. A thread's block is every ``step``-th run, not a contiguous range: the cost of a run
+    changes smoothly over a sweep or an atlas (many times over near kappa_c), so interleaved blocks
+    cost the same to within one run, where contiguous ones left a thread idle while another finished
+    an expensive stretch. On Ctrl-C or SIGTERM the rest of the block is left with the status
+    ``interrupted``.
+
+    The block's one workspace is made here, once; each run goes through the per-point kernels
+    (:func:`_start`, :func:`_loop`, :func:`summarize`) in it, without an event log, and allocates
+    nothing."""
+    ws = workspace(C.shape[1], st_t.shape[1])
+    no_events = np.empty((0, N_EV_COLUMNS))
+    no_samples = np.empty((0, N_SMP_COLUMNS))
+    no_times = np.empty(0)
+    ints, sticks = ws[W_INT], ws[W_STICKS]
     done = 0
     for i in range(start, stop, step):
         done += 1
@@ -842,19 +993,20 @@ def run_block(code, C, Y0, t_end, rtol, ATOL, max_step, settle, stop_kind, stop_
             for j in range(i, stop, step):
                 summary[j, S_STATUS] = INTERRUPTED
             break
-        # the run reads its own copies: a row of the shared batch arrays would share their reference
-        # count, which run (an allocating function) updates, between the threads (a contended cache line)
-        copy_values(C[i], c)
-        copy_values(Y0[i], y0)
-        copy_values(ATOL[i], atol)
-        s, events, _, _ = _run(code, c, y0, t_end[i], rtol, atol, max_step[i], settle, stop_kind, stop_count,
-                               np.int64(SAVE_SUMMARY), empty, max_steps, max_events, stiff_after)
-        copy_values(s, summary[i])
-        permanent = s[S_OUTCOME] == PERMANENT_STICK
-        st_count[i] = stick_points(events, s[S_T_STOP], permanent, st_t[i], st_delta[i], st_dwell[i])
-        if s[S_STATUS] == INTERRUPTED:
+        copy_values(C[i], ws[W_C])
+        copy_values(Y0[i], ws[W_Y][Y_START])
+        copy_values(ATOL[i], ws[W_ATOL])
+        _set_options(ws, t_end[i], rtol, max_step[i], settle, stop_kind, stop_count, np.int64(SAVE_SUMMARY),
+                     max_steps, stiff_after)
+        ints[I_MAX_EVENTS], ints[I_LOGGING] = max_events, 0
+        _start(code, ws, no_events, no_samples, no_times)
+        _loop(code, ws, no_events, no_samples, no_times)
+        summarize(code, ws)
+        copy_values(ws[W_SUMMARY], summary[i])
+        st_count[i] = ints[I_N_STICK]
+        for j in range(min(ints[I_N_STICK], sticks.shape[1])):
+            st_t[i, j], st_delta[i, j], st_dwell[i, j] = sticks[ST_T, j], sticks[ST_DELTA, j], sticks[ST_DWELL, j]
+        if summary[i, S_STATUS] == INTERRUPTED:
             for j in range(i + step, stop, step):
                 summary[j, S_STATUS] = INTERRUPTED
             break
-
-

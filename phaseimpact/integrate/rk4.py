@@ -15,19 +15,43 @@ from ..model.rhs import X1, X2, energy, rhs
 from .driver import (
     FAILED_STOP,
     HORIZON,
+    I_LOGGING,
+    I_MODE,
+    I_N_EV,
+    I_N_S,
+    I_NFEV,
+    I_NSTEPS,
+    I_REASON,
+    I_SAVE_KIND,
+    I_STATUS,
     INTERRUPTED,
     NON_FINITE,
     POLL_STEPS,
+    R_T_STOP,
     RUNAWAY_STOP,
     SAVE_STEPS,
+    STAT_MAX_FORCE,
+    STAT_MAX_INDENTATION,
     SUCCESS,
     TOO_MANY_STEPS,
+    W_C,
+    W_INT,
+    W_REAL,
+    W_STATS,
+    W_SUMMARY,
+    W_Y,
+    Y_START,
+    Y_STATE,
+    add_sample,
+    grow,
+    log_event,
+    new_logs,
     open_logs,
-    push_event,
-    push_sample,
     summarize,
+    workspace,
 )
 from .events import CONTACT, SEPARATION, energy_limit_of
+from .phase import copy_values
 
 # Scratch rows (5 numbers): the rate at the state, a stage's argument, the step's end and its rate, the stages.
 RK_F, RK_TMP, RK_Y_NEW, RK_F_NEW, RK_K = range(5)
@@ -41,9 +65,14 @@ def run_rk4(code, c, y0, t_end, save_kind, times, max_steps, rk4_step, rk4_every
     linearly); with ``save_kind`` steps, every ``rk4_every``-th step is kept. Returns what
     :func:`run` does. An entry of its own, not a branch of :func:`run`: the first compile of a run
     that does not ask for it leaves it out."""
-    y = y0.copy()
+    ws = workspace(c.shape[0], 0)  # the run's record, logs and summary (driver.run's)
+    ints, stats, y = ws[W_INT], ws[W_STATS], ws[W_Y][Y_STATE]
+    copy_values(c, ws[W_C])
+    copy_values(y0, ws[W_Y][Y_START])
+    copy_values(y0, y)
     t = 0.0
     mode = np.int64(PLAIN)
+    ints[I_MODE], ints[I_SAVE_KIND], ints[I_LOGGING] = mode, save_kind, 1
     rows = np.empty((N_RK_ROWS, 5))
     tmp = rows[RK_TMP]
     y_new = rows[RK_Y_NEW]
@@ -56,9 +85,8 @@ def run_rk4(code, c, y0, t_end, save_kind, times, max_steps, rk4_step, rk4_every
     nfev = 1
     nsteps = 0
     energy_limit = energy_limit_of(code, c, y0)
-    ev, n_ev, smp, n_s, counts, _ = open_logs(y, mode, force, save_kind, times)
-    max_force = force
-    max_indentation = y[X1] - y[X2]
+    ev, smp = new_logs(save_kind, times)
+    open_logs(ws, ev, smp, times, force)
     status = SUCCESS
     reason = HORIZON
     while t < t_end:
@@ -94,18 +122,22 @@ def run_rk4(code, c, y0, t_end, save_kind, times, max_steps, rk4_step, rk4_every
         if (d_old <= 0 < d_new) or (d_old > 0 >= d_new):
             kind = CONTACT if d_new > 0 else SEPARATION
             t_cross = t + h * d_old / (d_old - d_new)  # linear: RK4 resolves no event
-            ev, n_ev = push_event(ev, n_ev, t_cross, kind, mode, y_new, force_new)
-            counts[kind] += 1
+            if ints[I_N_EV] == ev.shape[0]:
+                ev = grow(ev, ints[I_N_EV])
+            log_event(ws, ev, t_cross, kind, mode, y_new, force_new)
         t += h
         for j in range(5):
             y[j] = y_new[j]
-        max_force = max(max_force, force_new)
-        max_indentation = max(max_indentation, d_new)
+        stats[STAT_MAX_FORCE] = max(stats[STAT_MAX_FORCE], force_new)
+        stats[STAT_MAX_INDENTATION] = max(stats[STAT_MAX_INDENTATION], d_new)
         if save_kind == SAVE_STEPS and (nsteps % rk4_every == 0 or t >= t_end):
-            smp, n_s = push_sample(smp, n_s, t, y, mode, force_new)
+            if ints[I_N_S] == smp.shape[0]:
+                smp = grow(smp, ints[I_N_S])
+            add_sample(ws, smp, t, y, mode, force_new)
         if energy(code, c, y) > energy_limit:
             reason = RUNAWAY_STOP
             break
-    summary = summarize(code, c, y0, y, mode, status, reason, t, max_force, max_indentation, counts,
-                         n_ev, ev, nsteps, nfev)
-    return summary, ev[:n_ev], smp[:n_s], y
+    ints[I_STATUS], ints[I_REASON], ints[I_NSTEPS], ints[I_NFEV] = status, reason, nsteps, nfev
+    ws[W_REAL][R_T_STOP] = t
+    summarize(code, ws)
+    return ws[W_SUMMARY].copy(), ev[:ints[I_N_EV]], smp[:ints[I_N_S]], y.copy()

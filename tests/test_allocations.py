@@ -14,6 +14,7 @@ import numpy as np
 from phaseimpact import seed_parameters, simulate
 from phaseimpact.integrate import api
 
+# numba counts its allocations only when NUMBA_NRT_STATS is set as its runtime starts: a process of its own
 COUNT = r"""
 import json
 import numpy as np
@@ -27,7 +28,7 @@ def allocations(n, threads):
     columns = simulate_many(cases, "paper", n_threads=threads)
     return rtsys.get_allocation_stats().alloc - before, int(columns.stick_count.max())
 
-allocations(1, 1)  # the engine loaded (or compiled) first
+simulate_many([seed_parameters(v=1.0)], "paper", n_threads=2)  # the engine loaded (or compiled) first
 print(json.dumps({"chunk": api.PACK_CHUNK, "one": allocations(1, 1), "many": allocations(10_000, 1),
                   "many_two_threads": allocations(10_000, 2)}))
 """
@@ -35,8 +36,8 @@ print(json.dumps({"chunk": api.PACK_CHUNK, "one": allocations(1, 1), "many": all
 
 def test_a_sweep_allocates_per_chunk_not_per_point():
     """10 000 runs in 5 chunks of api.PACK_CHUNK (one thread; two threads: one workspace per
-    thread and chunk) make as many numba allocations as 5 (10) one-run calls: the workspace and
-    the arrays handed in, nothing per run (the old driver made ~21 per run, 200 000 here)."""
+    thread and chunk) make exactly as many numba allocations as 5 (10) one-run calls: the
+    workspace and the arrays handed in, nothing per run (the previous driver made ~21 per run)."""
     env = dict(os.environ, NUMBA_NRT_STATS="1")
     out = subprocess.run([sys.executable, "-c", COUNT], env=env, capture_output=True, text=True, timeout=900)
     assert out.returncode == 0, out.stderr[-3000:]
