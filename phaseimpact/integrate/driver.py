@@ -47,13 +47,11 @@ from ..model.rhs import (
     stuck_pair_energy,
 )
 from . import dop853, flight, radau5
-from .dop853 import N_DENSE, N_STAGES, N_STATE
 from .events import (
     CONTACT,
     DELTA,
     DELTADOT,
     ENERGY,
-    EVENT_KINDS,
     FORCE_PEAK,
     FORCE_RATE,
     N_EVENTS,
@@ -86,6 +84,93 @@ from .phase import (
     physical,
     regularised,
 )
+from .record import (
+    G_NEW,
+    G_OLD,
+    G_ROOTS,
+    I_HAVE_DENSE,
+    I_LOGGING,
+    I_MAX_EVENTS,
+    I_MAX_STEPS,
+    I_MODE,
+    I_N_EV,
+    I_N_S,
+    I_N_STICK,
+    I_NEXT_POLL,
+    I_NFEV,
+    I_NSTEPS,
+    I_OPEN_STICK,
+    I_REASON,
+    I_SAVE_KIND,
+    I_SETTLE,
+    I_SIDE,
+    I_STATUS,
+    I_STOP_COUNT,
+    I_STOP_KIND,
+    I_TIME_INDEX,
+    N_SUMMARY,
+    R_CONTACT_DURATION,
+    R_CONTACT_SPEED,
+    R_CONTACT_T,
+    R_ENERGY_LIMIT,
+    R_FLIGHT_STEP,
+    R_FORCE,
+    R_FORCE_NEW,
+    R_H,
+    R_H_ABS,
+    R_H_NEXT,
+    R_MAX_STEP,
+    R_PAIR_ENERGY,
+    R_RESTITUTION,
+    R_RTOL,
+    R_S,
+    R_STICK_T,
+    R_STIFF_AFTER,
+    R_T_END,
+    R_T_RUN,
+    R_T_STOP,
+    R_W_FLOOR,
+    ST_DELTA,
+    ST_DWELL,
+    ST_T,
+    STAT_MAX_FORCE,
+    STAT_MAX_INDENTATION,
+    U_ATOL,
+    U_DENSE,
+    U_FU,
+    U_FU_NEW,
+    U_FU_ROOT,
+    U_NEW,
+    U_ROOT,
+    U_STAGES,
+    U_TMP,
+    U_TRIAL,
+    U_U,
+    W_ATOL,
+    W_C,
+    W_COUNTS,
+    W_FIRED,
+    W_G,
+    W_INT,
+    W_REAL,
+    W_STATS,
+    W_STICKS,
+    W_STIFF,
+    W_SUMMARY,
+    W_U,
+    W_Y,
+    Y_F,
+    Y_F_NEW,
+    Y_F_ROOT,
+    Y_F_TRIAL,
+    Y_FIRST_STICK,
+    Y_NEW,
+    Y_ROOT,
+    Y_START,
+    Y_STATE,
+    Y_TRIAL,
+    workspace,
+)
 from .rootfind import brent, locate, polish_root, s_at_time
 
 # Run status (numerical health) and why the run stopped.
@@ -114,28 +199,7 @@ N_SMP_COLUMNS = 8
 (S_STATUS, S_REASON, S_OUTCOME, S_T_STOP, S_MAX_FORCE, S_MAX_INDENTATION, S_RESTITUTION,
  S_CONTACT_DURATION, S_DISSIPATED, S_LOOP_AREA, S_N_STICK, S_N_CONTACTS, S_T_RUN, S_FIRST_STICK_DELTA,
  S_FIRST_STICK_MARGIN, S_FIRST_STICK_T, S_NSTEPS, S_NFEV, S_MODE) = range(19)
-N_SUMMARY = 19
 
-# Named rows of a run's scratch arrays (an allocation costs about 30 ns, a row of one array nothing).
-# Physical states (5 numbers): the rate at the state, a step's end state and rate, the state and rate
-# at a root, and of the root finders; the run's state, its start and its first stick.
-Y_F, Y_NEW, Y_F_NEW, Y_ROOT, Y_F_ROOT, Y_TRIAL, Y_F_TRIAL, Y_STATE, Y_START, Y_FIRST_STICK = range(10)
-N_Y_ROWS = 10
-# Event values (N_EVENTS numbers): at a trial point, before and after the step, the roots.
-G_TRIAL, G_OLD, G_NEW, G_ROOTS = range(4)
-N_G_ROWS = 4
-# Integration states (N_STATE numbers): the state and its rate, a step's end, the state at a root,
-# at a trial point, scratch, the phase's absolute tolerances; then DOP853's stages (a flight's
-# invariants) and the step's interpolant.
-U_U, U_FU, U_NEW, U_FU_NEW, U_ROOT, U_FU_ROOT, U_TRIAL, U_TMP, U_ATOL = range(9)
-U_STAGES = 9
-U_DENSE = U_STAGES + N_STAGES
-N_U_ROWS = U_DENSE + N_DENSE
-# The running extremes of a run (``stats``), kept up to date by the kernels that take steps.
-STAT_MAX_FORCE, STAT_MAX_INDENTATION = 0, 1
-N_STATS = 2
-#: Event kinds (``events.EVENT_KINDS``): the length of a run's counts.
-N_KINDS = len(EVENT_KINDS)
 #: Smallest step reduction after a rejection when the observed order is used (else MIN_FACTOR).
 OBSERVED_MIN_FACTOR = 0.01
 _TINY = np.finfo(np.float64).tiny
@@ -180,12 +244,16 @@ def _quiet_start(quiet, y, mode, g):
 
 
 @kernel(inline="always")  # the hot loop's own code: a call costs more than it
-def _dop853_attempt(code, c, mode, side, s, s_bound, u, fu, h_abs, rtol, atol, K, u_new, fu_new):
-    """One accepted DOP853 step from ``(s, u)`` (at most to ``s_bound``), first try ``h_abs``.
+def _dop853_attempt(code, ws, s, s_bound, h_abs):
+    """One accepted DOP853 step from ``(s, u)`` (row ``U_U``; at most to ``s_bound``) into rows
+    ``U_NEW``, ``U_FU_NEW``, first try ``h_abs``.
 
     Returns ``(ok, s_new, h_next, force_new, evaluations)``; ``ok`` False when the step size
-    collapsed. The stages stay in ``K`` for the interpolant.
+    collapsed. The stages stay in rows ``U_STAGES`` for the interpolant.
     """
+    c, ints, ur, rtol = ws[W_C], ws[W_INT], ws[W_U], ws[W_REAL][R_RTOL]
+    mode, side, u, fu, atol, K, u_new, fu_new = (ints[I_MODE], ints[I_SIDE], ur[U_U], ur[U_FU], ur[U_ATOL],
+                                                 ur[U_STAGES:U_DENSE], ur[U_NEW], ur[U_FU_NEW])
     evaluations = 0
     rejected = False
     h_rejected = err_rejected = 0.0
@@ -217,20 +285,30 @@ def _dop853_attempt(code, c, mode, side, s, s_bound, u, fu, h_abs, rtol, atol, K
 
 
 @kernel
-def _advance(code, c, mode, side, s, t_end, u, fu, y, f, force, h_abs, rtol, atol, max_step, flight_step, w_floor,
-             energy_limit, next_sample, steps_left, g_old, g_new, fired, K, u_new, fu_new, y_new, f_new, stats, stiff):
-    """Take steps in ``s`` from ``(s, u)`` while nothing happens: no event crosses, no sample and
-    (regularised phase) not the horizon falls inside. Accepted steps update ``u, fu, y, f, g_old``
-    and the running extremes ``stats``. DOP853 until the phase turns stiff (:mod:`.radau5`), Radau
+def _advance(code, ws, next_sample, steps_left):
+    """Take steps in ``s`` from the run's state (record ``R_S``, rows ``U_U``, ``U_FU``, ``Y_STATE``,
+    ``Y_F``) while nothing happens: no event crosses, no sample (``next_sample``) and (regularised
+    phase) not the horizon falls inside; at most ``steps_left``. Accepted steps update those rows,
+    ``G_OLD`` and the running extremes ``W_STATS``. DOP853 until the phase turns stiff (:mod:`.radau5`), Radau
     from then on; a flight in closed form (:mod:`.flight`), in steps that end where the target
     passes its centre or after ``flight_step``, or to ``t_end`` at once when no event can happen
     any more and ``flight_step`` is inf (not saving steps).
 
-    Returns ``(result, s, h, h_abs, h_next, force, force_new, steps, evaluations)``: ``_ADV_STEP``
-    leaves the last step (``h``, ``u_new``, ``fu_new``, ``y_new``, ``f_new``, ``g_new``, ``fired``)
-    for the caller to look at; ``_ADV_END`` means ``t_end`` was reached. The hot loop is kept small
-    on purpose: the compiler optimises it as a whole.
+    Returns ``(result, steps, evaluations)``, and ``s, h, h_abs, h_next, force, force_new`` in the
+    record (:func:`_advanced`): ``_ADV_STEP`` leaves the last step (``R_H``, rows ``U_NEW``,
+    ``U_FU_NEW``, ``Y_NEW``, ``Y_F_NEW``, ``G_NEW``, ``fired``) for the caller to look at;
+    ``_ADV_END`` means ``t_end`` was reached. The hot loop is kept small and its state in local
+    variables on purpose: the compiler optimises it as a whole.
     """
+    real, ints, c, ur, yr, g, stats, stiff = (ws[W_REAL], ws[W_INT], ws[W_C], ws[W_U], ws[W_Y], ws[W_G],
+                                              ws[W_STATS], ws[W_STIFF])
+    mode, side, s, t_end, force, h_abs = ints[I_MODE], ints[I_SIDE], real[R_S], real[R_T_END], real[R_FORCE], \
+        real[R_H_ABS]
+    max_step, flight_step, w_floor, energy_limit = real[R_MAX_STEP], real[R_FLIGHT_STEP], real[R_W_FLOOR], \
+        real[R_ENERGY_LIMIT]
+    u, fu, u_new, fu_new, K = ur[U_U], ur[U_FU], ur[U_NEW], ur[U_FU_NEW], ur[U_STAGES:U_DENSE]
+    y, f, y_new, f_new, g_old, g_new, fired = yr[Y_STATE], yr[Y_F], yr[Y_NEW], yr[Y_F_NEW], g[G_OLD], g[G_NEW], \
+        ws[W_FIRED]
     steps = 0
     evaluations = 0
     h = 0.0
@@ -239,7 +317,8 @@ def _advance(code, c, mode, side, s, t_end, u, fu, y, f, force, h_abs, rtol, ato
     s_bound = t_end if not regularised(side) else math.inf  # a plain phase ends on the horizon
     while u[TIME] < t_end:
         if steps >= steps_left:
-            return _ADV_LIMIT, s, h, h_abs, h_next, force, force_new, steps, evaluations
+            _advanced(real, s, h, h_abs, h_next, force, force_new)
+            return _ADV_LIMIT, steps, evaluations
         if side == FLIGHT:  # K: the flight's invariants (it has no stages)
             if flight_step == math.inf and flight.unreachable(K, u):
                 s_new = s_bound
@@ -252,16 +331,16 @@ def _advance(code, c, mode, side, s, t_end, u, fu, y, f, force, h_abs, rtol, ato
             # a regularised phase advances the time by w ds: its cap on the time step is one on s
             h_abs = min(h_abs, max_step if not regularised(side) else max_step / max(abs(u[0]), w_floor))
             if radau5.due(stiff):  # entered from an accepted state, so that every step has one method
-                evaluations += radau5.enter(code, c, mode, side, u, fu, rtol, atol, stiff)
+                evaluations += radau5.enter(code, c, mode, side, u, fu, real[R_RTOL], ur[U_ATOL], stiff)
             if radau5.active(stiff):
                 ok, s_new, h_next, force_new, spent = radau5.attempt(code, c, mode, side, s, s_bound, u, fu, h_abs,
                                                                      stiff, u_new, fu_new)
             else:
-                ok, s_new, h_next, force_new, spent = _dop853_attempt(code, c, mode, side, s, s_bound, u, fu, h_abs,
-                                                                      rtol, atol, K, u_new, fu_new)
+                ok, s_new, h_next, force_new, spent = _dop853_attempt(code, ws, s, s_bound, h_abs)
         evaluations += spent
         if not ok:
-            return _ADV_COLLAPSE, s, h, h_next, h_next, force, force_new, steps, evaluations
+            _advanced(real, s, h, h_next, h_next, force, force_new)
+            return _ADV_COLLAPSE, steps, evaluations
         h = s_new - s
         steps += 1
         if not regularised(side):
@@ -283,7 +362,8 @@ def _advance(code, c, mode, side, s, t_end, u, fu, y, f, force, h_abs, rtol, ato
             fired[col] = crossed(col, g_old, g_new)
             any_fired = any_fired or fired[col]
         if any_fired or u_new[TIME] >= next_sample or (regularised(side) and u_new[TIME] >= t_end):
-            return _ADV_STEP, s, h, h_abs, h_next, force, force_new, steps, evaluations
+            _advanced(real, s, h, h_abs, h_next, force, force_new)
+            return _ADV_STEP, steps, evaluations
         s = s_new
         copy_values(u_new, u)
         copy_values(fu_new, fu)
@@ -294,26 +374,24 @@ def _advance(code, c, mode, side, s, t_end, u, fu, y, f, force, h_abs, rtol, ato
         h_abs = h_next
         stats[STAT_MAX_FORCE] = max(stats[STAT_MAX_FORCE], force)
         stats[STAT_MAX_INDENTATION] = max(stats[STAT_MAX_INDENTATION], y[X1] - y[X2])
-    return _ADV_END, s, h, h_abs, h_next, force, force_new, steps, evaluations
+    _advanced(real, s, h, h_abs, h_next, force, force_new)
+    return _ADV_END, steps, evaluations
 
 
 @kernel(inline="always")
-def _interpolant(code, c, mode, side, u, fu, u_new, fu_new, h, K, F, tmp, stiff):
-    """The last step's interpolant into ``F`` (a flight's invariants, see :func:`dense`); returns the
-    evaluations spent."""
-    if side == FLIGHT:
-        copy_values(K[0], F[0])  # the flight's invariants
-        return 0
-    if radau5.active(stiff):
-        radau5.dense_coefficients(stiff, F)
-        return 0
-    dop853.dense_coefficients(code, c, mode, side, u, fu, u_new, fu_new, h, K, F, tmp)
-    return 3
+def _advanced(real, s, h, h_abs, h_next, force, force_new):
+    """Where :func:`_advance` stands, into the run's record."""
+    real[R_S], real[R_H], real[R_H_ABS], real[R_H_NEXT], real[R_FORCE], real[R_FORCE_NEW] = (
+        s, h, h_abs, h_next, force, force_new)
 
 
 @kernel(inline="always")
-def _phase_step(code, c, mode, side, u, fu, rtol, atol, t_end, max_step, w_floor, tmp, f1):
-    """Initial step of a phase (scipy's rule), in its own independent variable."""
+def _phase_step(code, ws):
+    """Initial step of the run's phase (scipy's rule; the record's mode and side, rows ``U_U``,
+    ``U_FU``, ``U_ATOL``), in its own independent variable."""
+    real, ints, ur = ws[W_REAL], ws[W_INT], ws[W_U]
+    mode, side, u, t_end, max_step, w_floor = ints[I_MODE], ints[I_SIDE], ur[U_U], real[R_T_END], real[R_MAX_STEP], \
+        real[R_W_FLOOR]
     interval = t_end - u[TIME]
     if interval <= 0:
         return 0.0  # the phase starts on the horizon (an event at t_end): no step follows
@@ -321,8 +399,9 @@ def _phase_step(code, c, mode, side, u, fu, rtol, atol, t_end, max_step, w_floor
         return interval  # closed form: its steps only bracket events (see _advance)
     if regularised(side):
         interval /= max(abs(u[0]), w_floor)
-    return dop853.initial_step(code, c, mode, side, u, fu, rtol, atol, interval,
-                               max_step if not regularised(side) else max_step / max(abs(u[0]), w_floor), tmp, f1)
+    return dop853.initial_step(code, ws[W_C], mode, side, u, ur[U_FU], real[R_RTOL], ur[U_ATOL], interval,
+                               max_step if not regularised(side) else max_step / max(abs(u[0]), w_floor), ur[U_TMP],
+                               ur[U_FU_NEW])
 
 
 @kernel
@@ -333,20 +412,16 @@ def _locate_events(code, ws, s_horizon):
     (polished on steps when the step was Radau's). Returns ``(unresolved, restart_col, s_restart,
     evaluations)``: ``unresolved`` when an event left and re-crossed zero inside the step (the
     caller retries a smaller step); ``restart_col`` -1 when no event restarts the run."""
-    real, ints, c, g, ur, yr, fired, stiff = (ws[W_REAL], ws[W_INT], ws[W_C], ws[W_G], ws[W_U], ws[W_Y], ws[W_FIRED],
-                                              ws[W_STIFF])
-    mode, side, energy_limit, s, h = ints[I_MODE], ints[I_SIDE], real[R_ENERGY_LIMIT], real[R_S], real[R_H]
+    ints, g, fired = ws[W_INT], ws[W_G], ws[W_FIRED]
+    mode, s, h = ints[I_MODE], ws[W_REAL][R_S], ws[W_REAL][R_H]
     g_old, g_new, roots = g[G_OLD], g[G_NEW], g[G_ROOTS]
-    u, F, us, ys, fs = ur[U_U], ur[U_DENSE:], ur[U_TRIAL], yr[Y_TRIAL], yr[Y_F_TRIAL]
-    s_new = s + h
     evaluations = 0
     restart_col = np.int64(-1)
     s_restart = math.inf
     unresolved = False
     for col in range(N_EVENTS):
         if fired[col]:
-            roots[col] = locate(code, c, mode, side, energy_limit, col, F, u, s, h, s_new, g_old[col], g_new[col],
-                                us, ys, fs)
+            roots[col] = locate(code, ws, col, g_old[col], g_new[col])
             if roots[col] == -math.inf:
                 if h > 1e3 * (np.nextafter(s, np.inf) - s):
                     unresolved = True
@@ -359,19 +434,15 @@ def _locate_events(code, ws, s_horizon):
     if fired[DELTADOT] and not fired[DELTA]:
         # an extreme of delta inside the step on the other side of zero: a contact (or
         # separation) and its return both fell inside the step
-        d_ext = event_at(code, c, mode, side, energy_limit, 0.0, np.int64(DELTA), F, u, s, h, roots[DELTADOT], us, ys,
-                         fs)
+        d_ext = event_at(code, ws, np.int64(DELTA), 0.0, roots[DELTADOT])
         if d_ext * g_old[DELTA] < 0:
             fired[DELTA] = True
-            roots[DELTA] = brent(code, c, mode, side, energy_limit, 0.0, np.int64(DELTA), F, u, s, h, s,
-                                 roots[DELTADOT], g_old[DELTA], d_ext, us, ys, fs)
+            roots[DELTA] = brent(code, ws, np.int64(DELTA), 0.0, s, roots[DELTADOT], g_old[DELTA], d_ext)
     for col in range(N_EVENTS):
         if fired[col] and (restarts(code, col, mode, ints[I_SETTLE] != 0) or col == ENERGY) and roots[col] < s_restart:
             restart_col, s_restart = col, roots[col]
-    if restart_col >= 0 and radau5.active(stiff):
-        s_restart, spent = polish_root(code, c, mode, side, energy_limit, restart_col, s, u, ur[U_FU], s_new,
-                                       g_old[restart_col], g_new[restart_col], s_restart, ur[U_STAGES:U_DENSE],
-                                       ur[U_ROOT], ur[U_FU_ROOT], stiff, ys, fs, g[G_TRIAL])
+    if restart_col >= 0 and radau5.active(ws[W_STIFF]):
+        s_restart, spent = polish_root(code, ws, restart_col, g_old[restart_col], g_new[restart_col], s_restart)
         evaluations += spent
     return False, restart_col, s_restart, evaluations
 
@@ -398,8 +469,7 @@ def _record(code, ws, ev, s_restart):
             break
         fired[best] = False
         if radau5.active(stiff):  # the state from a step to the root: the polynomial is of order 3
-            evaluations += fresh_step(code, c, mode, side, s, u, ur[U_FU], roots[best] - s, ur[U_STAGES:U_DENSE], us,
-                                      ur[U_FU_ROOT], stiff)
+            evaluations += fresh_step(code, ws, roots[best] - s, us, ur[U_FU_ROOT])
         else:
             dense(c, side, ur[U_DENSE:], u, s, h, roots[best], us)
         f_ev = physical(code, c, mode, side, us, ys, fs)
@@ -430,7 +500,7 @@ def _restart(code, ws, column, s_restart):
     evaluations = 0
     h_r = s_restart - s
     if h_r > 0:
-        evaluations += fresh_step(code, c, mode, side, s, u, fu, h_r, K, u_r, ur[U_FU_ROOT], stiff)
+        evaluations += fresh_step(code, ws, h_r, u_r, ur[U_FU_ROOT])
     else:
         copy_values(u, u_r)
     t = s_restart if not regularised(side) else u_r[TIME]
@@ -451,8 +521,8 @@ def _restart(code, ws, column, s_restart):
     phase_tolerances(code, mode, new_side, ws[W_ATOL], ur[U_ATOL])
     if new_side != side:  # the independent variable changes: a fresh initial step
         side = new_side
-        h_abs = _phase_step(code, c, mode, side, u, fu, real[R_RTOL], ur[U_ATOL], real[R_T_END], real[R_MAX_STEP],
-                            real[R_W_FLOOR], ur[U_TMP], ur[U_FU_NEW])
+        ints[I_MODE], ints[I_SIDE] = mode, side
+        h_abs = _phase_step(code, ws)
         evaluations += 1
     else:
         h_abs = max(real[R_H_NEXT], h_r)
@@ -464,40 +534,10 @@ def _restart(code, ws, column, s_restart):
 
 
 # ------------------------------------------------------------------------------------------------
-# One run: its record and workspace, its logs, the loop
+# One run: its logs, the loop (its record and workspace: .record)
 # ------------------------------------------------------------------------------------------------
-# A run's whole state lives in a workspace (:func:`workspace`): fixed-size arrays made once per
-# thread and chunk of runs (:func:`run_block`) or once per trajectory (:func:`run`), never inside
-# the per-point kernels (:func:`_start`, :func:`_loop`, :func:`summarize`), which allocate nothing:
-# the form a GPU thread needs too. Members of the workspace tuple (numba indexes a tuple's members
-# of different types by constants):
-(W_REAL, W_INT, W_C, W_ATOL, W_Y, W_G, W_FIRED, W_U, W_STATS, W_COUNTS, W_SUMMARY, W_STICKS, W_STIFF) = range(13)
-# The run's record: its scalars (W_REAL) ...
-(R_S, R_H, R_H_ABS, R_H_NEXT, R_FORCE, R_FORCE_NEW, R_T_END, R_RTOL, R_MAX_STEP, R_STIFF_AFTER, R_FLIGHT_STEP,
- R_W_FLOOR, R_ENERGY_LIMIT, R_PAIR_ENERGY, R_T_STOP, R_CONTACT_T, R_CONTACT_SPEED, R_CONTACT_DURATION, R_RESTITUTION,
- R_STICK_T, R_T_RUN) = range(21)
-N_REAL = 21
-# ... and its integers (W_INT): phase, counters, options, log lengths (I_N_EV counts the events
-# also when no log is kept: I_LOGGING 0) and the stick points (I_N_STICK of them, those from
-# I_OPEN_STICK on still waiting for their slip).
-(I_MODE, I_SIDE, I_NSTEPS, I_NFEV, I_NEXT_POLL, I_TIME_INDEX, I_N_EV, I_N_S, I_STATUS, I_REASON, I_SETTLE,
- I_STOP_KIND, I_STOP_COUNT, I_SAVE_KIND, I_MAX_STEPS, I_MAX_EVENTS, I_N_STICK, I_OPEN_STICK, I_LOGGING,
- I_HAVE_DENSE) = range(20)
-N_INT = 20
-N_ATOL = 7  # absolute tolerances of (x1, x2, v1, v2, W, t, w)
-# Rows of the stick points (W_STICKS): time, depth and dwell of each stick phase.
-ST_T, ST_DELTA, ST_DWELL = range(3)
 #: What :func:`_loop` returns: the run ended, or its logs must grow before it goes on.
 RUN_DONE, RUN_LOG_FULL = range(2)
-
-
-@allocating(python=True)
-def workspace(n_coef, capacity):
-    """The arrays of one run (members ``W_*``), reused run after run; ``capacity`` stick points."""
-    return (np.empty(N_REAL), np.zeros(N_INT, np.int64), np.empty(n_coef), np.empty(N_ATOL),
-            np.empty((N_Y_ROWS, 5)), np.empty((N_G_ROWS, N_EVENTS)), np.zeros(N_EVENTS, np.bool_),
-            np.empty((N_U_ROWS, N_STATE)), np.empty(N_STATS), np.zeros(N_KINDS, np.int64), np.empty(N_SUMMARY),
-            np.empty((3, capacity)), radau5.workspace(0.0))
 
 
 @kernel
@@ -618,7 +658,7 @@ def _start(code, ws, ev, smp, times):
         fired[k] = False
     # Plain phases integrate u = (x1, x2, v1, v2, W, t) in s = t; regularised contact phases
     # (side = +-1) integrate u = (w, x2, v1, v2, W, t) in s with dt = w ds (model.rhs.rhs_integration).
-    rtol, t_end, max_step = real[R_RTOL], real[R_T_END], real[R_MAX_STEP]
+    rtol, max_step = real[R_RTOL], real[R_MAX_STEP]
     w_floor = ws[W_ATOL][6] / rtol  # the scale of w = sqrt(|delta|)
     # a flight's steps only bracket events, between the target's passes through its centre; a
     # figure gets a sample every sixteenth of the target's period
@@ -630,12 +670,13 @@ def _start(code, ws, ev, smp, times):
     g_old = ws[W_G][G_OLD]
     phase_events(code, c, mode, side, energy_limit, u, y, f, force, g_old)
     _quiet_start(np.int64(DELTA), y, mode, g_old)
-    h_abs = _phase_step(code, c, mode, side, u, fu, rtol, atol_u, t_end, max_step, w_floor, ur[U_TMP], ur[U_FU_NEW])
+    ints[I_SIDE], real[R_W_FLOOR] = side, w_floor
+    h_abs = _phase_step(code, ws)
     if side == FLIGHT:
         flight.coefficients(c, u, 0.0, ur[U_STAGES:U_DENSE])  # kept for the whole flight (it has no stages)
     radau5.clear(ws[W_STIFF], real[R_STIFF_AFTER])
-    ints[I_SIDE], ints[I_NFEV], ints[I_NEXT_POLL] = side, 3, POLL_STEPS
-    real[R_S], real[R_H_ABS], real[R_FORCE], real[R_W_FLOOR] = 0.0, h_abs, force, w_floor
+    ints[I_NFEV], ints[I_NEXT_POLL] = 3, POLL_STEPS
+    real[R_S], real[R_H_ABS], real[R_FORCE] = 0.0, h_abs, force
     real[R_ENERGY_LIMIT], real[R_PAIR_ENERGY] = energy_limit, stuck_pair_energy(c, y)  # the pair's: read while stuck
 
 
@@ -689,19 +730,11 @@ _RETRY = -2  # _look_at_step: the step is to be retried smaller
 @kernel
 def _take_steps(code, ws, times):
     """Steps of the current phase while nothing happens (:func:`_advance`); returns its result."""
-    real, ints, yr, g, ur = ws[W_REAL], ws[W_INT], ws[W_Y], ws[W_G], ws[W_U]
-    u = ur[U_U]
+    ints, u = ws[W_INT], ws[W_U][U_U]
     save_kind, i_time, nsteps = ints[I_SAVE_KIND], ints[I_TIME_INDEX], ints[I_NSTEPS]
     next_sample = u[TIME] if save_kind == SAVE_STEPS else (
         times[i_time] if save_kind == SAVE_TIMES and i_time < times.shape[0] else math.inf)
-    result, s, h, h_abs, h_next, force, force_new, d_steps, d_fev = _advance(
-        code, ws[W_C], ints[I_MODE], ints[I_SIDE], real[R_S], real[R_T_END], u, ur[U_FU], yr[Y_STATE], yr[Y_F],
-        real[R_FORCE], real[R_H_ABS], real[R_RTOL], ur[U_ATOL], real[R_MAX_STEP], real[R_FLIGHT_STEP],
-        real[R_W_FLOOR], real[R_ENERGY_LIMIT], next_sample, min(ints[I_MAX_STEPS], ints[I_NEXT_POLL]) - nsteps,
-        g[G_OLD], g[G_NEW], ws[W_FIRED], ur[U_STAGES:U_DENSE], ur[U_NEW], ur[U_FU_NEW], yr[Y_NEW], yr[Y_F_NEW],
-        ws[W_STATS], ws[W_STIFF])
-    real[R_S], real[R_H], real[R_H_ABS], real[R_H_NEXT], real[R_FORCE], real[R_FORCE_NEW] = (
-        s, h, h_abs, h_next, force, force_new)
+    result, d_steps, d_fev = _advance(code, ws, next_sample, min(ints[I_MAX_STEPS], ints[I_NEXT_POLL]) - nsteps)
     ints[I_NSTEPS], ints[I_NFEV] = nsteps + d_steps, ints[I_NFEV] + d_fev
     return result
 
@@ -712,9 +745,8 @@ def _look_at_step(code, ws, ev):
     events that fired located and the recorded ones logged. Returns ``(restart_col, s_restart,
     s_horizon, stop_record)`` (see :func:`_locate_events`, :func:`_record`; inf where none);
     ``restart_col`` is ``_RETRY`` when the step must be retried smaller."""
-    real, ints, c, ur, yr, fired = ws[W_REAL], ws[W_INT], ws[W_C], ws[W_U], ws[W_Y], ws[W_FIRED]
-    mode, side, s, h = ints[I_MODE], ints[I_SIDE], real[R_S], real[R_H]
-    u, F = ur[U_U], ur[U_DENSE:]
+    real, ints, ur, fired = ws[W_REAL], ws[W_INT], ws[W_U], ws[W_FIRED]
+    side, h = ints[I_SIDE], real[R_H]
     any_fired = False
     for col in range(N_EVENTS):
         any_fired = any_fired or fired[col]
@@ -727,7 +759,7 @@ def _look_at_step(code, ws, ev):
     if regularised(side) and ur[U_NEW][TIME] >= real[R_T_END]:
         nfev += _step_interpolant(code, ws)
         have_dense = True
-        s_horizon = s_at_time(code, c, mode, side, F, u, s, h, real[R_T_END], ur[U_TRIAL], yr[Y_TRIAL], yr[Y_F_TRIAL])
+        s_horizon = s_at_time(code, ws, real[R_T_END])
     if any_fired:
         if not have_dense:
             nfev += _step_interpolant(code, ws)
@@ -745,25 +777,36 @@ def _look_at_step(code, ws, ev):
     return restart_col, s_restart, s_horizon, stop_record
 
 
-@kernel
+# inlined at numba level, like fresh_step: with their flight branch LLVM stopped inlining these
+# small dispatchers into the run, which cost runs without a flight 5-9 %
+@kernel(inline="always")
 def _step_interpolant(code, ws):
-    """The interpolant of the step :func:`_advance` left into ``U_DENSE``; returns the evaluations."""
-    ints, ur = ws[W_INT], ws[W_U]
-    return _interpolant(code, ws[W_C], ints[I_MODE], ints[I_SIDE], ur[U_U], ur[U_FU], ur[U_NEW], ur[U_FU_NEW],
-                        ws[W_REAL][R_H], ur[U_STAGES:U_DENSE], ur[U_DENSE:], ur[U_TMP], ws[W_STIFF])
+    """The interpolant of the step :func:`_advance` left into rows ``U_DENSE`` (a flight's
+    invariants, see :func:`~.phase.dense`); returns the evaluations spent."""
+    ints, ur, stiff = ws[W_INT], ws[W_U], ws[W_STIFF]
+    side, K, F = ints[I_SIDE], ur[U_STAGES:U_DENSE], ur[U_DENSE:]
+    if side == FLIGHT:
+        copy_values(K[0], F[0])  # the flight's invariants
+        return 0
+    if radau5.active(stiff):
+        radau5.dense_coefficients(stiff, F)
+        return 0
+    dop853.dense_coefficients(code, ws[W_C], ints[I_MODE], side, ur[U_U], ur[U_FU], ur[U_NEW], ur[U_FU_NEW],
+                              ws[W_REAL][R_H], K, F, ur[U_TMP])
+    return 3
 
 
 @kernel
 def _after_step(code, ws, ev, smp, times, restart_col, s_restart, s_horizon, stop_record):
     """After :func:`_look_at_step`: stop at a recorded event, take the samples in the step, stop on
     the horizon, restart at an event, or accept the whole step. Returns True when the run ends."""
-    real, ints, c, ur, yr, stiff = ws[W_REAL], ws[W_INT], ws[W_C], ws[W_U], ws[W_Y], ws[W_STIFF]
+    real, ints, c, ur, yr = ws[W_REAL], ws[W_INT], ws[W_C], ws[W_U], ws[W_Y]
     mode, side, s = ints[I_MODE], ints[I_SIDE], real[R_S]
-    u, fu, u_r, K, y, f = ur[U_U], ur[U_FU], ur[U_ROOT], ur[U_STAGES:U_DENSE], yr[Y_STATE], yr[Y_F]
+    u, fu, u_r, y, f = ur[U_U], ur[U_FU], ur[U_ROOT], yr[Y_STATE], yr[Y_F]
     if stop_record >= 0:
         # stopped at a recorded event: the state there from a fresh step that ends at it
         if stop_record > s:
-            ints[I_NFEV] += fresh_step(code, c, mode, side, s, u, fu, stop_record - s, K, u_r, ur[U_FU_ROOT], stiff)
+            ints[I_NFEV] += fresh_step(code, ws, stop_record - s, u_r, ur[U_FU_ROOT])
             copy_values(u_r, u)
             if not regularised(side):
                 u[TIME] = stop_record
@@ -774,7 +817,7 @@ def _after_step(code, ws, ev, smp, times, restart_col, s_restart, s_horizon, sto
         _samples_in_step(code, ws, smp, times, restart_col, s_restart, s_horizon)
     if restart_col < 0 and s_horizon < math.inf:
         # a regularised phase reaches the horizon inside the step: the state there from a fresh step
-        ints[I_NFEV] += fresh_step(code, c, mode, side, s, u, fu, s_horizon - s, K, u_r, ur[U_FU_ROOT], stiff)
+        ints[I_NFEV] += fresh_step(code, ws, s_horizon - s, u_r, ur[U_FU_ROOT])
         copy_values(u_r, u)
         u[TIME] = real[R_T_END]  # without the root finder's residue
         force = physical(code, c, mode, side, u, y, f)
@@ -826,7 +869,7 @@ def _samples_in_step(code, ws, smp, times, restart_col, s_restart, s_horizon):
         if not have_dense:
             ints[I_NFEV] += _step_interpolant(code, ws)
             have_dense = True
-        s_i = s_at_time(code, c, mode, side, F, u, s, h, times[i_time], us, ys, fs)
+        s_i = s_at_time(code, ws, times[i_time])
         dense(c, side, F, u, s, h, s_i, us)
         f_i = physical(code, c, mode, side, us, ys, fs)
         add_sample(ws, smp, times[i_time], ys, mode, f_i)

@@ -16,6 +16,26 @@ from ..model.laws import dent_depth
 from ..model.rhs import FLIGHT, V1, V2, WORK, X1, X2, relative_slip, rhs, rhs_integration
 from . import dop853, flight, radau5
 from .events import DELTA, DELTADOT, FORCE_RATE, N_EVENTS, event_value, event_values
+from .record import (
+    I_MODE,
+    I_SIDE,
+    R_ENERGY_LIMIT,
+    R_H,
+    R_S,
+    U_DENSE,
+    U_FU,
+    U_STAGES,
+    U_TRIAL,
+    U_U,
+    W_C,
+    W_INT,
+    W_REAL,
+    W_STIFF,
+    W_U,
+    W_Y,
+    Y_F_TRIAL,
+    Y_TRIAL,
+)
 
 TIME = 5  # the physical time in the integration state u
 TIME_COLUMN = N_EVENTS  # a pseudo event column: the physical time minus a target
@@ -112,13 +132,16 @@ def phase_events(code, c, mode, side, energy_limit, u, y, f, force, g):
 
 
 @kernel
-def event_at(code, c, mode, side, energy_limit, target, column, F, u0, s0, h, s, us, ys, fs):
-    """Event function ``column`` at ``s`` on the dense output of the step; the pseudo column
-    ``TIME_COLUMN`` is the physical time minus ``target`` (horizon and output times of a
-    regularised phase, where ``t`` is a component of the state). The physical state is left in
-    ``ys``; the right-hand side (``fs``) is evaluated only for the force's rate, the one event that
+def event_at(code, ws, column, target, s):
+    """Event function ``column`` at ``s`` on the dense output of the run's step (``R_S``, ``R_H``
+    from row ``U_U``, interpolant ``U_DENSE``); the pseudo column ``TIME_COLUMN`` is the physical
+    time minus ``target`` (horizon and output times of a regularised phase, where ``t`` is a
+    component of the state). The state is left in rows ``U_TRIAL`` and ``Y_TRIAL``; the
+    right-hand side (``Y_F_TRIAL``) is evaluated only for the force's rate, the one event that
     reads it."""
-    dense(c, side, F, u0, s0, h, s, us)
+    c, ints, ur, yr = ws[W_C], ws[W_INT], ws[W_U], ws[W_Y]
+    mode, side, us, ys, fs = ints[I_MODE], ints[I_SIDE], ur[U_TRIAL], yr[Y_TRIAL], yr[Y_F_TRIAL]
+    dense(c, side, ur[U_DENSE:], ur[U_U], ws[W_REAL][R_S], ws[W_REAL][R_H], s, us)
     if column == TIME_COLUMN:
         return us[TIME] - target
     if column == DELTA and regularised(side) and dent_depth(code, c) == 0.0:
@@ -130,15 +153,18 @@ def event_at(code, c, mode, side, energy_limit, target, column, F, u0, s0, h, s,
     else:
         physical_state(code, mode, side, us, ys)
         force = math.nan
-    return event_value(code, c, ys, fs, force, mode, energy_limit, column)
+    return event_value(code, c, ys, fs, force, mode, ws[W_REAL][R_ENERGY_LIMIT], column)
 
 
 # inlined at numba level, like the two below: with their flight branch LLVM stopped inlining
 # these small dispatchers into the run, which cost runs without a flight 5-9 %
 @kernel(inline="always")
-def fresh_step(code, c, mode, side, s, u, fu, h, K, u_new, fu_new, stiff):
-    """A step of exactly ``h`` from ``(s, u)`` with the phase's current method (the state at a
-    root, a stop or the horizon); returns the evaluations spent."""
+def fresh_step(code, ws, h, u_new, fu_new):
+    """A step of exactly ``h`` from the run's state (``R_S``, row ``U_U``) with the phase's current
+    method into ``u_new``, ``fu_new`` (the state at a root, a stop or the horizon); returns the
+    evaluations spent."""
+    c, ints, ur, stiff = ws[W_C], ws[W_INT], ws[W_U], ws[W_STIFF]
+    mode, side, s, u, fu, K = ints[I_MODE], ints[I_SIDE], ws[W_REAL][R_S], ur[U_U], ur[U_FU], ur[U_STAGES:U_DENSE]
     if side == FLIGHT:
         flight.state_at(c, K, u, s, s + h, u_new)  # K: the flight's invariants
         rhs_integration(code, c, u_new, mode, side, fu_new)

@@ -15,6 +15,23 @@ from ..model.rhs import X1, X2, energy, rhs
 from .driver import (
     FAILED_STOP,
     HORIZON,
+    INTERRUPTED,
+    NON_FINITE,
+    POLL_STEPS,
+    RUNAWAY_STOP,
+    SAVE_STEPS,
+    SUCCESS,
+    TOO_MANY_STEPS,
+    add_sample,
+    grow,
+    log_event,
+    new_logs,
+    open_logs,
+    summarize,
+)
+from .events import CONTACT, SEPARATION, energy_limit_of
+from .phase import copy_values
+from .record import (
     I_LOGGING,
     I_MODE,
     I_N_EV,
@@ -24,16 +41,9 @@ from .driver import (
     I_REASON,
     I_SAVE_KIND,
     I_STATUS,
-    INTERRUPTED,
-    NON_FINITE,
-    POLL_STEPS,
     R_T_STOP,
-    RUNAWAY_STOP,
-    SAVE_STEPS,
     STAT_MAX_FORCE,
     STAT_MAX_INDENTATION,
-    SUCCESS,
-    TOO_MANY_STEPS,
     W_C,
     W_INT,
     W_REAL,
@@ -42,16 +52,8 @@ from .driver import (
     W_Y,
     Y_START,
     Y_STATE,
-    add_sample,
-    grow,
-    log_event,
-    new_logs,
-    open_logs,
-    summarize,
     workspace,
 )
-from .events import CONTACT, SEPARATION, energy_limit_of
-from .phase import copy_values
 
 # Scratch rows (5 numbers): the rate at the state, a stage's argument, the step's end and its rate, the stages.
 RK_F, RK_TMP, RK_Y_NEW, RK_F_NEW, RK_K = range(5)
