@@ -304,9 +304,8 @@ def _advance(code, ws, next_sample, steps_left):
                                               ws[W_STATS], ws[W_STIFF])
     mode, side, s, t_end, force, h_abs = ints[I_MODE], ints[I_SIDE], real[R_S], real[R_T_END], real[R_FORCE], \
         real[R_H_ABS]
-    max_step, flight_step, w_floor, energy_limit = real[R_MAX_STEP], real[R_FLIGHT_STEP], real[R_W_FLOOR], \
-        real[R_ENERGY_LIMIT]
-    u, fu, u_new, fu_new, K = ur[U_U], ur[U_FU], ur[U_NEW], ur[U_FU_NEW], ur[U_STAGES:U_DENSE]
+    max_step, w_floor, energy_limit = real[R_MAX_STEP], real[R_W_FLOOR], real[R_ENERGY_LIMIT]
+    u, fu, u_new, fu_new = ur[U_U], ur[U_FU], ur[U_NEW], ur[U_FU_NEW]
     y, f, y_new, f_new, g_old, g_new, fired = yr[Y_STATE], yr[Y_F], yr[Y_NEW], yr[Y_F_NEW], g[G_OLD], g[G_NEW], \
         ws[W_FIRED]
     steps = 0
@@ -319,14 +318,8 @@ def _advance(code, ws, next_sample, steps_left):
         if steps >= steps_left:
             _advanced(real, s, h, h_abs, h_next, force, force_new)
             return _ADV_LIMIT, steps, evaluations
-        if side == FLIGHT:  # K: the flight's invariants (it has no stages)
-            if flight_step == math.inf and flight.unreachable(K, u):
-                s_new = s_bound
-            else:
-                s_new = min(s + min(h_abs, flight_step), s_bound, flight.next_centre(K, s))
-            flight.state_at(c, K, u, s, s_new, u_new)
-            force_new = rhs_integration(code, c, u_new, mode, side, fu_new)
-            ok, h_next, spent = True, flight_step, 0
+        if side == FLIGHT:
+            ok, s_new, h_next, force_new, spent = _flight_attempt(code, ws, s, s_bound, h_abs)
         else:
             # a regularised phase advances the time by w ds: its cap on the time step is one on s
             h_abs = min(h_abs, max_step if not regularised(side) else max_step / max(abs(u[0]), w_floor))
@@ -343,17 +336,8 @@ def _advance(code, ws, next_sample, steps_left):
             return _ADV_COLLAPSE, steps, evaluations
         h = s_new - s
         steps += 1
-        if not regularised(side):
-            u_new[TIME] = s_new  # t' = 1: the time is s itself, without the sum's rounding
-            for j in range(5):
-                y_new[j] = u_new[j]
-                f_new[j] = fu_new[j]
-            if relative_slip(code, mode, side):
-                y_new[V1] = u_new[V1] + u_new[V2]
-                f_new[V1] = fu_new[V1] + fu_new[V2]
-        else:
-            force_new = physical(code, c, mode, side, u_new, y_new, f_new)
-            evaluations += 1
+        force_new, spent = _step_end(code, ws, s_new, force_new)
+        evaluations += spent
         if side != FLIGHT and not radau5.active(stiff):
             radau5.watch(stiff, h * damping_rate(code, c, u_new, mode, side))
         phase_events(code, c, mode, side, energy_limit, u_new, y_new, f_new, force_new, g_new)
@@ -376,6 +360,42 @@ def _advance(code, ws, next_sample, steps_left):
         stats[STAT_MAX_INDENTATION] = max(stats[STAT_MAX_INDENTATION], y[X1] - y[X2])
     _advanced(real, s, h, h_abs, h_next, force, force_new)
     return _ADV_END, steps, evaluations
+
+
+@kernel(inline="always")  # the hot loop's own code, like the two below
+def _flight_attempt(code, ws, s, s_bound, h_abs):
+    """A flight's step (closed form, the flight's invariants in rows ``U_STAGES``), as
+    :func:`_dop853_attempt` returns it: to ``s_bound`` at once when no event can happen any more
+    and no step is kept, else at most ``R_FLIGHT_STEP`` and to the target's next pass through its
+    centre."""
+    c, ints, ur, flight_step = ws[W_C], ws[W_INT], ws[W_U], ws[W_REAL][R_FLIGHT_STEP]
+    u, u_new, K = ur[U_U], ur[U_NEW], ur[U_STAGES:U_DENSE]
+    if flight_step == math.inf and flight.unreachable(K, u):
+        s_new = s_bound
+    else:
+        s_new = min(s + min(h_abs, flight_step), s_bound, flight.next_centre(K, s))
+    flight.state_at(c, K, u, s, s_new, u_new)
+    force_new = rhs_integration(code, c, u_new, ints[I_MODE], ints[I_SIDE], ur[U_FU_NEW])
+    return True, s_new, flight_step, force_new, 0
+
+
+@kernel(inline="always")
+def _step_end(code, ws, s_new, force_new):
+    """The physical state and rate at a step's end (rows ``Y_NEW``, ``Y_F_NEW`` from ``U_NEW``,
+    ``U_FU_NEW``); returns ``(force, evaluations)``."""
+    c, ints, ur, yr = ws[W_C], ws[W_INT], ws[W_U], ws[W_Y]
+    mode, side, u_new, fu_new, y_new, f_new = ints[I_MODE], ints[I_SIDE], ur[U_NEW], ur[U_FU_NEW], yr[Y_NEW], \
+        yr[Y_F_NEW]
+    if regularised(side):
+        return physical(code, c, mode, side, u_new, y_new, f_new), 1
+    u_new[TIME] = s_new  # t' = 1: the time is s itself, without the sum's rounding
+    for j in range(5):
+        y_new[j] = u_new[j]
+        f_new[j] = fu_new[j]
+    if relative_slip(code, mode, side):
+        y_new[V1] = u_new[V1] + u_new[V2]
+        f_new[V1] = fu_new[V1] + fu_new[V2]
+    return force_new, 0
 
 
 @kernel(inline="always")
