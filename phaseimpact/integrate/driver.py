@@ -558,15 +558,28 @@ def _restart(code, ws, column, s_restart):
 # ------------------------------------------------------------------------------------------------
 #: What :func:`_loop` returns: the run ended, or its logs must grow before it goes on.
 RUN_DONE, RUN_LOG_FULL = range(2)
+#: The options of a run, a tuple: relative tolerance, whether to stop once settled, the event kind
+#: and count to stop at (-1: none), the step and event caps, DOP853 steps at the stability limit
+#: before Radau (0: never). The same for every run of a batch.
+OPT_RTOL, OPT_SETTLE, OPT_STOP_KIND, OPT_STOP_COUNT, OPT_MAX_STEPS, OPT_MAX_EVENTS, OPT_STIFF_AFTER = range(7)
+#: A batch of runs (:func:`run_block`), a tuple of arrays with a row or entry per run: coefficients,
+#: start states, horizons, absolute tolerances (n, 7), largest steps.
+B_C, B_Y0, B_T_END, B_ATOL, B_MAX_STEP = range(5)
+#: What :func:`run_block` fills, a tuple of arrays with a row or entry per run: the summaries, the
+#: stick points' times, depths and dwells (their first ``capacity``), their numbers.
+O_SUMMARY, O_STICK_T, O_STICK_DELTA, O_STICK_DWELL, O_STICK_COUNT = range(5)
 
 
 @kernel
-def _set_options(ws, t_end, rtol, max_step, settle, stop_kind, stop_count, save_kind, max_steps, stiff_after):
-    """A run's options into its record (see :func:`run`)."""
+def _set_options(ws, options, t_end, max_step, save_kind):
+    """A run's options (the tuple ``OPT_*``), horizon, largest step and save kind into its record."""
     real, ints = ws[W_REAL], ws[W_INT]
-    real[R_T_END], real[R_RTOL], real[R_MAX_STEP], real[R_STIFF_AFTER] = t_end, rtol, max_step, stiff_after
-    ints[I_SETTLE], ints[I_STOP_KIND], ints[I_STOP_COUNT] = settle, stop_kind, stop_count
-    ints[I_SAVE_KIND], ints[I_MAX_STEPS] = save_kind, max_steps
+    real[R_T_END], real[R_RTOL], real[R_MAX_STEP], real[R_STIFF_AFTER] = (t_end, options[OPT_RTOL], max_step,
+                                                                          options[OPT_STIFF_AFTER])
+    ints[I_SETTLE], ints[I_STOP_KIND], ints[I_STOP_COUNT] = (options[OPT_SETTLE], options[OPT_STOP_KIND],
+                                                             options[OPT_STOP_COUNT])
+    ints[I_SAVE_KIND], ints[I_MAX_STEPS] = save_kind, options[OPT_MAX_STEPS]
+    ints[I_MAX_EVENTS] = options[OPT_MAX_EVENTS]
 
 
 @kernel
@@ -1002,9 +1015,9 @@ def new_logs(save_kind, times):
 
 
 @allocating(python=True, nogil=True)  # runs side by side in threads (phaseimpact.train's orbit diagrams)
-def run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count, save_kind, times,
-        max_steps, max_events, stiff_after):
-    """Integrate one trajectory. See :func:`phaseimpact.integrate.simulate` for the meaning.
+def run(code, c, y0, atol, t_end, max_step, options, save_kind, times):
+    """Integrate one trajectory. See :func:`phaseimpact.integrate.simulate` for the meaning;
+    ``options`` is the tuple ``OPT_*``.
 
     Returns ``(summary, events, samples, y_final)``: the event log (columns ``EV_*``) and the
     samples (columns ``SMP_*``) trimmed to their lengths. The per-point kernels of
@@ -1015,9 +1028,9 @@ def run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count,
     copy_values(c, ws[W_C])
     copy_values(y0, ws[W_Y][Y_START])
     copy_values(atol, ws[W_ATOL])
-    _set_options(ws, t_end, rtol, max_step, settle, stop_kind, stop_count, save_kind, max_steps, stiff_after)
+    _set_options(ws, options, t_end, max_step, save_kind)
     ints = ws[W_INT]
-    ints[I_MAX_EVENTS], ints[I_LOGGING] = max_events, 1
+    ints[I_LOGGING] = 1
     ev, smp = new_logs(save_kind, times)
     _start(code, ws, ev, smp, times)
     while _loop(code, ws, ev, smp, times) == RUN_LOG_FULL:
@@ -1027,13 +1040,28 @@ def run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count,
     return ws[W_SUMMARY].copy(), ev[:ints[I_N_EV]], smp[:ints[I_N_S]], ws[W_Y][Y_STATE].copy()
 
 
+@kernel
+def run_point(code, ws, batch, options, i):
+    """Run ``i`` of ``batch`` (the tuple ``B_*``) in the workspace ``ws``, summary only, without an
+    event log: its summary in ``W_SUMMARY``, its stick points in ``W_STICKS`` (the first of
+    them, ``I_N_STICK`` in all). Allocates nothing: a thread's whole work for one point."""
+    copy_values(batch[B_C][i], ws[W_C])
+    copy_values(batch[B_Y0][i], ws[W_Y][Y_START])
+    copy_values(batch[B_ATOL][i], ws[W_ATOL])
+    _set_options(ws, options, batch[B_T_END][i], batch[B_MAX_STEP][i], np.int64(SAVE_SUMMARY))
+    ws[W_INT][I_LOGGING] = 0
+    no_log, no_times = ws[W_G][:0], ws[W_G][0, :0]  # log_event writes no event, and nothing samples
+    _start(code, ws, no_log, no_log, no_times)
+    _loop(code, ws, no_log, no_log, no_times)
+    summarize(code, ws)
+
+
 @allocating(python=True, nogil=True)
-def run_block(code, C, Y0, t_end, rtol, ATOL, max_step, settle, stop_kind, stop_count, max_steps, max_events,
-              stiff_after, start, stop, step, summary, st_t, st_delta, st_dwell, st_count):
+def run_block(code, batch, options, start, stop, step, outputs):
     """Runs ``start, start + step, ...`` (below ``stop``) of a batch, without the GIL (callers run
-    blocks in threads; each run's numbers depend on nothing else). Fills ``summary`` (n, N_SUMMARY)
-    and the first ``capacity`` stick points of each run; ``st_count`` holds each run's full number
-    of stick points (more than ``capacity``: the caller runs it again with room for them all).
+    blocks in threads; each run's numbers depend on nothing else). Fills ``outputs`` (the tuple
+    ``O_*``): the summaries (n, N_SUMMARY), the first ``capacity`` stick points of each run and its
+    full number of stick points (more than ``capacity``: the caller runs it again on the full path).
     Threads over blocks, not a compiled parallel loop: that would compile the driver a second
     time. A thread's block is every ``step``-th run, not a contiguous range: the cost of a run
     changes smoothly over a sweep or an atlas (many times over near kappa_c), so interleaved blocks
@@ -1041,13 +1069,11 @@ def run_block(code, C, Y0, t_end, rtol, ATOL, max_step, settle, stop_kind, stop_
     an expensive stretch. On Ctrl-C or SIGTERM the rest of the block is left with the status
     ``interrupted``.
 
-    The block's one workspace is made here, once; each run goes through the per-point kernels
-    (:func:`_start`, :func:`_loop`, :func:`summarize`) in it, without an event log, and allocates
-    nothing."""
-    ws = workspace(C.shape[1], st_t.shape[1])
-    no_events = np.empty((0, N_EV_COLUMNS))
-    no_samples = np.empty((0, N_SMP_COLUMNS))
-    no_times = np.empty(0)
+    The block's one workspace is made here, once; each run goes through :func:`run_point` in it,
+    without an event log, and allocates nothing."""
+    summary, st_t, st_delta, st_dwell, st_count = (outputs[O_SUMMARY], outputs[O_STICK_T], outputs[O_STICK_DELTA],
+                                                   outputs[O_STICK_DWELL], outputs[O_STICK_COUNT])
+    ws = workspace(batch[B_C].shape[1], st_t.shape[1])
     ints, sticks = ws[W_INT], ws[W_STICKS]
     done = 0
     for i in range(start, stop, step):
@@ -1056,15 +1082,7 @@ def run_block(code, C, Y0, t_end, rtol, ATOL, max_step, settle, stop_kind, stop_
             for j in range(i, stop, step):
                 summary[j, S_STATUS] = INTERRUPTED
             break
-        copy_values(C[i], ws[W_C])
-        copy_values(Y0[i], ws[W_Y][Y_START])
-        copy_values(ATOL[i], ws[W_ATOL])
-        _set_options(ws, t_end[i], rtol, max_step[i], settle, stop_kind, stop_count, np.int64(SAVE_SUMMARY),
-                     max_steps, stiff_after)
-        ints[I_MAX_EVENTS], ints[I_LOGGING] = max_events, 0
-        _start(code, ws, no_events, no_samples, no_times)
-        _loop(code, ws, no_events, no_samples, no_times)
-        summarize(code, ws)
+        run_point(code, ws, batch, options, i)
         copy_values(ws[W_SUMMARY], summary[i])
         st_count[i] = ints[I_N_STICK]
         for j in range(min(ints[I_N_STICK], sticks.shape[1])):
