@@ -9,10 +9,12 @@ steps while none fires); each crossing is located on the step's dense output (:m
 Radau's roots then polished on steps: :func:`_locate_events`); recorded events are logged
 (:func:`_record`), and at the first event that changes the phase the state is taken from a
 fresh step that ends exactly at the root, the transition is applied and the run restarts there
-in the new mode (:func:`_restart`). :func:`run` holds the loop and the run's logs.
-
-Scratch vectors are rows of a few arrays with named rows (``Y_*``, ``G_*``, ``U_*``); the kernels of
-one phase (its states, dense output, event values) are in :mod:`.phase`.
+in the new mode (:func:`_restart`). :func:`_start`, :func:`_loop` and :func:`summarize` are
+the per-point kernels: they read and write one run's workspace (:mod:`.record`) and allocate
+nothing. :func:`run_point` runs one point of a batch in them (no event log; the summary and the
+stick points follow the events as they happen), :func:`run_block` many in one workspace, and
+:func:`run` one trajectory with logs that grow between passes of the loop. The kernels of one
+phase (its states, dense output, event values) are in :mod:`.phase`.
 
 Everything here is scalars and small arrays (numba's subset); strings, objects and messages are
 made outside (:mod:`.api`). The same source runs uncompiled with ``NUMBA_DISABLE_JIT=1``.
