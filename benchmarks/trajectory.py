@@ -58,18 +58,16 @@ def driver_args(params, law, t_end, rtol, stop_on):
     s = api.scales(params)
     stop_kind, stop_count = api._stop_on(stop_on)
     horizon = s.horizon if t_end is None else t_end
-    return (law.code, pack(params, law), api._initial(params, None), horizon, rtol, api._atol(params, rtol, None),
-            s.max_step, True, stop_kind, stop_count, d.SAVE_SUMMARY, np.empty(0), api.MAX_STEPS, api.MAX_EVENTS,
-            api._stiff_after(True))
+    return (law.code, pack(params, law), api._initial(params, None), api._atol(params, rtol, None), horizon,
+            s.max_step, (rtol, True, stop_kind, stop_count, api.MAX_STEPS, api.MAX_EVENTS, api._stiff_after(True)),
+            d.SAVE_SUMMARY, np.empty(0))
 
 
 @numba.njit
-def _loop(n, code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count, save_kind, times, max_steps,
-          max_events, stiff_after):
+def _loop(n, code, c, y0, atol, t_end, max_step, options, save_kind, times):
     total = 0.0
     for _ in range(n):
-        out = d.run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count, save_kind, times,
-                    max_steps, max_events, stiff_after)
+        out = d.run(code, c, y0, atol, t_end, max_step, options, save_kind, times)
         total += out[0][d.S_MAX_FORCE]
     return total
 

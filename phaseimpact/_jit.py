@@ -223,9 +223,9 @@ def announce() -> str:
     return f"phaseimpact: compiling the engine once for this machine, {FIRST_COMPILE} on 2 cores (cache: {info.path})"
 
 
-#: The module of the run loops called from Python, whose compile is the engine's (a kernel called
+#: The modules of the run loops called from Python, whose compile is the engine's (a kernel called
 #: from Python, as the tests do, compiles in a second).
-_ENTRIES_MODULE = "phaseimpact.integrate.driver"
+_ENTRIES_MODULES = ("phaseimpact.integrate.driver", "phaseimpact.integrate.rk4")
 
 
 @functools.cache
@@ -239,7 +239,7 @@ def _listen_for_first_compile() -> None:
 
         def on_start(self, ev):
             dispatcher = ev.data["dispatcher"]
-            if (not self.announced and getattr(dispatcher.py_func, "__module__", "") == _ENTRIES_MODULE
+            if (not self.announced and getattr(dispatcher.py_func, "__module__", "") in _ENTRIES_MODULES
                     and not dispatcher.targetoptions.get("no_cpython_wrapper", False)):
                 self.announced = True
                 print(announce(), file=sys.stderr, flush=True)

@@ -318,19 +318,18 @@ def test_engine_kernels_are_compiled_without_reference_counting():
     time of a trajectory)."""
     from numba.core.registry import CPUDispatcher
 
-    from phaseimpact.integrate import _dop853_stages, dop853, driver, events, radau5
+    from phaseimpact.integrate import _dop853_stages, dop853, driver, events, phase, radau5, record, rk4, rootfind
     from phaseimpact.model import laws
     from phaseimpact.model import rhs as rhs_module
 
     counted = set()
-    for module in (laws, rhs_module, events, _dop853_stages, dop853, radau5, driver):
+    for module in (laws, rhs_module, events, _dop853_stages, dop853, radau5, record, phase, rootfind, driver, rk4):
         for name, obj in vars(module).items():
             if isinstance(obj, CPUDispatcher) and obj.py_func.__module__ == module.__name__:
                 assert "_nrt" in obj.targetoptions, f"{module.__name__}.{name} is not declared through _jit"
                 if obj.targetoptions["_nrt"]:
                     counted.add(name)
-    assert counted == {"run", "_run", "run_block", "run_rk4", "_open_logs", "_grow", "_push_event", "_push_sample",
-                       "_summarize", "workspace"}
+    assert counted == {"run", "run_block", "run_rk4", "grow", "new_logs", "workspace"}
 
 
 def _python_calls_of_compiled_functions():
@@ -420,7 +419,7 @@ def test_no_kernel_returns_an_array():
     from numba.core import types
     from numba.core.registry import CPUDispatcher
 
-    from phaseimpact.integrate import _dop853_stages, dop853, driver, events, radau5
+    from phaseimpact.integrate import _dop853_stages, dop853, driver, events, phase, radau5, record, rk4, rootfind
     from phaseimpact.model import laws
     from phaseimpact.model import rhs as rhs_module
 
@@ -437,9 +436,9 @@ def test_no_kernel_returns_an_array():
         index = dispatcher._cache._cache_file._load_index()
         return [dispatcher._cache.load_overload(key[0], dispatcher.targetctx).signature.return_type for key in index]
 
-    assert any(holds_array(t) for t in return_types(driver._grow))  # the check sees an array return
+    assert any(holds_array(t) for t in return_types(driver.grow))  # the check sees an array return
     checked = 0
-    for module in (laws, rhs_module, events, _dop853_stages, dop853, radau5, driver):
+    for module in (laws, rhs_module, events, _dop853_stages, dop853, radau5, record, phase, rootfind, driver, rk4):
         for name, obj in vars(module).items():
             if isinstance(obj, CPUDispatcher) and obj.py_func.__module__ == module.__name__ \
                     and not obj.targetoptions["_nrt"]:

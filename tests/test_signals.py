@@ -24,6 +24,7 @@ import pytest
 from phaseimpact import _signals, archive, seed_parameters, simulate, simulate_many
 from phaseimpact.integrate import api
 from phaseimpact.integrate import driver as d
+from phaseimpact.integrate.rk4 import run_rk4
 from phaseimpact.model import as_law, pack
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -35,9 +36,9 @@ def _run_args(params, law, t_end):
     """The arguments simulate gives driver.run (summary, settle)."""
     law = as_law(law)
     s = api.scales(params)
-    return (law.code, pack(params, law), api._initial(params, None), t_end, 1e-10, api._atol(params, 1e-10, None),
-            s.max_step, True, -1, 0, d.SAVE_SUMMARY, np.empty(0), api.MAX_STEPS, api.MAX_EVENTS,
-            api._stiff_after(True))
+    return (law.code, pack(params, law), api._initial(params, None), api._atol(params, 1e-10, None), t_end,
+            s.max_step, (1e-10, True, -1, 0, api.MAX_STEPS, api.MAX_EVENTS, api._stiff_after(True)), d.SAVE_SUMMARY,
+            np.empty(0))
 
 
 @pytest.fixture
@@ -58,9 +59,9 @@ def test_a_byte_in_the_pipe_stops_a_compiled_run_at_its_next_look(pipe):
     assert d.STATUSES[int(stopped[d.S_STATUS])] == "interrupted" and d.OUTCOMES[int(stopped[d.S_OUTCOME])] == "failed"
     assert stopped[d.S_NSTEPS] == d.POLL_STEPS  # the first look
     # the RK4 loop looks too
-    code, c, y0, t_end, *_ = _run_args(seed_parameters(v=1.0, kappa=3e9), "hunt-crossley", 2e-3)
+    code, c, y0, _, t_end, *_ = _run_args(seed_parameters(v=1.0, kappa=3e9), "hunt-crossley", 2e-3)
     os.write(pipe, b"\x02")
-    stopped = d.run_rk4(code, c, y0, t_end, d.SAVE_SUMMARY, np.empty(0), api.MAX_STEPS, 1e-8, 1)[0]  # 2e5 steps
+    stopped = run_rk4(code, c, y0, t_end, d.SAVE_SUMMARY, np.empty(0), api.MAX_STEPS, 1e-8, 1)[0]  # 2e5 steps
     assert d.STATUSES[int(stopped[d.S_STATUS])] == "interrupted" and stopped[d.S_NSTEPS] == d.POLL_STEPS
 
 
@@ -99,8 +100,9 @@ def _interrupted_block(pipe, start: int, step: int) -> np.ndarray:
     st = np.empty((3, n, 32))
     count = np.empty(n, np.int64)
     os.write(pipe, b"\x02")
-    d.run_block(batch.law.code, batch.C, batch.Y0, batch.t_end, 1e-10, batch.atol, batch.max_step, True, -1, 0,
-                api.MAX_STEPS, api.MAX_EVENTS, api._stiff_after(True), start, n, step, summary, *st, count)
+    d.run_block(batch.law.code, (batch.C, batch.Y0, batch.t_end, batch.atol, batch.max_step),
+                (1e-10, True, -1, 0, api.MAX_STEPS, api.MAX_EVENTS, api._stiff_after(True)), start, n, step,
+                (summary, *st, count))
     return summary[:, d.S_STATUS]
 
 

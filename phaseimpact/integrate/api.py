@@ -20,6 +20,7 @@ from . import driver as d
 from . import radau5
 from .events import EVENT_KINDS
 from .result import Columns, Trajectory
+from .rk4 import run_rk4
 
 __all__ = ["simulate", "simulate_many", "Scales", "scales", "INTEGRATORS", "RTOL_RANGE"]
 
@@ -383,11 +384,11 @@ def simulate(params: Parameters, law: ContactLaw | str = "paper", t_end: float |
         if native is not None:
             native.reset()
         if rk4_step:
-            out = d.run_rk4(law.code, c, y0, horizon, save_kind, times, int(max_steps), rk4_step, int(every))
+            out = run_rk4(law.code, c, y0, horizon, save_kind, times, int(max_steps), rk4_step, int(every))
         else:
-            out = d.run(law.code, c, y0, horizon, rtol, default_atol if atol is None else _atol(params, rtol, atol),
-                        s.max_step, settle, stop_kind, stop_count, save_kind, times, int(max_steps), MAX_EVENTS,
-                        stiff_after)
+            out = d.run(law.code, c, y0, default_atol if atol is None else _atol(params, rtol, atol), horizon,
+                        s.max_step, (rtol, settle, stop_kind, stop_count, int(max_steps), MAX_EVENTS, stiff_after),
+                        save_kind, times)
         woken = _woken(out[0][d.S_STATUS], native)
         if not (woken or _signals.deferred):
             break
@@ -485,8 +486,8 @@ def run_batch(batch: Batch, *, rtol: float, settle: bool = True, stop_on=None, n
     summary = np.empty((n, d.N_SUMMARY))
     st = np.empty((3, n, capacity))
     count = np.empty(n, np.int64)
-    args = (batch.law.code, batch.C, batch.Y0, batch.t_end, rtol, batch.atol, batch.max_step, settle, stop_kind,
-            stop_count, MAX_STEPS, MAX_EVENTS, stiff_after)
+    args = (batch.law.code, (batch.C, batch.Y0, batch.t_end, batch.atol, batch.max_step),
+            (rtol, settle, stop_kind, stop_count, MAX_STEPS, MAX_EVENTS, stiff_after))
     outputs = (summary, st[0], st[1], st[2], count)
     threads = max(1, min(int(n_threads), n))
     if not _signals.installed:
@@ -496,10 +497,10 @@ def run_batch(batch: Batch, *, rtol: float, settle: bool = True, stop_on=None, n
         if native is not None:
             native.reset()
         if threads == 1:
-            d.run_block(*args, 0, n, 1, *outputs)
+            d.run_block(*args, 0, n, 1, outputs)
         else:  # thread k runs k, k + threads, ...: equal loads (run_block); the driver releases the GIL
             with ThreadPoolExecutor(threads) as pool:
-                list(pool.map(lambda start: d.run_block(*args, start, n, threads, *outputs), range(threads)))
+                list(pool.map(lambda start: d.run_block(*args, start, n, threads, outputs), range(threads)))
         woken = bool(np.any(summary[:, d.S_STATUS] == d.INTERRUPTED)) or _woken(d.SUCCESS, native)
         if not (woken or _signals.deferred):
             break
@@ -527,9 +528,9 @@ def _run_one(batch: Batch, i: int, rtol, settle, stop_kind, stop_count, stiff_af
     while True:
         if native is not None:
             native.reset()
-        out = d.run(batch.law.code, batch.C[i], batch.Y0[i], batch.t_end[i], rtol, batch.atol[i],
-                    batch.max_step[i], settle, stop_kind, stop_count, d.SAVE_SUMMARY, _NO_TIMES, MAX_STEPS,
-                    MAX_EVENTS, stiff_after)
+        out = d.run(batch.law.code, batch.C[i], batch.Y0[i], batch.atol[i], batch.t_end[i], batch.max_step[i],
+                    (rtol, settle, stop_kind, stop_count, MAX_STEPS, MAX_EVENTS, stiff_after), d.SAVE_SUMMARY,
+                    _NO_TIMES)
         woken = _woken(out[0][d.S_STATUS], native)
         if not (woken or _signals.deferred):
             return out

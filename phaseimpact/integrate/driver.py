@@ -2,17 +2,19 @@
 
 Between events the right-hand side of the current mode is smooth and a stepper advances it:
 adaptive DOP853 (:mod:`.dop853`), Radau IIA for the rest of a phase whose DOP853 steps stay at
-their stability limit (:mod:`.radau5`); or, in an entry of its own (:func:`run_rk4`), the seed's
-fixed-step RK4 (eq. 8 read literally, no events resolved, so its chattering across ``deltadot = 0``
-stays visible).
+their stability limit (:mod:`.radau5`); or, in an entry of its own (:mod:`.rk4`), the seed's
+fixed-step RK4.
 After each step the event table (:mod:`.events`) is checked for crossings (:func:`_advance`
-steps while none fires); each crossing is located by Brent's method on the step's dense output
-(Radau's roots then polished on steps: :func:`_locate_events`); recorded events are logged
+steps while none fires); each crossing is located on the step's dense output (:mod:`.rootfind`;
+Radau's roots then polished on steps: :func:`_locate_events`); recorded events are logged
 (:func:`_record`), and at the first event that changes the phase the state is taken from a
 fresh step that ends exactly at the root, the transition is applied and the run restarts there
-in the new mode (:func:`_restart`). :func:`run` holds the loop and the run's logs.
-
-Scratch vectors are rows of a few arrays with named rows (``Y_*``, ``G_*``, ``U_*``, ``RK_*``).
+in the new mode (:func:`_restart`). :func:`_start`, :func:`_loop` and :func:`summarize` are
+the per-point kernels: they read and write one run's workspace (:mod:`.record`) and allocate
+nothing. :func:`run_point` runs one point of a batch in them (no event log; the summary and the
+stick points follow the events as they happen), :func:`run_block` many in one workspace, and
+:func:`run` one trajectory with logs that grow between passes of the loop. The kernels of one
+phase (its states, dense output, event values) are in :mod:`.phase`.
 
 Everything here is scalars and small arrays (numba's subset); strings, objects and messages are
 made outside (:mod:`.api`). The same source runs uncompiled with ``NUMBA_DISABLE_JIT=1``.
@@ -26,10 +28,9 @@ import numpy as np
 
 from .._jit import allocating, kernel
 from .._signals import interrupted
-from ..model.laws import PLAIN, STUCK, dent_depth
+from ..model.laws import STUCK
 from ..model.rhs import (
     FLIGHT,
-    M2_,
     RIGID_,
     SPRINGS_,
     V1,
@@ -44,18 +45,15 @@ from ..model.rhs import (
     relative_slip,
     rhs,
     rhs_integration,
-    spring_force,
     stick_margin,
     stuck_pair_energy,
 )
 from . import dop853, flight, radau5
-from .dop853 import N_DENSE, N_STAGES, N_STATE
 from .events import (
     CONTACT,
     DELTA,
     DELTADOT,
     ENERGY,
-    EVENT_KINDS,
     FORCE_PEAK,
     FORCE_RATE,
     N_EVENTS,
@@ -72,12 +70,110 @@ from .events import (
     crossed,
     departure_sign,
     energy_limit_of,
-    event_value,
-    event_values,
     initial_mode,
     restarts,
     transition,
 )
+from .phase import (
+    TIME,
+    copy_values,
+    dense,
+    event_at,
+    fresh_step,
+    integration_state,
+    phase_events,
+    phase_tolerances,
+    physical,
+    regularised,
+)
+from .record import (
+    G_NEW,
+    G_OLD,
+    G_ROOTS,
+    I_HAVE_DENSE,
+    I_LOGGING,
+    I_MAX_EVENTS,
+    I_MAX_STEPS,
+    I_MODE,
+    I_N_EV,
+    I_N_S,
+    I_N_STICK,
+    I_NEXT_POLL,
+    I_NFEV,
+    I_NSTEPS,
+    I_OPEN_STICK,
+    I_REASON,
+    I_SAVE_KIND,
+    I_SETTLE,
+    I_SIDE,
+    I_STATUS,
+    I_STOP_COUNT,
+    I_STOP_KIND,
+    I_TIME_INDEX,
+    N_SUMMARY,
+    R_CONTACT_DURATION,
+    R_CONTACT_SPEED,
+    R_CONTACT_T,
+    R_ENERGY_LIMIT,
+    R_FLIGHT_STEP,
+    R_FORCE,
+    R_FORCE_NEW,
+    R_H,
+    R_H_ABS,
+    R_H_NEXT,
+    R_MAX_STEP,
+    R_PAIR_ENERGY,
+    R_RESTITUTION,
+    R_RTOL,
+    R_S,
+    R_STICK_T,
+    R_STIFF_AFTER,
+    R_T_END,
+    R_T_RUN,
+    R_T_STOP,
+    R_W_FLOOR,
+    ST_DELTA,
+    ST_DWELL,
+    ST_T,
+    STAT_MAX_FORCE,
+    STAT_MAX_INDENTATION,
+    U_ATOL,
+    U_DENSE,
+    U_FU,
+    U_FU_NEW,
+    U_FU_ROOT,
+    U_NEW,
+    U_ROOT,
+    U_STAGES,
+    U_TMP,
+    U_TRIAL,
+    U_U,
+    W_ATOL,
+    W_C,
+    W_COUNTS,
+    W_FIRED,
+    W_G,
+    W_INT,
+    W_REAL,
+    W_STATS,
+    W_STICKS,
+    W_STIFF,
+    W_SUMMARY,
+    W_U,
+    W_Y,
+    Y_F,
+    Y_F_NEW,
+    Y_F_ROOT,
+    Y_F_TRIAL,
+    Y_FIRST_STICK,
+    Y_NEW,
+    Y_ROOT,
+    Y_START,
+    Y_STATE,
+    Y_TRIAL,
+    workspace,
+)
+from .rootfind import brent, locate, polish_root, s_at_time
 
 # Run status (numerical health) and why the run stopped.
 SUCCESS, STEP_SIZE_COLLAPSE, TOO_MANY_STEPS, NON_FINITE, INTERRUPTED = range(5)
@@ -105,62 +201,18 @@ N_SMP_COLUMNS = 8
 (S_STATUS, S_REASON, S_OUTCOME, S_T_STOP, S_MAX_FORCE, S_MAX_INDENTATION, S_RESTITUTION,
  S_CONTACT_DURATION, S_DISSIPATED, S_LOOP_AREA, S_N_STICK, S_N_CONTACTS, S_T_RUN, S_FIRST_STICK_DELTA,
  S_FIRST_STICK_MARGIN, S_FIRST_STICK_T, S_NSTEPS, S_NFEV, S_MODE) = range(19)
-N_SUMMARY = 19
 
-TIME = 5  # the physical time in the integration state u
-
-# Named rows of a run's scratch arrays (an allocation costs about 30 ns, a row of one array nothing).
-# Physical states (5 numbers): the rate at the state, a step's end state and rate, the state and rate
-# at a root, and at a trial point of the root finders.
-Y_F, Y_NEW, Y_F_NEW, Y_ROOT, Y_F_ROOT, Y_TRIAL, Y_F_TRIAL = range(7)
-N_Y_ROWS = 7
-# Event values (N_EVENTS numbers): at a trial point, before and after the step, the roots.
-G_TRIAL, G_OLD, G_NEW, G_ROOTS = range(4)
-N_G_ROWS = 4
-# Integration states (N_STATE numbers): the state and its rate, a step's end, the state at a root,
-# at a trial point, scratch, the phase's absolute tolerances; then DOP853's stages (a flight's
-# invariants) and the step's interpolant.
-U_U, U_FU, U_NEW, U_FU_NEW, U_ROOT, U_FU_ROOT, U_TRIAL, U_TMP, U_ATOL = range(9)
-U_STAGES = 9
-U_DENSE = U_STAGES + N_STAGES
-N_U_ROWS = U_DENSE + N_DENSE
-# RK4 (5 numbers): the rate at the state, a stage's argument, the step's end and its rate, the stages.
-RK_F, RK_TMP, RK_Y_NEW, RK_F_NEW, RK_K = range(5)
-N_RK_ROWS = RK_K + 4
-# The running extremes of a run (``stats``), kept up to date by the kernels that take steps.
-STAT_MAX_FORCE, STAT_MAX_INDENTATION = 0, 1
-N_STATS = 2
-#: Event kinds (``events.EVENT_KINDS``): the length of a run's counts.
-N_KINDS = len(EVENT_KINDS)
-TIME_COLUMN = N_EVENTS  # a pseudo event column: the physical time minus a target
 #: Smallest step reduction after a rejection when the observed order is used (else MIN_FACTOR).
 OBSERVED_MIN_FACTOR = 0.01
-#: Absolute tolerance of ``deltadot`` in a slip, relative to that of the velocities (which is
-#: rtol times the impact speed). A slip's own speed near the critical damping is 1e-7 to 1e-12 of
-#: the impact speed, and its sign decides whether the slip re-sticks. 1e-3 is the largest power of
-#: ten that counts the seed case at v = 7 m/s, kappa = 4.16865e11 right (4 stick phases; 1e-2 gives
-#: 2); it costs a stiff creep far above kappa_c about five times the Radau steps (161 -> 777).
-SLIP_SPEED_SCALE = 1e-3
 _TINY = np.finfo(np.float64).tiny
 _EPS = np.finfo(np.float64).eps
 
 
-# Copies go element by element on purpose: a slice or row assignment makes numba compile its
-# shape-mismatch error messages (string formatting), which was half of the first-ever compile.
-# The length comes from dst, not from an argument: a constant argument (5, N_STATE) would
-# compile a copy of the function for each value.
-@kernel
-def _copy(src, dst):
-    """``dst[:] = src[:len(dst)]``."""
-    for j in range(dst.shape[0]):
-        dst[j] = src[j]
-
-
 @allocating
-def _grow(a, n):
+def grow(a, n):
     """``a`` in an array twice as long, its first ``n`` rows kept."""
     b = np.empty((max(2 * a.shape[0], 16),) + a.shape[1:], a.dtype)
-    _copy(a.ravel(), b.ravel()[:n * (a.size // max(a.shape[0], 1))])
+    copy_values(a.ravel(), b.ravel()[:n * (a.size // max(a.shape[0], 1))])
     return b
 
 
@@ -174,270 +226,6 @@ def _write_event(ev, n, t, kind, mode, y, force):
     for j in range(5):
         row[EV_Y + j] = y[j]
     row[EV_FORCE] = force
-
-
-@allocating
-def _push_event(ev, n, t, kind, mode, y, force):
-    """Append an event to the log ``ev`` (columns ``EV_*``, grown by doubling); returns the log
-    and its new length."""
-    if n == ev.shape[0]:
-        ev = _grow(ev, n)
-    _write_event(ev, n, t, kind, mode, y, force)
-    return ev, n + 1
-
-
-@allocating
-def _push_sample(smp, n, t, y, mode, force):
-    """Append a sample to ``smp`` (columns ``SMP_*``, grown by doubling); returns the samples and
-    their new length."""
-    if n == smp.shape[0]:
-        smp = _grow(smp, n)
-    row = smp[n]
-    row[SMP_T] = t
-    for j in range(5):
-        row[SMP_Y + j] = y[j]
-    row[SMP_FORCE] = force
-    row[SMP_MODE] = mode
-    return smp, n + 1
-
-
-@kernel
-def _regularised(side):
-    """A contact phase integrated in w = sqrt(|delta|) and dt = w ds (side +-1)."""
-    return side == 1 or side == -1
-
-
-@kernel
-def _physical_state(code, mode, side, u, y):
-    """Physical state ``y`` at the integration state ``u``."""
-    y[X1] = u[X1] if not _regularised(side) else u[X2] + side * u[0] * u[0]
-    for j in range(1, 5):
-        y[j] = u[j]
-    if relative_slip(code, mode, side):
-        y[V1] = u[V1] + u[V2]
-
-
-@kernel
-def _physical(code, c, mode, side, u, y, f):
-    """Physical state ``y`` and ``dy/dt`` (``f``) at the integration state ``u``; returns the force."""
-    _physical_state(code, mode, side, u, y)
-    return rhs(code, c, y, mode, f)
-
-
-@kernel
-def _integration_state(code, mode, side, y, t, u):
-    """The integration state of a phase on ``side`` (see :func:`~phaseimpact.model.rhs.rhs_integration`)."""
-    u[X1] = y[X1] if not _regularised(side) else math.sqrt(abs(y[X1] - y[X2]))
-    for j in range(1, 5):
-        u[j] = y[j]
-    if relative_slip(code, mode, side):
-        u[V1] = y[V1] - y[V2]
-    u[TIME] = t
-
-
-@kernel(inline="always")  # in the root finders' loops: a call costs more than it
-def _dense(c, side, F, u0, s0, h, s, out):
-    """The integration state at ``s`` inside the step ``[s0, s0 + h]`` from ``u0``: the flight's
-    closed form, or the interpolant ``F`` of the step (:func:`_interpolant`)."""
-    if side == FLIGHT:
-        flight.state_at(c, F, u0, s0, s, out)
-    else:
-        dop853.dense_eval(F, u0, s0, h, s, out)
-
-
-@kernel
-def _phase_tolerances(code, mode, side, atol, out):
-    """Absolute tolerances of the integration state: ``atol`` is (x1, x2, v1, v2, W, t, w).
-
-    A :func:`relative_slip` phase controls ``deltadot`` relative to itself: its absolute
-    tolerance is that of the velocities times :data:`SLIP_SPEED_SCALE`.
-
-    The work ``W`` is a quadrature along the motion that feeds nothing back: it is left out of the
-    step control (an infinite tolerance), as ODE codes do with quadratures. Controlled, it chose
-    nearly every rejected step inside contact while the motion itself was far more accurate.
-    """
-    out[0] = atol[0] if not _regularised(side) else atol[6]
-    for j in range(1, 6):
-        out[j] = atol[j]
-    out[WORK] = math.inf
-    if relative_slip(code, mode, side):
-        out[V1] = atol[V1] * SLIP_SPEED_SCALE
-
-
-@kernel
-def _events(code, c, mode, side, energy_limit, u, y, f, force, g):
-    """Event values at ``u`` (physical ``y``, ``f``, ``force``) into ``g``."""
-    event_values(code, c, y, f, force, mode, energy_limit, g)
-    if _regularised(side) and dent_depth(code, c) == 0.0:  # past a dent the gap is not w: its value from y
-        g[DELTA] = side * u[0]  # delta = side w^2 keeps its sign through its root; w changes sign there
-    if relative_slip(code, mode, side):
-        g[DELTADOT] = u[V1]  # as integrated: x1dot - x2dot of the physical state has lost its digits
-
-
-@kernel
-def _event_at(code, c, mode, side, energy_limit, target, column, F, u0, s0, h, s, us, ys, fs):
-    """Event function ``column`` at ``s`` on the dense output of the step; the pseudo column
-    ``TIME_COLUMN`` is the physical time minus ``target`` (horizon and output times of a
-    regularised phase, where ``t`` is a component of the state). The physical state is left in
-    ``ys``; the right-hand side (``fs``) is evaluated only for the force's rate, the one event that
-    reads it."""
-    _dense(c, side, F, u0, s0, h, s, us)
-    if column == TIME_COLUMN:
-        return us[TIME] - target
-    if column == DELTA and _regularised(side) and dent_depth(code, c) == 0.0:
-        return side * us[0]  # delta = side w^2 keeps its sign through its root; w changes sign there
-    if column == DELTADOT and relative_slip(code, mode, side):
-        return us[V1]
-    if column == FORCE_RATE:
-        force = _physical(code, c, mode, side, us, ys, fs)
-    else:
-        _physical_state(code, mode, side, us, ys)
-        force = math.nan
-    return event_value(code, c, ys, fs, force, mode, energy_limit, column)
-
-
-@kernel
-def _brent(code, c, mode, side, energy_limit, target, column, F, u0, s0, h, xa, xb, fa, fb, us, ys, fs):
-    """Zero of event ``column`` in ``[xa, xb]`` (signs of ``fa``, ``fb`` differ): scipy's brentq."""
-    xpre, xcur, fpre, fcur = xa, xb, fa, fb
-    xblk = fblk = spre = scur = 0.0
-    xtol = 4.0 * _EPS * max(abs(xa), abs(xb))
-    for _ in range(200):
-        if fpre != 0 and fcur != 0 and (fpre < 0) != (fcur < 0):
-            xblk, fblk = xpre, fpre
-            spre = scur = xcur - xpre
-        if abs(fblk) < abs(fcur):
-            xpre, xcur, xblk = xcur, xblk, xcur
-            fpre, fcur, fblk = fcur, fblk, fcur
-        tol = 0.5 * (xtol + 4.0 * _EPS * abs(xcur))
-        sbis = 0.5 * (xblk - xcur)
-        if fcur == 0 or abs(sbis) < tol:
-            return xcur
-        if abs(spre) > tol and abs(fcur) < abs(fpre):
-            if xpre == xblk:
-                stry = -fcur * (xcur - xpre) / (fcur - fpre)
-            else:
-                dpre = (fpre - fcur) / (xpre - xcur)
-                dblk = (fblk - fcur) / (xblk - xcur)
-                stry = -fcur * (fblk * dblk - fpre * dpre) / (dblk * dpre * (fblk - fpre))
-            if 2.0 * abs(stry) < min(abs(spre), 3.0 * abs(sbis) - tol):
-                spre, scur = scur, stry
-            else:
-                spre = scur = sbis
-        else:
-            spre = scur = sbis
-        xpre, fpre = xcur, fcur
-        xcur += scur if abs(scur) > tol else (tol if sbis > 0 else -tol)
-        fcur = _event_at(code, c, mode, side, energy_limit, target, column, F, u0, s0, h, xcur, us, ys, fs)
-    return xcur
-
-
-@kernel
-def _flight_rate(c, column, y):
-    """The time derivative of event ``column`` in a flight, where ``delta``, ``deltadot`` and the
-    reach test are the events that can fire (NaN for the others)."""
-    if column == DELTA:
-        return y[V1] - y[V2]
-    if column == DELTADOT:
-        return 0.0 if c[RIGID_] > 0 else spring_force(c, y[X2]) / c[M2_]  # -x2'', the projectile uniform
-    if column == REACH:
-        return -y[V1]  # -(x1 + A), the reach A constant in a flight
-    return math.nan
-
-
-@kernel
-def _flight_root(code, c, mode, side, energy_limit, column, F, u0, s0, h, a, b, fa, fb, us, ys, fs):
-    """Zero of event ``column`` in ``[a, b]`` (signs of ``fa``, ``fb`` differ) of a flight: Newton's
-    method on the closed form with the event's exact rate, kept inside the bracket (bisection
-    where it would leave it). Three or four evaluations where Brent's method on the same bracket
-    takes ten or more, each an elliptic function."""
-    # converged when the Newton correction is below 1e-14 of the bracket: the next one would be
-    # below rounding (quadratic convergence); the event values' own rounding keeps the correction
-    # from shrinking to machine epsilon of s
-    tol = 1e-14 * (b - a) + 4.0 * _EPS * abs(b)
-    x = a - fa * (b - a) / (fb - fa)
-    for _ in range(100):
-        g = _event_at(code, c, mode, side, energy_limit, 0.0, column, F, u0, s0, h, x, us, ys, fs)
-        if g == 0:
-            return x
-        left = (g < 0) == (fa < 0)
-        if left:
-            a, fa = x, g
-        else:
-            b, fb = x, g
-        rate = _flight_rate(c, column, ys)
-        step = g / rate if rate != 0 else math.inf
-        inward = step < 0 if left else step > 0  # towards the bracket's other end, where the root is
-        if b - a <= tol or (inward and abs(step) <= tol):
-            return x
-        x -= step
-        if not (a < x < b):
-            x = 0.5 * (a + b)
-    return x
-
-
-@kernel
-def _locate(code, c, mode, side, energy_limit, column, F, u0, s0, h, s1, g_start, g_end, us, ys, fs):
-    """The first zero of event ``column`` in ``[s0, s1]`` on the dense output.
-
-    A run that restarts on this event's zero (``g_start`` a signed tiny number) may leave it
-    and come back within one step, as a brief slip does near a grazing stick break: the dense
-    output is then sampled to find where the function has left zero, and the return is
-    bracketed from there.
-    """
-    expected = 1.0 if g_start > 0 else -1.0
-    a, ga, b, gb = s0, g_start, s1, g_end
-    g0 = _event_at(code, c, mode, side, energy_limit, 0.0, column, F, u0, s0, h, s0, us, ys, fs)
-    if g0 * expected <= 0 and side == FLIGHT and column == DELTA:
-        # a flight step holds at most one extremum of delta (flight.py): if delta left zero and
-        # came back, it was away at that extremum, the zero of deltadot
-        d0 = _event_at(code, c, mode, side, energy_limit, 0.0, np.int64(DELTADOT), F, u0, s0, h, s0, us, ys, fs)
-        d1 = _event_at(code, c, mode, side, energy_limit, 0.0, np.int64(DELTADOT), F, u0, s0, h, s1, us, ys, fs)
-        if not d0 * d1 < 0:
-            return -math.inf
-        a = _flight_root(code, c, mode, side, energy_limit, np.int64(DELTADOT), F, u0, s0, h, s0, s1, d0, d1, us, ys,
-                         fs)
-        ga = _event_at(code, c, mode, side, energy_limit, 0.0, column, F, u0, s0, h, a, us, ys, fs)
-        if ga * expected <= 0:
-            return -math.inf
-    elif g0 * expected <= 0:
-        found_away = False
-        prev = s0
-        for i in range(1, 33):
-            s = s0 + (s1 - s0) * i / 32.0
-            gv = _event_at(code, c, mode, side, energy_limit, 0.0, column, F, u0, s0, h, s, us, ys, fs)
-            if not found_away:
-                if gv * expected > 0:
-                    found_away = True
-                    a, ga = s, gv
-            elif gv * expected <= 0:
-                a, b, gb = prev, s, gv
-                ga = _event_at(code, c, mode, side, energy_limit, 0.0, column, F, u0, s0, h, a, us, ys, fs)
-                break
-            prev = s
-        if not found_away:
-            return -math.inf  # the excursion is below what the step resolves: the caller shrinks it
-    if gb == 0 or ga * gb > 0:
-        return b
-    if side == FLIGHT and not math.isnan(_flight_rate(c, column, ys)):
-        return _flight_root(code, c, mode, side, energy_limit, column, F, u0, s0, h, a, b, ga, gb, us, ys, fs)
-    return _brent(code, c, mode, side, energy_limit, 0.0, column, F, u0, s0, h, a, b, ga, gb, us, ys, fs)
-
-
-@kernel
-def _s_at_time(code, c, mode, side, F, u0, s0, h, time, us, ys, fs):
-    """Where on the step the physical time is ``time`` (it lies within the step): ``s`` itself in
-    a plain phase, a root of ``t(s)`` on the dense output in a regularised one."""
-    if not _regularised(side):
-        return time
-    s1 = s0 + h
-    fa = u0[TIME] - time
-    if fa >= 0:
-        return s0
-    fb = _event_at(code, c, mode, side, 0.0, time, np.int64(TIME_COLUMN), F, u0, s0, h, s1, us, ys, fs)
-    if fb <= 0:
-        return s1
-    return _brent(code, c, mode, side, 0.0, time, np.int64(TIME_COLUMN), F, u0, s0, h, s0, s1, fa, fb, us, ys, fs)
 
 
 _ADV_END, _ADV_STEP, _ADV_COLLAPSE, _ADV_LIMIT = range(4)
@@ -458,12 +246,16 @@ def _quiet_start(quiet, y, mode, g):
 
 
 @kernel(inline="always")  # the hot loop's own code: a call costs more than it
-def _dop853_attempt(code, c, mode, side, s, s_bound, u, fu, h_abs, rtol, atol, K, u_new, fu_new):
-    """One accepted DOP853 step from ``(s, u)`` (at most to ``s_bound``), first try ``h_abs``.
+def _dop853_attempt(code, ws, s, s_bound, h_abs):
+    """One accepted DOP853 step from ``(s, u)`` (row ``U_U``; at most to ``s_bound``) into rows
+    ``U_NEW``, ``U_FU_NEW``, first try ``h_abs``.
 
     Returns ``(ok, s_new, h_next, force_new, evaluations)``; ``ok`` False when the step size
-    collapsed. The stages stay in ``K`` for the interpolant.
+    collapsed. The stages stay in rows ``U_STAGES`` for the interpolant.
     """
+    c, ints, ur, rtol = ws[W_C], ws[W_INT], ws[W_U], ws[W_REAL][R_RTOL]
+    mode, side, u, fu, atol, K, u_new, fu_new = (ints[I_MODE], ints[I_SIDE], ur[U_U], ur[U_FU], ur[U_ATOL],
+                                                 ur[U_STAGES:U_DENSE], ur[U_NEW], ur[U_FU_NEW])
     evaluations = 0
     rejected = False
     h_rejected = err_rejected = 0.0
@@ -495,191 +287,163 @@ def _dop853_attempt(code, c, mode, side, s, s_bound, u, fu, h_abs, rtol, atol, K
 
 
 @kernel
-def _advance(code, c, mode, side, s, t_end, u, fu, y, f, force, h_abs, rtol, atol, max_step, flight_step, w_floor,
-             energy_limit, next_sample, steps_left, g_old, g_new, fired, K, u_new, fu_new, y_new, f_new, stats, stiff):
-    """Take steps in ``s`` from ``(s, u)`` while nothing happens: no event crosses, no sample and
-    (regularised phase) not the horizon falls inside. Accepted steps update ``u, fu, y, f, g_old``
-    and the running extremes ``stats``. DOP853 until the phase turns stiff (:mod:`.radau5`), Radau
+def _advance(code, ws, next_sample, steps_left):
+    """Take steps in ``s`` from the run's state (record ``R_S``, rows ``U_U``, ``U_FU``, ``Y_STATE``,
+    ``Y_F``) while nothing happens: no event crosses, no sample (``next_sample``) and (regularised
+    phase) not the horizon falls inside; at most ``steps_left``. Accepted steps update those rows,
+    ``G_OLD`` and the running extremes ``W_STATS``. DOP853 until the phase turns stiff (:mod:`.radau5`), Radau
     from then on; a flight in closed form (:mod:`.flight`), in steps that end where the target
     passes its centre or after ``flight_step``, or to ``t_end`` at once when no event can happen
     any more and ``flight_step`` is inf (not saving steps).
 
-    Returns ``(result, s, h, h_abs, h_next, force, force_new, steps, evaluations)``: ``_ADV_STEP``
-    leaves the last step (``h``, ``u_new``, ``fu_new``, ``y_new``, ``f_new``, ``g_new``, ``fired``)
-    for the caller to look at; ``_ADV_END`` means ``t_end`` was reached. The hot loop is kept small
-    on purpose: the compiler optimises it as a whole.
+    Returns ``(result, steps, evaluations)``, and ``s, h, h_abs, h_next, force, force_new`` in the
+    record (:func:`_advanced`): ``_ADV_STEP`` leaves the last step (``R_H``, rows ``U_NEW``,
+    ``U_FU_NEW``, ``Y_NEW``, ``Y_F_NEW``, ``G_NEW``, ``fired``) for the caller to look at;
+    ``_ADV_END`` means ``t_end`` was reached. The hot loop is kept small and its state in local
+    variables on purpose: the compiler optimises it as a whole.
     """
+    real, ints, c, ur, yr, g, stats, stiff = (ws[W_REAL], ws[W_INT], ws[W_C], ws[W_U], ws[W_Y], ws[W_G],
+                                              ws[W_STATS], ws[W_STIFF])
+    mode, side, s, t_end, force, h_abs = ints[I_MODE], ints[I_SIDE], real[R_S], real[R_T_END], real[R_FORCE], \
+        real[R_H_ABS]
+    max_step, w_floor, energy_limit = real[R_MAX_STEP], real[R_W_FLOOR], real[R_ENERGY_LIMIT]
+    u, fu, u_new, fu_new = ur[U_U], ur[U_FU], ur[U_NEW], ur[U_FU_NEW]
+    y, f, y_new, f_new, g_old, g_new, fired = yr[Y_STATE], yr[Y_F], yr[Y_NEW], yr[Y_F_NEW], g[G_OLD], g[G_NEW], \
+        ws[W_FIRED]
     steps = 0
     evaluations = 0
     h = 0.0
     h_next = h_abs
     force_new = force
-    s_bound = t_end if not _regularised(side) else math.inf  # a plain phase ends on the horizon
+    s_bound = t_end if not regularised(side) else math.inf  # a plain phase ends on the horizon
     while u[TIME] < t_end:
         if steps >= steps_left:
-            return _ADV_LIMIT, s, h, h_abs, h_next, force, force_new, steps, evaluations
-        if side == FLIGHT:  # K: the flight's invariants (it has no stages)
-            if flight_step == math.inf and flight.unreachable(K, u):
-                s_new = s_bound
-            else:
-                s_new = min(s + min(h_abs, flight_step), s_bound, flight.next_centre(K, s))
-            flight.state_at(c, K, u, s, s_new, u_new)
-            force_new = rhs_integration(code, c, u_new, mode, side, fu_new)
-            ok, h_next, spent = True, flight_step, 0
+            _advanced(real, s, h, h_abs, h_next, force, force_new)
+            return _ADV_LIMIT, steps, evaluations
+        if side == FLIGHT:
+            ok, s_new, h_next, force_new, spent = _flight_attempt(code, ws, s, s_bound, h_abs)
         else:
             # a regularised phase advances the time by w ds: its cap on the time step is one on s
-            h_abs = min(h_abs, max_step if not _regularised(side) else max_step / max(abs(u[0]), w_floor))
+            h_abs = min(h_abs, max_step if not regularised(side) else max_step / max(abs(u[0]), w_floor))
             if radau5.due(stiff):  # entered from an accepted state, so that every step has one method
-                evaluations += radau5.enter(code, c, mode, side, u, fu, rtol, atol, stiff)
+                evaluations += radau5.enter(code, c, mode, side, u, fu, real[R_RTOL], ur[U_ATOL], stiff)
             if radau5.active(stiff):
                 ok, s_new, h_next, force_new, spent = radau5.attempt(code, c, mode, side, s, s_bound, u, fu, h_abs,
                                                                      stiff, u_new, fu_new)
             else:
-                ok, s_new, h_next, force_new, spent = _dop853_attempt(code, c, mode, side, s, s_bound, u, fu, h_abs,
-                                                                      rtol, atol, K, u_new, fu_new)
+                ok, s_new, h_next, force_new, spent = _dop853_attempt(code, ws, s, s_bound, h_abs)
         evaluations += spent
         if not ok:
-            return _ADV_COLLAPSE, s, h, h_next, h_next, force, force_new, steps, evaluations
+            _advanced(real, s, h, h_next, h_next, force, force_new)
+            return _ADV_COLLAPSE, steps, evaluations
         h = s_new - s
         steps += 1
-        if not _regularised(side):
-            u_new[TIME] = s_new  # t' = 1: the time is s itself, without the sum's rounding
-            for j in range(5):
-                y_new[j] = u_new[j]
-                f_new[j] = fu_new[j]
-            if relative_slip(code, mode, side):
-                y_new[V1] = u_new[V1] + u_new[V2]
-                f_new[V1] = fu_new[V1] + fu_new[V2]
-        else:
-            force_new = _physical(code, c, mode, side, u_new, y_new, f_new)
-            evaluations += 1
+        force_new, spent = _step_end(code, ws, s_new, force_new)
+        evaluations += spent
         if side != FLIGHT and not radau5.active(stiff):
             radau5.watch(stiff, h * damping_rate(code, c, u_new, mode, side))
-        _events(code, c, mode, side, energy_limit, u_new, y_new, f_new, force_new, g_new)
+        phase_events(code, c, mode, side, energy_limit, u_new, y_new, f_new, force_new, g_new)
         any_fired = False
         for col in range(N_EVENTS):
             fired[col] = crossed(col, g_old, g_new)
             any_fired = any_fired or fired[col]
-        if any_fired or u_new[TIME] >= next_sample or (_regularised(side) and u_new[TIME] >= t_end):
-            return _ADV_STEP, s, h, h_abs, h_next, force, force_new, steps, evaluations
+        if any_fired or u_new[TIME] >= next_sample or (regularised(side) and u_new[TIME] >= t_end):
+            _advanced(real, s, h, h_abs, h_next, force, force_new)
+            return _ADV_STEP, steps, evaluations
         s = s_new
-        _copy(u_new, u)
-        _copy(fu_new, fu)
-        _copy(y_new, y)
-        _copy(f_new, f)
-        _copy(g_new, g_old)
+        copy_values(u_new, u)
+        copy_values(fu_new, fu)
+        copy_values(y_new, y)
+        copy_values(f_new, f)
+        copy_values(g_new, g_old)
         force = force_new
         h_abs = h_next
         stats[STAT_MAX_FORCE] = max(stats[STAT_MAX_FORCE], force)
         stats[STAT_MAX_INDENTATION] = max(stats[STAT_MAX_INDENTATION], y[X1] - y[X2])
-    return _ADV_END, s, h, h_abs, h_next, force, force_new, steps, evaluations
+    _advanced(real, s, h, h_abs, h_next, force, force_new)
+    return _ADV_END, steps, evaluations
 
 
-# inlined at numba level, like the two below: with their flight branch LLVM stopped inlining
-# these small dispatchers into the run, which cost runs without a flight 5-9 %
-@kernel(inline="always")
-def _fresh_step(code, c, mode, side, s, u, fu, h, K, u_new, fu_new, stiff):
-    """A step of exactly ``h`` from ``(s, u)`` with the phase's current method (the state at a
-    root, a stop or the horizon); returns the evaluations spent."""
-    if side == FLIGHT:
-        flight.state_at(c, K, u, s, s + h, u_new)  # K: the flight's invariants
-        rhs_integration(code, c, u_new, mode, side, fu_new)
-        return 0
-    if radau5.active(stiff):
-        return radau5.fixed_step(code, c, mode, side, s, u, fu, h, stiff, u_new, fu_new)
-    dop853.step(code, c, mode, side, u, fu, h, K, u_new, fu_new)
-    return 12
-
-
-@kernel
-def _polish_root(code, c, mode, side, energy_limit, column, s, u, fu, s_end, g_start, g_end, x, K, u_r, fu_r, stiff,
-                 ys, fs, gs):
-    """Refine the root ``x`` of event ``column`` (found on the step's interpolant) on steps from
-    ``s`` that end at the trial points (Illinois' regula falsi in ``[s, s_end]``).
-
-    Radau's collocation polynomial is of order 3 between its end points: where an event crosses
-    slowly (a creep coming to rest) its root could lie several per cent of the phase away. The
-    end point of a step carries the method's full order. Returns ``(root, evaluations)``.
-    """
-    evaluations = 0
-    a, fa, b, fb = s, g_start, s_end, g_end
-    if not (fa * fb < 0 and a < x < b):
-        return x, evaluations
-    best, f_best = x, math.inf
-    kept = 0
-    for _ in range(40):
-        evaluations += _fresh_step(code, c, mode, side, s, u, fu, x - s, K, u_r, fu_r, stiff)
-        force = _physical(code, c, mode, side, u_r, ys, fs)
-        _events(code, c, mode, side, energy_limit, u_r, ys, fs, force, gs)
-        fx = gs[column]
-        if abs(fx) < f_best:
-            best, f_best = x, abs(fx)
-        if fx == 0:
-            break
-        if (fx < 0) == (fa < 0):
-            a, fa = x, fx
-            if kept == -1:
-                fb *= 0.5  # the same end kept twice: Illinois' halving keeps the secant moving
-            kept = -1
-        else:
-            b, fb = x, fx
-            if kept == 1:
-                fa *= 0.5
-            kept = 1
-        if b - a <= 1e-12 * (s_end - s) + 4.0 * _EPS * abs(b):
-            break
-        x = (a * fb - b * fa) / (fb - fa)
-        if not (a < x < b):
-            x = 0.5 * (a + b)
-    return best, evaluations
+@kernel(inline="always")  # the hot loop's own code, like the two below
+def _flight_attempt(code, ws, s, s_bound, h_abs):
+    """A flight's step (closed form, the flight's invariants in rows ``U_STAGES``), as
+    :func:`_dop853_attempt` returns it: to ``s_bound`` at once when no event can happen any more
+    and no step is kept, else at most ``R_FLIGHT_STEP`` and to the target's next pass through its
+    centre."""
+    c, ints, ur, flight_step = ws[W_C], ws[W_INT], ws[W_U], ws[W_REAL][R_FLIGHT_STEP]
+    u, u_new, K = ur[U_U], ur[U_NEW], ur[U_STAGES:U_DENSE]
+    if flight_step == math.inf and flight.unreachable(K, u):
+        s_new = s_bound
+    else:
+        s_new = min(s + min(h_abs, flight_step), s_bound, flight.next_centre(K, s))
+    flight.state_at(c, K, u, s, s_new, u_new)
+    force_new = rhs_integration(code, c, u_new, ints[I_MODE], ints[I_SIDE], ur[U_FU_NEW])
+    return True, s_new, flight_step, force_new, 0
 
 
 @kernel(inline="always")
-def _interpolant(code, c, mode, side, u, fu, u_new, fu_new, h, K, F, tmp, stiff):
-    """The last step's interpolant into ``F`` (a flight's invariants, see :func:`_dense`); returns the
-    evaluations spent."""
-    if side == FLIGHT:
-        _copy(K[0], F[0])  # the flight's invariants
-        return 0
-    if radau5.active(stiff):
-        radau5.dense_coefficients(stiff, F)
-        return 0
-    dop853.dense_coefficients(code, c, mode, side, u, fu, u_new, fu_new, h, K, F, tmp)
-    return 3
+def _step_end(code, ws, s_new, force_new):
+    """The physical state and rate at a step's end (rows ``Y_NEW``, ``Y_F_NEW`` from ``U_NEW``,
+    ``U_FU_NEW``); returns ``(force, evaluations)``."""
+    c, ints, ur, yr = ws[W_C], ws[W_INT], ws[W_U], ws[W_Y]
+    mode, side, u_new, fu_new, y_new, f_new = ints[I_MODE], ints[I_SIDE], ur[U_NEW], ur[U_FU_NEW], yr[Y_NEW], \
+        yr[Y_F_NEW]
+    if regularised(side):
+        return physical(code, c, mode, side, u_new, y_new, f_new), 1
+    u_new[TIME] = s_new  # t' = 1: the time is s itself, without the sum's rounding
+    for j in range(5):
+        y_new[j] = u_new[j]
+        f_new[j] = fu_new[j]
+    if relative_slip(code, mode, side):
+        y_new[V1] = u_new[V1] + u_new[V2]
+        f_new[V1] = fu_new[V1] + fu_new[V2]
+    return force_new, 0
 
 
 @kernel(inline="always")
-def _phase_step(code, c, mode, side, u, fu, rtol, atol, t_end, max_step, w_floor, tmp, f1):
-    """Initial step of a phase (scipy's rule), in its own independent variable."""
+def _advanced(real, s, h, h_abs, h_next, force, force_new):
+    """Where :func:`_advance` stands, into the run's record."""
+    real[R_S], real[R_H], real[R_H_ABS], real[R_H_NEXT], real[R_FORCE], real[R_FORCE_NEW] = (
+        s, h, h_abs, h_next, force, force_new)
+
+
+@kernel(inline="always")
+def _phase_step(code, ws):
+    """Initial step of the run's phase (scipy's rule; the record's mode and side, rows ``U_U``,
+    ``U_FU``, ``U_ATOL``), in its own independent variable."""
+    real, ints, ur = ws[W_REAL], ws[W_INT], ws[W_U]
+    mode, side, u, t_end, max_step, w_floor = ints[I_MODE], ints[I_SIDE], ur[U_U], real[R_T_END], real[R_MAX_STEP], \
+        real[R_W_FLOOR]
     interval = t_end - u[TIME]
     if interval <= 0:
         return 0.0  # the phase starts on the horizon (an event at t_end): no step follows
     if side == FLIGHT:
         return interval  # closed form: its steps only bracket events (see _advance)
-    if _regularised(side):
+    if regularised(side):
         interval /= max(abs(u[0]), w_floor)
-    return dop853.initial_step(code, c, mode, side, u, fu, rtol, atol, interval,
-                               max_step if not _regularised(side) else max_step / max(abs(u[0]), w_floor), tmp, f1)
+    return dop853.initial_step(code, ws[W_C], mode, side, u, ur[U_FU], real[R_RTOL], ur[U_ATOL], interval,
+                               max_step if not regularised(side) else max_step / max(abs(u[0]), w_floor), ur[U_TMP],
+                               ur[U_FU_NEW])
 
 
 @kernel
-def _locate_events(code, c, mode, side, settle, energy_limit, s, h, s_horizon, u, fu, g_old, g_new, fired, roots, K,
-                   F, u_r, fu_r, stiff, us, ys, fs, gs):
-    """Locate the events that fired in the step ``[s, s + h]`` on its interpolant ``F``: their roots
-    into ``roots`` (``fired`` cleared where the crossing did not happen or falls after the horizon
-    ``s_horizon``), and the first root that restarts the run (polished on steps when the step was
-    Radau's). Returns ``(unresolved, restart_col, s_restart, evaluations)``: ``unresolved`` when an
-    event left and re-crossed zero inside the step (the caller retries a smaller step);
-    ``restart_col`` -1 when no event restarts the run."""
-    s_new = s + h
+def _locate_events(code, ws, s_horizon):
+    """Locate the events that fired in the step ``[s, s + h]`` (record ``R_S``, ``R_H``) on its
+    interpolant: their roots into row ``G_ROOTS`` (``fired`` cleared where the crossing did not
+    happen or falls after the horizon ``s_horizon``), and the first root that restarts the run
+    (polished on steps when the step was Radau's). Returns ``(unresolved, restart_col, s_restart,
+    evaluations)``: ``unresolved`` when an event left and re-crossed zero inside the step (the
+    caller retries a smaller step); ``restart_col`` -1 when no event restarts the run."""
+    ints, g, fired = ws[W_INT], ws[W_G], ws[W_FIRED]
+    mode, s, h = ints[I_MODE], ws[W_REAL][R_S], ws[W_REAL][R_H]
+    g_old, g_new, roots = g[G_OLD], g[G_NEW], g[G_ROOTS]
     evaluations = 0
     restart_col = np.int64(-1)
     s_restart = math.inf
     unresolved = False
     for col in range(N_EVENTS):
         if fired[col]:
-            roots[col] = _locate(code, c, mode, side, energy_limit, col, F, u, s, h, s_new, g_old[col], g_new[col],
-                                 us, ys, fs)
+            roots[col] = locate(code, ws, col, g_old[col], g_new[col])
             if roots[col] == -math.inf:
                 if h > 1e3 * (np.nextafter(s, np.inf) - s):
                     unresolved = True
@@ -692,30 +456,29 @@ def _locate_events(code, c, mode, side, settle, energy_limit, s, h, s_horizon, u
     if fired[DELTADOT] and not fired[DELTA]:
         # an extreme of delta inside the step on the other side of zero: a contact (or
         # separation) and its return both fell inside the step
-        d_ext = _event_at(code, c, mode, side, energy_limit, 0.0, np.int64(DELTA), F, u, s, h, roots[DELTADOT], us, ys,
-                          fs)
+        d_ext = event_at(code, ws, np.int64(DELTA), 0.0, roots[DELTADOT])
         if d_ext * g_old[DELTA] < 0:
             fired[DELTA] = True
-            roots[DELTA] = _brent(code, c, mode, side, energy_limit, 0.0, np.int64(DELTA), F, u, s, h, s,
-                                  roots[DELTADOT], g_old[DELTA], d_ext, us, ys, fs)
+            roots[DELTA] = brent(code, ws, np.int64(DELTA), 0.0, s, roots[DELTADOT], g_old[DELTA], d_ext)
     for col in range(N_EVENTS):
-        if fired[col] and (restarts(code, col, mode, settle) or col == ENERGY) and roots[col] < s_restart:
+        if fired[col] and (restarts(code, col, mode, ints[I_SETTLE] != 0) or col == ENERGY) and roots[col] < s_restart:
             restart_col, s_restart = col, roots[col]
-    if restart_col >= 0 and radau5.active(stiff):
-        s_restart, spent = _polish_root(code, c, mode, side, energy_limit, restart_col, s, u, fu, s_new,
-                                        g_old[restart_col], g_new[restart_col], s_restart, K, u_r, fu_r, stiff, ys,
-                                        fs, gs)
+    if restart_col >= 0 and radau5.active(ws[W_STIFF]):
+        s_restart, spent = polish_root(code, ws, restart_col, g_old[restart_col], g_new[restart_col], s_restart)
         evaluations += spent
     return False, restart_col, s_restart, evaluations
 
 
 @kernel
-def _record(code, c, mode, side, settle, stop_kind, stop_count, s, h, s_restart, fired, roots, u, fu, F, K, us, fu_r,
-            stiff, ys, fs, ev, n_ev, counts, stats):
+def _record(code, ws, ev, s_restart):
     """Log the recorded events (force peaks, reversals, reach) that fired in the step up to
-    ``s_restart``, in time order, into ``ev`` (which has a free row for each event column); the
-    running extremes ``stats`` follow them. Returns ``(n_ev, stop_record, evaluations)``:
-    ``stop_record`` is the root of the event the run was asked to stop at (-1 if none)."""
+    ``s_restart``, in time order (:func:`log_event`; ``ev`` has a free row for each event column);
+    the running extremes follow them. Returns ``(stop_record, evaluations)``: ``stop_record`` is the
+    root of the event the run was asked to stop at (-1 if none)."""
+    ints, c, ur, yr, fired, stiff, counts, stats = (ws[W_INT], ws[W_C], ws[W_U], ws[W_Y], ws[W_FIRED], ws[W_STIFF],
+                                                    ws[W_COUNTS], ws[W_STATS])
+    mode, side, settle, s, h = ints[I_MODE], ints[I_SIDE], ints[I_SETTLE] != 0, ws[W_REAL][R_S], ws[W_REAL][R_H]
+    roots, u, us, ys, fs = ws[W_G][G_ROOTS], ur[U_U], ur[U_TRIAL], yr[Y_TRIAL], yr[Y_F_TRIAL]
     evaluations = 0
     stop_record = -1.0
     while True:
@@ -728,445 +491,483 @@ def _record(code, c, mode, side, settle, stop_kind, stop_count, s, h, s_restart,
             break
         fired[best] = False
         if radau5.active(stiff):  # the state from a step to the root: the polynomial is of order 3
-            evaluations += _fresh_step(code, c, mode, side, s, u, fu, roots[best] - s, K, us, fu_r, stiff)
+            evaluations += fresh_step(code, ws, roots[best] - s, us, ur[U_FU_ROOT])
         else:
-            _dense(c, side, F, u, s, h, roots[best], us)
-        f_ev = _physical(code, c, mode, side, us, ys, fs)
+            dense(c, side, ur[U_DENSE:], u, s, h, roots[best], us)
+        f_ev = physical(code, c, mode, side, us, ys, fs)
         kind = FORCE_PEAK if best == FORCE_RATE else REVERSAL
         if best == REACH:
             kind = SETTLED  # recorded only: the run goes on
-        t_ev = us[TIME] if _regularised(side) else roots[best]
-        _write_event(ev, n_ev, t_ev, kind, mode, ys, f_ev)
-        n_ev += 1
-        counts[kind] += 1
+        t_ev = us[TIME] if regularised(side) else roots[best]
+        log_event(ws, ev, t_ev, kind, mode, ys, f_ev)
         stats[STAT_MAX_FORCE] = max(stats[STAT_MAX_FORCE], f_ev)
         stats[STAT_MAX_INDENTATION] = max(stats[STAT_MAX_INDENTATION], ys[X1] - ys[X2])
-        if kind == stop_kind and counts[kind] >= stop_count:
+        if kind == ints[I_STOP_KIND] and counts[kind] >= ints[I_STOP_COUNT]:
             stop_record = roots[best]
             break
-    return n_ev, stop_record, evaluations
+    return stop_record, evaluations
 
 
 @kernel
-def _restart(code, c, settle, column, mode, side, s, s_restart, h_next, u, fu, u_r, fu_r, y_r, f_r, y, f, K, stiff,
-             rtol, atol, atol_u, t_end, max_step, w_floor, tmp, f_tmp, pair_energy):
+def _restart(code, ws, column, s_restart):
     """Restart the run at the root ``s_restart`` of event ``column``: the state there from a fresh
     step that ends there (the stages beyond the root belong to the continuation, not to the
-    motion), the transition, and the new phase in ``u``, ``fu``, ``y``, ``f``, ``atol_u`` (``K``: a
-    flight's invariants). Returns ``(kind, mode, action, side, s, t, h_abs, force, pair_energy,
-    evaluations)``."""
+    motion), the transition, and the new phase in the record (mode, side, ``s``, first step, force)
+    and in rows ``U_U``, ``U_FU``, ``Y_STATE``, ``Y_F``, ``U_ATOL`` (``U_STAGES``: a flight's
+    invariants). Returns ``(kind, action, t)``."""
+    real, ints, c, ur, yr, stiff = ws[W_REAL], ws[W_INT], ws[W_C], ws[W_U], ws[W_Y], ws[W_STIFF]
+    mode, side, s = ints[I_MODE], ints[I_SIDE], real[R_S]
+    u, fu, u_r, K = ur[U_U], ur[U_FU], ur[U_ROOT], ur[U_STAGES:U_DENSE]
+    y, f, y_r = yr[Y_STATE], yr[Y_F], yr[Y_ROOT]
     evaluations = 0
     h_r = s_restart - s
     if h_r > 0:
-        evaluations += _fresh_step(code, c, mode, side, s, u, fu, h_r, K, u_r, fu_r, stiff)
+        evaluations += fresh_step(code, ws, h_r, u_r, ur[U_FU_ROOT])
     else:
-        _copy(u, u_r)
-    t = s_restart if not _regularised(side) else u_r[TIME]
-    _physical(code, c, mode, side, u_r, y_r, f_r)
+        copy_values(u, u_r)
+    t = s_restart if not regularised(side) else u_r[TIME]
+    physical(code, c, mode, side, u_r, y_r, yr[Y_F_ROOT])
     if column == STICK_BREAK and c[SPRINGS_] > 0 and c[RIGID_] == 0:
-        onto_stuck_orbit(c, pair_energy, y_r)
-    kind, mode, action = transition(code, c, column, y_r, mode, settle)
+        onto_stuck_orbit(c, real[R_PAIR_ENERGY], y_r)
+    kind, mode, action = transition(code, c, column, y_r, mode, ints[I_SETTLE] != 0)
     if kind == STICK:
-        pair_energy = stuck_pair_energy(c, y_r)
-    _copy(y_r, y)
-    force = rhs(code, c, y, mode, f)
+        real[R_PAIR_ENERGY] = stuck_pair_energy(c, y_r)
+    copy_values(y_r, y)
+    real[R_FORCE] = rhs(code, c, y, mode, f)
     new_side = contact_side(code, c, y, mode)
-    _integration_state(code, mode, new_side, y, t, u)
-    s = t if not _regularised(new_side) else 0.0
+    integration_state(code, mode, new_side, y, t, u)
+    s = t if not regularised(new_side) else 0.0
     rhs_integration(code, c, u, mode, new_side, fu)
     evaluations += 2
     radau5.reset(stiff)  # a new phase starts explicit
-    _phase_tolerances(code, mode, new_side, atol, atol_u)
+    phase_tolerances(code, mode, new_side, ws[W_ATOL], ur[U_ATOL])
     if new_side != side:  # the independent variable changes: a fresh initial step
         side = new_side
-        h_abs = _phase_step(code, c, mode, side, u, fu, rtol, atol_u, t_end, max_step, w_floor, tmp, f_tmp)
+        ints[I_MODE], ints[I_SIDE] = mode, side
+        h_abs = _phase_step(code, ws)
         evaluations += 1
     else:
-        h_abs = max(h_next, h_r)
+        h_abs = max(real[R_H_NEXT], h_r)
     if side == FLIGHT:
         flight.coefficients(c, u, s, K)
-    return kind, mode, action, side, s, t, h_abs, force, pair_energy, evaluations
+    ints[I_MODE], ints[I_SIDE], ints[I_NFEV] = mode, side, ints[I_NFEV] + evaluations
+    real[R_S], real[R_H_ABS] = s, h_abs
+    return kind, action, t
 
 
-@allocating
-def _open_logs(y, mode, force, save_kind, times):
-    """The event log and the samples of a run from ``y`` at t = 0 (its contact when it starts on one,
-    its first samples). Returns ``(ev, n_ev, smp, n_s, counts, i_time)``: ``counts`` per event kind,
-    ``i_time`` the next output time (``SAVE_TIMES``)."""
-    # Integer constants passed to compiled callees go as np.int64: a literal argument would compile
-    # a second copy of the callee (and of everything it calls) specialised on that value.
-    ev = np.empty((64, N_EV_COLUMNS))
-    n_ev = np.int64(0)
-    smp = np.empty((256 if save_kind != SAVE_SUMMARY else 1, N_SMP_COLUMNS))
-    n_s = np.int64(0)
-    counts = np.zeros(N_KINDS, np.int64)
-    i_time = 0
+# ------------------------------------------------------------------------------------------------
+# One run: its logs, the loop (its record and workspace: .record)
+# ------------------------------------------------------------------------------------------------
+#: What :func:`_loop` returns: the run ended, or its logs must grow before it goes on.
+RUN_DONE, RUN_LOG_FULL = range(2)
+#: The options of a run, a tuple: relative tolerance, whether to stop once settled, the event kind
+#: and count to stop at (-1: none), the step and event caps, DOP853 steps at the stability limit
+#: before Radau (0: never). The same for every run of a batch.
+OPT_RTOL, OPT_SETTLE, OPT_STOP_KIND, OPT_STOP_COUNT, OPT_MAX_STEPS, OPT_MAX_EVENTS, OPT_STIFF_AFTER = range(7)
+#: A batch of runs (:func:`run_block`), a tuple of arrays with a row or entry per run: coefficients,
+#: start states, horizons, absolute tolerances (n, 7), largest steps.
+B_C, B_Y0, B_T_END, B_ATOL, B_MAX_STEP = range(5)
+#: What :func:`run_block` fills, a tuple of arrays with a row or entry per run: the summaries, the
+#: stick points' times, depths and dwells (their first ``capacity``), their numbers.
+O_SUMMARY, O_STICK_T, O_STICK_DELTA, O_STICK_DWELL, O_STICK_COUNT = range(5)
+
+
+@kernel
+def _set_options(ws, options, t_end, max_step, save_kind):
+    """A run's options (the tuple ``OPT_*``), horizon, largest step and save kind into its record."""
+    real, ints = ws[W_REAL], ws[W_INT]
+    real[R_T_END], real[R_RTOL], real[R_MAX_STEP], real[R_STIFF_AFTER] = (t_end, options[OPT_RTOL], max_step,
+                                                                          options[OPT_STIFF_AFTER])
+    ints[I_SETTLE], ints[I_STOP_KIND], ints[I_STOP_COUNT] = (options[OPT_SETTLE], options[OPT_STOP_KIND],
+                                                             options[OPT_STOP_COUNT])
+    ints[I_SAVE_KIND], ints[I_MAX_STEPS] = save_kind, options[OPT_MAX_STEPS]
+    ints[I_MAX_EVENTS] = options[OPT_MAX_EVENTS]
+
+
+@kernel
+def log_event(ws, ev, t, kind, mode, y, force):
+    """An event of the run: counted, written into the log ``ev`` when the run keeps one (it has a
+    free row: :func:`_room`), and followed by the summary (the first contact's duration and
+    restitution, the first stick, the escape) and the stick points."""
+    real, ints, sticks = ws[W_REAL], ws[W_INT], ws[W_STICKS]
+    if ints[I_LOGGING] != 0:
+        _write_event(ev, ints[I_N_EV], t, kind, mode, y, force)
+    ints[I_N_EV] += 1
+    ws[W_COUNTS][kind] += 1
+    if kind == CONTACT and math.isnan(real[R_CONTACT_T]):
+        real[R_CONTACT_T], real[R_CONTACT_SPEED] = t, y[V1] - y[V2]
+    elif kind == SEPARATION and not math.isnan(real[R_CONTACT_T]) and math.isnan(real[R_CONTACT_DURATION]):
+        real[R_CONTACT_DURATION] = t - real[R_CONTACT_T]
+        if real[R_CONTACT_SPEED] != 0:
+            real[R_RESTITUTION] = -(y[V1] - y[V2]) / real[R_CONTACT_SPEED]
+    n = ints[I_N_STICK]
+    if kind == STICK:
+        if n == 0:
+            real[R_STICK_T] = t
+            copy_values(y, ws[W_Y][Y_FIRST_STICK])
+        if n < sticks.shape[1]:
+            sticks[ST_T, n], sticks[ST_DELTA, n] = t, y[X1] - y[X2]
+        ints[I_N_STICK] = n + 1
+    if kind == SEPARATION and n > 0 and math.isnan(real[R_T_RUN]):
+        real[R_T_RUN] = t
+    if kind == SLIP:
+        _close_sticks(ws, t)
+
+
+@kernel
+def _close_sticks(ws, end):
+    """The stick phases still waiting for their end (a slip, the run's end) end at ``end``."""
+    ints, sticks = ws[W_INT], ws[W_STICKS]
+    for j in range(ints[I_OPEN_STICK], min(ints[I_N_STICK], sticks.shape[1])):
+        sticks[ST_DWELL, j] = end - sticks[ST_T, j]
+    ints[I_OPEN_STICK] = ints[I_N_STICK]
+
+
+@kernel
+def add_sample(ws, smp, t, y, mode, force):
+    """Append a sample to ``smp`` (columns ``SMP_*``; it has a free row: :func:`_room`)."""
+    n = ws[W_INT][I_N_S]
+    row = smp[n]
+    row[SMP_T] = t
+    for j in range(5):
+        row[SMP_Y + j] = y[j]
+    row[SMP_FORCE] = force
+    row[SMP_MODE] = mode
+    ws[W_INT][I_N_S] = n + 1
+
+
+@kernel
+def _room(ws, ev, smp, times):
+    """Whether the logs hold what one more pass of the loop may add: an event per column and the
+    restart's, two samples (steps) or every output time left (times)."""
+    ints = ws[W_INT]
+    samples = 0
+    if ints[I_SAVE_KIND] == SAVE_STEPS:
+        samples = 2
+    elif ints[I_SAVE_KIND] == SAVE_TIMES:
+        samples = times.shape[0] - ints[I_TIME_INDEX]
+    return ints[I_N_EV] + N_EVENTS + 1 <= ev.shape[0] and ints[I_N_S] + samples <= smp.shape[0]
+
+
+@kernel
+def open_logs(ws, ev, smp, times, force):
+    """The logs and the summary's trackers of a run from row ``Y_STATE`` at t = 0 in mode
+    ``I_MODE``: its contact when it starts on one, its first samples, the running extremes."""
+    real, ints, y = ws[W_REAL], ws[W_INT], ws[W_Y][Y_STATE]
+    mode = ints[I_MODE]
+    for k in (I_N_EV, I_N_S, I_N_STICK, I_OPEN_STICK, I_TIME_INDEX, I_NSTEPS):
+        ints[k] = 0
+    ints[I_STATUS], ints[I_REASON] = SUCCESS, HORIZON
+    for k in (R_CONTACT_T, R_CONTACT_SPEED, R_CONTACT_DURATION, R_RESTITUTION, R_STICK_T, R_T_RUN):
+        real[k] = math.nan
+    counts = ws[W_COUNTS]
+    for k in range(counts.shape[0]):
+        counts[k] = 0
     if y[X1] == y[X2] and y[V1] > y[V2]:
-        ev, n_ev = _push_event(ev, n_ev, 0.0, np.int64(CONTACT), mode, y, force)
-        counts[CONTACT] += 1
-    if save_kind == SAVE_STEPS:
-        smp, n_s = _push_sample(smp, n_s, 0.0, y, mode, force)
-    if save_kind == SAVE_TIMES:
-        while i_time < times.shape[0] and times[i_time] <= 0.0:
-            smp, n_s = _push_sample(smp, n_s, times[i_time], y, mode, force)
-            i_time += 1
-    return ev, n_ev, smp, n_s, counts, i_time
+        log_event(ws, ev, 0.0, np.int64(CONTACT), mode, y, force)
+    if ints[I_SAVE_KIND] == SAVE_STEPS:
+        add_sample(ws, smp, 0.0, y, mode, force)
+    if ints[I_SAVE_KIND] == SAVE_TIMES:
+        while ints[I_TIME_INDEX] < times.shape[0] and times[ints[I_TIME_INDEX]] <= 0.0:
+            add_sample(ws, smp, times[ints[I_TIME_INDEX]], y, mode, force)
+            ints[I_TIME_INDEX] += 1
+    ws[W_STATS][STAT_MAX_FORCE] = force
+    ws[W_STATS][STAT_MAX_INDENTATION] = y[X1] - y[X2]
 
 
-@allocating(python=True, nogil=True)
-def run_rk4(code, c, y0, t_end, save_kind, times, max_steps, rk4_step, rk4_every):
-    """The seed's classic RK4: eq. 8's plain right-hand side, fixed steps ``rk4_step``, nothing
-    resolved (a contact or separation is logged where ``delta`` changed sign, its time interpolated
-    linearly); with ``save_kind`` steps, every ``rk4_every``-th step is kept. Returns what
-    :func:`run` does. An entry of its own, not a branch of :func:`run`: the first compile of a run
-    that does not ask for it leaves it out."""
-    y = y0.copy()
-    t = 0.0
-    mode = np.int64(PLAIN)
-    rows = np.empty((N_RK_ROWS, 5))
-    tmp = rows[RK_TMP]
-    y_new = rows[RK_Y_NEW]
-    f_new = rows[RK_F_NEW]
-    k1 = rows[RK_K]
-    k2 = rows[RK_K + 1]
-    k3 = rows[RK_K + 2]
-    k4 = rows[RK_K + 3]
-    force = rhs(code, c, y, mode, rows[RK_F])
-    nfev = 1
-    nsteps = 0
-    energy_limit = energy_limit_of(code, c, y0)
-    ev, n_ev, smp, n_s, counts, _ = _open_logs(y, mode, force, save_kind, times)
-    max_force = force
-    max_indentation = y[X1] - y[X2]
-    status = SUCCESS
-    reason = HORIZON
-    while t < t_end:
-        if nsteps >= max_steps:
-            status, reason = TOO_MANY_STEPS, FAILED_STOP
-            break
-        if nsteps % POLL_STEPS == 0 and nsteps > 0 and interrupted():
-            status, reason = INTERRUPTED, FAILED_STOP
-            break
-        h = min(rk4_step, t_end - t)
-        rhs(code, c, y, mode, k1)
-        for j in range(5):
-            tmp[j] = y[j] + 0.5 * h * k1[j]
-        rhs(code, c, tmp, mode, k2)
-        for j in range(5):
-            tmp[j] = y[j] + 0.5 * h * k2[j]
-        rhs(code, c, tmp, mode, k3)
-        for j in range(5):
-            tmp[j] = y[j] + h * k3[j]
-        rhs(code, c, tmp, mode, k4)
-        finite = True
-        for j in range(5):
-            y_new[j] = y[j] + h / 6.0 * (k1[j] + 2.0 * k2[j] + 2.0 * k3[j] + k4[j])
-            finite = finite and math.isfinite(y_new[j])
-        nfev += 4
-        nsteps += 1
-        if not finite:
-            status, reason = NON_FINITE, FAILED_STOP
-            break
-        force_new = rhs(code, c, y_new, mode, f_new)
-        d_old = y[X1] - y[X2]
-        d_new = y_new[X1] - y_new[X2]
-        if (d_old <= 0 < d_new) or (d_old > 0 >= d_new):
-            kind = CONTACT if d_new > 0 else SEPARATION
-            t_cross = t + h * d_old / (d_old - d_new)  # linear: RK4 resolves no event
-            ev, n_ev = _push_event(ev, n_ev, t_cross, kind, mode, y_new, force_new)
-            counts[kind] += 1
-        t += h
-        for j in range(5):
-            y[j] = y_new[j]
-        max_force = max(max_force, force_new)
-        max_indentation = max(max_indentation, d_new)
-        if save_kind == SAVE_STEPS and (nsteps % rk4_every == 0 or t >= t_end):
-            smp, n_s = _push_sample(smp, n_s, t, y, mode, force_new)
-        if energy(code, c, y) > energy_limit:
-            reason = RUNAWAY_STOP
-            break
-    summary = _summarize(code, c, y0, y, mode, status, reason, t, max_force, max_indentation, counts,
-                         n_ev, ev, nsteps, nfev)
-    return summary, ev[:n_ev], smp[:n_s], y
-
-
-@allocating(python=True, nogil=True)  # runs side by side in threads (phaseimpact.train's orbit diagrams)
-def run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count, save_kind, times,
-        max_steps, max_events, stiff_after):
-    """Integrate one trajectory. See :func:`phaseimpact.integrate.simulate` for the meaning.
-
-    Returns ``(summary, events, samples, y_final)``: the event log (columns ``EV_*``) and the
-    samples (columns ``SMP_*``) trimmed to their lengths. Adaptive DOP853 (Radau IIA where a
-    phase turns stiff) with events: steps while nothing happens (:func:`_advance`), then on the
-    step where something did, the events located (:func:`_locate_events`), the recorded ones
-    logged (:func:`_record`) and the run restarted at the first that changes the phase
-    (:func:`_restart`). The seed's RK4 is :func:`run_rk4`.
-
-    The loop is :func:`_run`, which :func:`run_block` calls too: a first compile makes the two
-    entries from it (:func:`phaseimpact.integrate.precompile.warmup` compiles both ahead).
-    """
-    return _run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count, save_kind, times,
-                max_steps, max_events, stiff_after)
-
-
-@allocating
-def _run(code, c, y0, t_end, rtol, atol, max_step, settle, stop_kind, stop_count, save_kind, times,
-         max_steps, max_events, stiff_after):
-    """:func:`run`'s loop."""
-    c = c.copy()  # the run's own: a law's memory is written into it (model.laws.remember)
-    y = y0.copy()
-    t = 0.0
+@kernel
+def _start(code, ws, ev, smp, times):
+    """A run from the start state (row ``Y_START``), coefficients (``W_C``, the run's own: a law's
+    memory is written into them, model.laws.remember), tolerances (``W_ATOL``) and options of its
+    workspace, at t = 0: its mode, logs, phase and first step."""
+    real, ints, c, yr, ur = ws[W_REAL], ws[W_INT], ws[W_C], ws[W_Y], ws[W_U]
+    y, f, u, fu, atol_u = yr[Y_STATE], yr[Y_F], ur[U_U], ur[U_FU], ur[U_ATOL]
+    copy_values(yr[Y_START], y)
     mode = initial_mode(code, c, y)
-    # scratch vectors as rows of three arrays (layouts Y_*, G_*, U_*)
-    rows5 = np.empty((N_Y_ROWS, 5))
-    f = rows5[Y_F]
-    y_new = rows5[Y_NEW]
-    f_new = rows5[Y_F_NEW]
-    y_r = rows5[Y_ROOT]
-    f_r = rows5[Y_F_ROOT]
-    ys = rows5[Y_TRIAL]
-    fs = rows5[Y_F_TRIAL]
     force = rhs(code, c, y, mode, f)
-    nfev = 1
-    nsteps = 0
-    energy_limit = energy_limit_of(code, c, y0)
-    ev, n_ev, smp, n_s, counts, i_time = _open_logs(y, mode, force, save_kind, times)
-    max_force = force
-    max_indentation = y[X1] - y[X2]
-    status = SUCCESS
-    reason = HORIZON
-    rows7 = np.empty((N_G_ROWS, N_EVENTS))
-    gs = rows7[G_TRIAL]
-    g_old = rows7[G_OLD]
-    g_new = rows7[G_NEW]
-    roots = rows7[G_ROOTS]
-    fired = np.zeros(N_EVENTS, np.bool_)
-
+    ints[I_MODE], ints[I_NFEV] = mode, 1
+    energy_limit = energy_limit_of(code, c, y)
+    open_logs(ws, ev, smp, times, force)
+    fired = ws[W_FIRED]
+    for k in range(N_EVENTS):
+        fired[k] = False
     # Plain phases integrate u = (x1, x2, v1, v2, W, t) in s = t; regularised contact phases
     # (side = +-1) integrate u = (w, x2, v1, v2, W, t) in s with dt = w ds (model.rhs.rhs_integration).
-    rows6 = np.empty((N_U_ROWS, N_STATE))
-    u = rows6[U_U]
-    fu = rows6[U_FU]
-    u_new = rows6[U_NEW]
-    fu_new = rows6[U_FU_NEW]
-    u_r = rows6[U_ROOT]
-    fu_r = rows6[U_FU_ROOT]
-    us = rows6[U_TRIAL]
-    tmp6 = rows6[U_TMP]
-    atol_u = rows6[U_ATOL]
-    K6 = rows6[U_STAGES:U_DENSE]  # DOP853's stages (a flight's invariants)
-    F6 = rows6[U_DENSE:]  # the step's interpolant
-    w_floor = atol[6] / rtol  # the scale of w = sqrt(|delta|)
+    rtol, max_step = real[R_RTOL], real[R_MAX_STEP]
+    w_floor = ws[W_ATOL][6] / rtol  # the scale of w = sqrt(|delta|)
     # a flight's steps only bracket events, between the target's passes through its centre; a
     # figure gets a sample every sixteenth of the target's period
-    flight_step = math.inf if save_kind != SAVE_STEPS else max_step / 2
+    real[R_FLIGHT_STEP] = math.inf if ints[I_SAVE_KIND] != SAVE_STEPS else max_step / 2
     side = contact_side(code, c, y, mode)
-    _integration_state(code, mode, side, y, 0.0, u)
-    _phase_tolerances(code, mode, side, atol, atol_u)
-    s = 0.0
+    integration_state(code, mode, side, y, 0.0, u)
+    phase_tolerances(code, mode, side, ws[W_ATOL], atol_u)
     rhs_integration(code, c, u, mode, side, fu)
-    nfev += 1
-    quiet = np.int64(DELTA)
-    _events(code, c, mode, side, energy_limit, u, y, f, force, g_old)
-    _quiet_start(quiet, y, mode, g_old)
-    h_abs = _phase_step(code, c, mode, side, u, fu, rtol, atol_u, t_end, max_step, w_floor, tmp6, fu_new)
-    nfev += 1
+    g_old = ws[W_G][G_OLD]
+    phase_events(code, c, mode, side, energy_limit, u, y, f, force, g_old)
+    _quiet_start(np.int64(DELTA), y, mode, g_old)
+    ints[I_SIDE], real[R_W_FLOOR] = side, w_floor
+    h_abs = _phase_step(code, ws)
     if side == FLIGHT:
-        flight.coefficients(c, u, s, K6)  # kept in K6 for the whole flight (it has no stages)
+        flight.coefficients(c, u, 0.0, ur[U_STAGES:U_DENSE])  # kept for the whole flight (it has no stages)
+    radau5.clear(ws[W_STIFF], real[R_STIFF_AFTER])
+    ints[I_NFEV], ints[I_NEXT_POLL] = 3, POLL_STEPS
+    real[R_S], real[R_H_ABS], real[R_FORCE] = 0.0, h_abs, force
+    real[R_ENERGY_LIMIT], real[R_PAIR_ENERGY] = energy_limit, stuck_pair_energy(c, y)  # the pair's: read while stuck
 
-    stats = np.empty(N_STATS)  # the running extremes (STAT_*) inside the kernels
-    next_poll = np.int64(POLL_STEPS)  # _advance returns there (_ADV_LIMIT); resuming it changes no bit
-    stiff = radau5.workspace(stiff_after)
-    pair_energy = stuck_pair_energy(c, y)  # read while stuck only
-    while u[TIME] < t_end:
-        if nsteps >= max_steps or n_ev >= max_events:
-            status, reason = TOO_MANY_STEPS, FAILED_STOP
+
+@kernel
+def _loop(code, ws, ev, smp, times):
+    """The run's loop: steps while nothing happens (:func:`_take_steps`), then on the step where
+    something did, the events located and logged (:func:`_look_at_step`) and the run restarted,
+    stopped or the step accepted (:func:`_after_step`). Returns ``RUN_DONE``, or ``RUN_LOG_FULL``
+    when the run keeps logs (``I_LOGGING``) and they may not hold one more pass: the caller grows
+    them and calls again, and the run goes on exactly where it stood."""
+    real, ints, u, stiff = ws[W_REAL], ws[W_INT], ws[W_U][U_U], ws[W_STIFF]
+    while u[TIME] < real[R_T_END]:
+        if ints[I_LOGGING] != 0 and not _room(ws, ev, smp, times):
+            return RUN_LOG_FULL
+        if ints[I_NSTEPS] >= ints[I_MAX_STEPS] or ints[I_N_EV] >= ints[I_MAX_EVENTS]:
+            ints[I_STATUS], ints[I_REASON] = TOO_MANY_STEPS, FAILED_STOP
             break
-        if nsteps >= next_poll:
-            next_poll = nsteps + POLL_STEPS
+        if ints[I_NSTEPS] >= ints[I_NEXT_POLL]:
+            ints[I_NEXT_POLL] = ints[I_NSTEPS] + POLL_STEPS
             if interrupted():
-                status, reason = INTERRUPTED, FAILED_STOP
+                ints[I_STATUS], ints[I_REASON] = INTERRUPTED, FAILED_STOP
                 break
         if radau5.failed(stiff):
             break
-        next_sample = u[TIME] if save_kind == SAVE_STEPS else (
-            times[i_time] if save_kind == SAVE_TIMES and i_time < times.shape[0] else math.inf)
-        stats[STAT_MAX_FORCE], stats[STAT_MAX_INDENTATION] = max_force, max_indentation
-        result, s, h, h_abs, h_next, force, force_new, d_steps, d_fev = _advance(
-            code, c, mode, side, s, t_end, u, fu, y, f, force, h_abs, rtol, atol_u, max_step, flight_step, w_floor,
-            energy_limit, next_sample, min(max_steps, next_poll) - nsteps, g_old, g_new, fired, K6, u_new, fu_new,
-            y_new, f_new, stats, stiff)
-        max_force, max_indentation = stats[STAT_MAX_FORCE], stats[STAT_MAX_INDENTATION]
-        nsteps += d_steps
-        nfev += d_fev
+        result = _take_steps(code, ws, times)
         if result == _ADV_END:
             break
         if result == _ADV_COLLAPSE:
-            status, reason = STEP_SIZE_COLLAPSE, FAILED_STOP
+            ints[I_STATUS], ints[I_REASON] = STEP_SIZE_COLLAPSE, FAILED_STOP
             break
         if result == _ADV_LIMIT:
-            if nsteps < max_steps:
-                continue  # at next_poll
-            status, reason = TOO_MANY_STEPS, FAILED_STOP
+            if ints[I_NSTEPS] < ints[I_MAX_STEPS]:
+                continue  # at the next poll
+            ints[I_STATUS], ints[I_REASON] = TOO_MANY_STEPS, FAILED_STOP
             break
         # a step to look at (an event fired in it, a sample or the horizon falls in it); not accepted yet
-        s_new = s + h
-        any_fired = False
-        for col in range(N_EVENTS):
-            any_fired = any_fired or fired[col]
-        have_dense = False
-        stop_record = -1.0
-        restart_col = np.int64(-1)
-        s_restart = math.inf
-        s_horizon = math.inf
-        if _regularised(side) and u_new[TIME] >= t_end:
-            nfev += _interpolant(code, c, mode, side, u, fu, u_new, fu_new, h, K6, F6, tmp6, stiff)
-            have_dense = True
-            s_horizon = _s_at_time(code, c, mode, side, F6, u, s, h, t_end, us, ys, fs)
-        if any_fired:
-            if not have_dense:
-                nfev += _interpolant(code, c, mode, side, u, fu, u_new, fu_new, h, K6, F6, tmp6, stiff)
-                have_dense = True
-            unresolved, restart_col, s_restart, spent = _locate_events(
-                code, c, mode, side, settle, energy_limit, s, h, s_horizon, u, fu, g_old, g_new, fired, roots, K6, F6,
-                u_r, fu_r, stiff, us, ys, fs, gs)
-            nfev += spent
-            if unresolved:
-                h_abs = h / 32.0  # an event left and re-crossed zero inside the step: resolve it
-                continue
-            if n_ev + N_EVENTS > ev.shape[0]:
-                ev = _grow(ev, n_ev)  # a free row for each event _record may log
-            stats[STAT_MAX_FORCE], stats[STAT_MAX_INDENTATION] = max_force, max_indentation
-            n_ev, stop_record, spent = _record(code, c, mode, side, settle, stop_kind, stop_count, s, h, s_restart,
-                                               fired, roots, u, fu, F6, K6, us, fu_r, stiff, ys, fs, ev, n_ev, counts,
-                                               stats)
-            max_force, max_indentation = stats[STAT_MAX_FORCE], stats[STAT_MAX_INDENTATION]
-            nfev += spent
-        if stop_record >= 0:
-            # stopped at a recorded event: the state there from a fresh step that ends at it
-            if stop_record > s:
-                nfev += _fresh_step(code, c, mode, side, s, u, fu, stop_record - s, K6, u_r, fu_r, stiff)
-                _copy(u_r, u)
-                if not _regularised(side):
-                    u[TIME] = stop_record
-            force = _physical(code, c, mode, side, u, y, f)
-            reason = ASKED_STOP
+        restart_col, s_restart, s_horizon, stop_record = _look_at_step(code, ws, ev)
+        if restart_col == _RETRY:
+            continue  # an event left and re-crossed zero inside the step: a smaller one resolves it
+        if _after_step(code, ws, ev, smp, times, restart_col, s_restart, s_horizon, stop_record):
             break
-        if save_kind == SAVE_TIMES:
-            # samples up to where this step's motion stands: its end, the restart or the horizon
-            t_seg = u_new[TIME]
-            if restart_col >= 0:
-                _dense(c, side, F6, u, s, h, s_restart, us)
-                t_seg = s_restart if not _regularised(side) else us[TIME]
-            elif s_horizon < math.inf:
-                t_seg = t_end
-            while i_time < times.shape[0] and times[i_time] <= t_seg:
-                if not have_dense:
-                    nfev += _interpolant(code, c, mode, side, u, fu, u_new, fu_new, h, K6, F6, tmp6, stiff)
-                    have_dense = True
-                s_i = _s_at_time(code, c, mode, side, F6, u, s, h, times[i_time], us, ys, fs)
-                _dense(c, side, F6, u, s, h, s_i, us)
-                f_i = _physical(code, c, mode, side, us, ys, fs)
-                smp, n_s = _push_sample(smp, n_s, times[i_time], ys, mode, f_i)
-                i_time += 1
-        if restart_col < 0 and s_horizon < math.inf:
-            # a regularised phase reaches the horizon inside the step: the state there from a fresh step
-            nfev += _fresh_step(code, c, mode, side, s, u, fu, s_horizon - s, K6, u_r, fu_r, stiff)
-            _copy(u_r, u)
-            u[TIME] = t_end  # without the root finder's residue
-            force = _physical(code, c, mode, side, u, y, f)
-            max_force = max(max_force, force)
-            max_indentation = max(max_indentation, y[X1] - y[X2])
-            if save_kind == SAVE_STEPS:
-                smp, n_s = _push_sample(smp, n_s, t_end, y, mode, force)
-            break
-        if restart_col >= 0:
-            kind, mode, action, side, s, t, h_abs, force, pair_energy, spent = _restart(
-                code, c, settle, restart_col, mode, side, s, s_restart, h_next, u, fu, u_r, fu_r, y_r, f_r, y, f, K6,
-                stiff, rtol, atol, atol_u, t_end, max_step, w_floor, tmp6, fu_new, pair_energy)
-            nfev += spent
-            if kind == SILENT:  # a restart only (the pair at its centre): nothing to log
-                quiet = restart_col
-                _events(code, c, mode, side, energy_limit, u, y, f, force, g_old)
-                _quiet_start(quiet, y, mode, g_old)
-                continue
-            ev, n_ev = _push_event(ev, n_ev, t, kind, mode, y, force)
-            counts[kind] += 1
-            max_force = max(max_force, force)
-            max_indentation = max(max_indentation, y[X1] - y[X2])
-            if save_kind == SAVE_STEPS:
-                smp, n_s = _push_sample(smp, n_s, t, y, mode, force)
-            if action == STOP_SETTLED:
-                reason = SETTLED_STOP
-                break
-            if action == STOP_RUNAWAY:
-                reason = RUNAWAY_STOP
-                break
-            if kind == stop_kind and counts[kind] >= stop_count:
-                reason = ASKED_STOP
-                break
-            quiet = restart_col
-            _events(code, c, mode, side, energy_limit, u, y, f, force, g_old)
-            _quiet_start(quiet, y, mode, g_old)
-            continue
-        # the whole step stands
-        s = s_new
-        _copy(u_new, u)
-        _copy(fu_new, fu)
-        _copy(y_new, y)
-        _copy(f_new, f)
-        force = force_new
-        _copy(g_new, g_old)
-        h_abs = h_next
-        max_force = max(max_force, force)
-        max_indentation = max(max_indentation, y[X1] - y[X2])
-        if save_kind == SAVE_STEPS:
-            smp, n_s = _push_sample(smp, n_s, u[TIME], y, mode, force)
-
     if radau5.failed(stiff):  # a step to a root did not converge: what follows it is not the motion
-        status, reason = STEP_SIZE_COLLAPSE, FAILED_STOP
-    t = u[TIME]
-
-    summary = _summarize(code, c, y0, y, mode, status, reason, t, max_force, max_indentation, counts,
-                         n_ev, ev, nsteps, nfev)
-    return summary, ev[:n_ev], smp[:n_s], y
+        ints[I_STATUS], ints[I_REASON] = STEP_SIZE_COLLAPSE, FAILED_STOP
+    real[R_T_STOP] = u[TIME]
+    return RUN_DONE
 
 
-@allocating
-def _summarize(code, c, y0, y, mode, status, reason, t_stop, max_force, max_indentation, counts,
-               n_ev, ev, nsteps, nfev):
-    """The summary vector of a run (indices ``S_*``); undefined entries are NaN."""
-    s = np.full(N_SUMMARY, np.nan)
+_RETRY = -2  # _look_at_step: the step is to be retried smaller
+
+
+@kernel
+def _take_steps(code, ws, times):
+    """Steps of the current phase while nothing happens (:func:`_advance`); returns its result."""
+    ints, u = ws[W_INT], ws[W_U][U_U]
+    save_kind, i_time, nsteps = ints[I_SAVE_KIND], ints[I_TIME_INDEX], ints[I_NSTEPS]
+    next_sample = u[TIME] if save_kind == SAVE_STEPS else (
+        times[i_time] if save_kind == SAVE_TIMES and i_time < times.shape[0] else math.inf)
+    result, d_steps, d_fev = _advance(code, ws, next_sample, min(ints[I_MAX_STEPS], ints[I_NEXT_POLL]) - nsteps)
+    ints[I_NSTEPS], ints[I_NFEV] = nsteps + d_steps, ints[I_NFEV] + d_fev
+    return result
+
+
+@kernel
+def _look_at_step(code, ws, ev):
+    """The step :func:`_advance` left: where a regularised phase reaches the horizon in it, the
+    events that fired located and the recorded ones logged. Returns ``(restart_col, s_restart,
+    s_horizon, stop_record)`` (see :func:`_locate_events`, :func:`_record`; inf where none);
+    ``restart_col`` is ``_RETRY`` when the step must be retried smaller."""
+    real, ints, ur, fired = ws[W_REAL], ws[W_INT], ws[W_U], ws[W_FIRED]
+    side, h = ints[I_SIDE], real[R_H]
+    any_fired = False
+    for col in range(N_EVENTS):
+        any_fired = any_fired or fired[col]
+    have_dense = False
+    stop_record = -1.0
+    restart_col = np.int64(-1)
+    s_restart = math.inf
+    s_horizon = math.inf
+    nfev = 0
+    if regularised(side) and ur[U_NEW][TIME] >= real[R_T_END]:
+        nfev += _step_interpolant(code, ws)
+        have_dense = True
+        s_horizon = s_at_time(code, ws, real[R_T_END])
+    if any_fired:
+        if not have_dense:
+            nfev += _step_interpolant(code, ws)
+            have_dense = True
+        unresolved, restart_col, s_restart, spent = _locate_events(code, ws, s_horizon)
+        nfev += spent
+        if unresolved:
+            real[R_H_ABS] = h / 32.0
+            ints[I_NFEV] += nfev
+            return np.int64(_RETRY), s_restart, s_horizon, stop_record
+        stop_record, spent = _record(code, ws, ev, s_restart)
+        nfev += spent
+    ints[I_NFEV] += nfev
+    ints[I_HAVE_DENSE] = have_dense
+    return restart_col, s_restart, s_horizon, stop_record
+
+
+# inlined at numba level, like fresh_step: with their flight branch LLVM stopped inlining these
+# small dispatchers into the run, which cost runs without a flight 5-9 %
+@kernel(inline="always")
+def _step_interpolant(code, ws):
+    """The interpolant of the step :func:`_advance` left into rows ``U_DENSE`` (a flight's
+    invariants, see :func:`~.phase.dense`); returns the evaluations spent."""
+    ints, ur, stiff = ws[W_INT], ws[W_U], ws[W_STIFF]
+    side, K, F = ints[I_SIDE], ur[U_STAGES:U_DENSE], ur[U_DENSE:]
+    if side == FLIGHT:
+        copy_values(K[0], F[0])  # the flight's invariants
+        return 0
+    if radau5.active(stiff):
+        radau5.dense_coefficients(stiff, F)
+        return 0
+    dop853.dense_coefficients(code, ws[W_C], ints[I_MODE], side, ur[U_U], ur[U_FU], ur[U_NEW], ur[U_FU_NEW],
+                              ws[W_REAL][R_H], K, F, ur[U_TMP])
+    return 3
+
+
+@kernel
+def _after_step(code, ws, ev, smp, times, restart_col, s_restart, s_horizon, stop_record):
+    """After :func:`_look_at_step`: stop at a recorded event, take the samples in the step, stop on
+    the horizon, restart at an event, or accept the whole step. Returns True when the run ends."""
+    real, ints, c, ur, yr = ws[W_REAL], ws[W_INT], ws[W_C], ws[W_U], ws[W_Y]
+    mode, side, s = ints[I_MODE], ints[I_SIDE], real[R_S]
+    u, fu, u_r, y, f = ur[U_U], ur[U_FU], ur[U_ROOT], yr[Y_STATE], yr[Y_F]
+    if stop_record >= 0:
+        # stopped at a recorded event: the state there from a fresh step that ends at it
+        if stop_record > s:
+            ints[I_NFEV] += fresh_step(code, ws, stop_record - s, u_r, ur[U_FU_ROOT])
+            copy_values(u_r, u)
+            if not regularised(side):
+                u[TIME] = stop_record
+        real[R_FORCE] = physical(code, c, mode, side, u, y, f)
+        ints[I_REASON] = ASKED_STOP
+        return True
+    if ints[I_SAVE_KIND] == SAVE_TIMES:
+        _samples_in_step(code, ws, smp, times, restart_col, s_restart, s_horizon)
+    if restart_col < 0 and s_horizon < math.inf:
+        # a regularised phase reaches the horizon inside the step: the state there from a fresh step
+        ints[I_NFEV] += fresh_step(code, ws, s_horizon - s, u_r, ur[U_FU_ROOT])
+        copy_values(u_r, u)
+        u[TIME] = real[R_T_END]  # without the root finder's residue
+        force = physical(code, c, mode, side, u, y, f)
+        real[R_FORCE] = force
+        _extremes(ws, force, y)
+        if ints[I_SAVE_KIND] == SAVE_STEPS:
+            add_sample(ws, smp, real[R_T_END], y, mode, force)
+        return True
+    if restart_col >= 0:
+        return _restart_and_log(code, ws, ev, smp, restart_col, s_restart)
+    # the whole step stands
+    real[R_S] = s + real[R_H]
+    copy_values(ur[U_NEW], u)
+    copy_values(ur[U_FU_NEW], fu)
+    copy_values(yr[Y_NEW], y)
+    copy_values(yr[Y_F_NEW], f)
+    copy_values(ws[W_G][G_NEW], ws[W_G][G_OLD])
+    force = real[R_FORCE_NEW]
+    real[R_FORCE], real[R_H_ABS] = force, real[R_H_NEXT]
+    _extremes(ws, force, y)
+    if ints[I_SAVE_KIND] == SAVE_STEPS:
+        add_sample(ws, smp, u[TIME], y, mode, force)
+    return False
+
+
+@kernel
+def _extremes(ws, force, y):
+    """The running extremes (``W_STATS``) after a state the run stands at."""
+    stats = ws[W_STATS]
+    stats[STAT_MAX_FORCE] = max(stats[STAT_MAX_FORCE], force)
+    stats[STAT_MAX_INDENTATION] = max(stats[STAT_MAX_INDENTATION], y[X1] - y[X2])
+
+
+@kernel
+def _samples_in_step(code, ws, smp, times, restart_col, s_restart, s_horizon):
+    """The output times in the step, up to where its motion stands: its end, the restart or the horizon."""
+    real, ints, c, ur, yr = ws[W_REAL], ws[W_INT], ws[W_C], ws[W_U], ws[W_Y]
+    mode, side, s, h = ints[I_MODE], ints[I_SIDE], real[R_S], real[R_H]
+    u, us, F, ys, fs = ur[U_U], ur[U_TRIAL], ur[U_DENSE:], yr[Y_TRIAL], yr[Y_F_TRIAL]
+    have_dense = ints[I_HAVE_DENSE] != 0
+    t_seg = ur[U_NEW][TIME]
+    if restart_col >= 0:
+        dense(c, side, F, u, s, h, s_restart, us)
+        t_seg = s_restart if not regularised(side) else us[TIME]
+    elif s_horizon < math.inf:
+        t_seg = real[R_T_END]
+    i_time = ints[I_TIME_INDEX]
+    while i_time < times.shape[0] and times[i_time] <= t_seg:
+        if not have_dense:
+            ints[I_NFEV] += _step_interpolant(code, ws)
+            have_dense = True
+        s_i = s_at_time(code, ws, times[i_time])
+        dense(c, side, F, u, s, h, s_i, us)
+        f_i = physical(code, c, mode, side, us, ys, fs)
+        add_sample(ws, smp, times[i_time], ys, mode, f_i)
+        i_time += 1
+    ints[I_TIME_INDEX] = i_time
+
+
+@kernel
+def _restart_and_log(code, ws, ev, smp, restart_col, s_restart):
+    """Restart at the event ``restart_col`` (:func:`_restart`), log it and stop where it says so;
+    returns True when the run ends."""
+    real, ints, yr = ws[W_REAL], ws[W_INT], ws[W_Y]
+    kind, action, t = _restart(code, ws, restart_col, s_restart)
+    mode, y, force = ints[I_MODE], yr[Y_STATE], real[R_FORCE]
+    if kind != SILENT:  # SILENT: a restart only (the pair at its centre): nothing to log
+        log_event(ws, ev, t, kind, mode, y, force)
+        _extremes(ws, force, y)
+        if ints[I_SAVE_KIND] == SAVE_STEPS:
+            add_sample(ws, smp, t, y, mode, force)
+        if action == STOP_SETTLED:
+            ints[I_REASON] = SETTLED_STOP
+            return True
+        if action == STOP_RUNAWAY:
+            ints[I_REASON] = RUNAWAY_STOP
+            return True
+        if kind == ints[I_STOP_KIND] and ws[W_COUNTS][kind] >= ints[I_STOP_COUNT]:
+            ints[I_REASON] = ASKED_STOP
+            return True
+    u, g_old = ws[W_U][U_U], ws[W_G][G_OLD]
+    phase_events(code, ws[W_C], mode, ints[I_SIDE], real[R_ENERGY_LIMIT], u, y, yr[Y_F], force, g_old)
+    _quiet_start(restart_col, y, mode, g_old)
+    return False
+
+
+@kernel
+def summarize(code, ws):
+    """The summary vector of the run (``W_SUMMARY``, indices ``S_*``; undefined entries NaN), and
+    the ends of its last stick phases."""
+    real, ints, c, yr, counts = ws[W_REAL], ws[W_INT], ws[W_C], ws[W_Y], ws[W_COUNTS]
+    s = ws[W_SUMMARY]
+    y0, y, mode, status, reason = yr[Y_START], yr[Y_STATE], ints[I_MODE], ints[I_STATUS], ints[I_REASON]
+    for k in range(N_SUMMARY):
+        s[k] = math.nan
     s[S_STATUS] = status
     s[S_REASON] = reason
-    s[S_T_STOP] = t_stop
-    s[S_MAX_FORCE] = max_force
-    s[S_MAX_INDENTATION] = max_indentation
+    s[S_T_STOP] = real[R_T_STOP]
+    s[S_MAX_FORCE] = ws[W_STATS][STAT_MAX_FORCE]
+    s[S_MAX_INDENTATION] = ws[W_STATS][STAT_MAX_INDENTATION]
     s[S_DISSIPATED] = energy(code, c, y0) - energy(code, c, y)
     s[S_LOOP_AREA] = y[WORK] - y0[WORK]
     s[S_N_STICK] = counts[STICK]
     s[S_N_CONTACTS] = counts[CONTACT]
-    s[S_NSTEPS] = nsteps
-    s[S_NFEV] = nfev
+    s[S_NSTEPS] = ints[I_NSTEPS]
+    s[S_NFEV] = ints[I_NFEV]
     s[S_MODE] = mode
-    first_contact = -1
-    first_stick = -1
-    for i in range(n_ev):
-        kind = int(ev[i, EV_KIND])
-        if kind == CONTACT and first_contact < 0:
-            first_contact = i
-        elif kind == SEPARATION and first_contact >= 0 and math.isnan(s[S_CONTACT_DURATION]):
-            s[S_CONTACT_DURATION] = ev[i, EV_T] - ev[first_contact, EV_T]
-            dd0 = ev[first_contact, EV_Y + V1] - ev[first_contact, EV_Y + V2]
-            if dd0 != 0:
-                s[S_RESTITUTION] = -(ev[i, EV_Y + V1] - ev[i, EV_Y + V2]) / dd0
-        if kind == STICK and first_stick < 0:
-            first_stick = i
-            s[S_FIRST_STICK_T] = ev[i, EV_T]
-            s[S_FIRST_STICK_DELTA] = ev[i, EV_Y + X1] - ev[i, EV_Y + X2]
-            s[S_FIRST_STICK_MARGIN] = stick_margin(code, c, ev[i, EV_Y:EV_Y + 5])
-        if kind == SEPARATION and first_stick >= 0 and math.isnan(s[S_T_RUN]):
-            s[S_T_RUN] = ev[i, EV_T]
+    s[S_CONTACT_DURATION] = real[R_CONTACT_DURATION]
+    s[S_RESTITUTION] = real[R_RESTITUTION]
+    if ints[I_N_STICK] > 0:
+        stuck = yr[Y_FIRST_STICK]
+        s[S_FIRST_STICK_T] = real[R_STICK_T]
+        s[S_FIRST_STICK_DELTA] = stuck[X1] - stuck[X2]
+        s[S_FIRST_STICK_MARGIN] = stick_margin(code, c, stuck)
+    s[S_T_RUN] = real[R_T_RUN]
     if status != SUCCESS:
         outcome = FAILED
     elif reason == RUNAWAY_STOP:
@@ -1181,7 +982,7 @@ def _summarize(code, c, y0, y, mode, status, reason, t_stop, max_force, max_inde
     else:
         outcome = BOUNDED
     s[S_OUTCOME] = outcome
-    return s
+    _close_sticks(ws, math.inf if outcome == PERMANENT_STICK else real[R_T_STOP])
 
 
 @kernel(python=True)
@@ -1208,22 +1009,74 @@ def stick_points(ev, t_stop, permanent, out_t, out_delta, out_dwell):
     return n
 
 
+@allocating
+def new_logs(save_kind, times):
+    """Empty logs for a run that keeps them: the event log and the samples."""
+    rows = 1 if save_kind == SAVE_SUMMARY else (256 if save_kind == SAVE_STEPS else times.shape[0] + 2)
+    return np.empty((64, N_EV_COLUMNS)), np.empty((rows, N_SMP_COLUMNS))
+
+
+@allocating(python=True, nogil=True)  # runs side by side in threads (phaseimpact.train's orbit diagrams)
+def run(code, c, y0, atol, t_end, max_step, options, save_kind, times):
+    """Integrate one trajectory. See :func:`phaseimpact.integrate.simulate` for the meaning;
+    ``options`` is the tuple ``OPT_*``.
+
+    Returns ``(summary, events, samples, y_final)``: the event log (columns ``EV_*``) and the
+    samples (columns ``SMP_*``) trimmed to their lengths. The per-point kernels of
+    :func:`run_block` in a workspace of its own, with logs that grow (by doubling) whenever
+    :func:`_loop` says they may not hold one more pass. The seed's RK4 is :func:`.rk4.run_rk4`.
+    """
+    ws = workspace(c.shape[0], 0)
+    copy_values(c, ws[W_C])
+    copy_values(y0, ws[W_Y][Y_START])
+    copy_values(atol, ws[W_ATOL])
+    _set_options(ws, options, t_end, max_step, save_kind)
+    ints = ws[W_INT]
+    ints[I_LOGGING] = 1
+    ev, smp = new_logs(save_kind, times)
+    _start(code, ws, ev, smp, times)
+    while _loop(code, ws, ev, smp, times) == RUN_LOG_FULL:
+        ev = grow(ev, ints[I_N_EV])
+        smp = grow(smp, ints[I_N_S])
+    summarize(code, ws)
+    return ws[W_SUMMARY].copy(), ev[:ints[I_N_EV]], smp[:ints[I_N_S]], ws[W_Y][Y_STATE].copy()
+
+
+@kernel
+def run_point(code, ws, batch, options, i):
+    """Run ``i`` of ``batch`` (the tuple ``B_*``) in the workspace ``ws``, summary only, without an
+    event log: its summary in ``W_SUMMARY``, its stick points in ``W_STICKS`` (the first of
+    them, ``I_N_STICK`` in all). Allocates nothing: a thread's whole work for one point."""
+    copy_values(batch[B_C][i], ws[W_C])
+    copy_values(batch[B_Y0][i], ws[W_Y][Y_START])
+    copy_values(batch[B_ATOL][i], ws[W_ATOL])
+    _set_options(ws, options, batch[B_T_END][i], batch[B_MAX_STEP][i], np.int64(SAVE_SUMMARY))
+    ws[W_INT][I_LOGGING] = 0
+    no_log, no_times = ws[W_G][:0], ws[W_G][0, :0]  # log_event writes no event, and nothing samples
+    _start(code, ws, no_log, no_log, no_times)
+    _loop(code, ws, no_log, no_log, no_times)
+    summarize(code, ws)
+
+
 @allocating(python=True, nogil=True)
-def run_block(code, C, Y0, t_end, rtol, ATOL, max_step, settle, stop_kind, stop_count, max_steps, max_events,
-              stiff_after, start, stop, step, summary, st_t, st_delta, st_dwell, st_count):
+def run_block(code, batch, options, start, stop, step, outputs):
     """Runs ``start, start + step, ...`` (below ``stop``) of a batch, without the GIL (callers run
-    blocks in threads; each run's numbers depend on nothing else). Fills ``summary`` (n, N_SUMMARY)
-    and the first ``capacity`` stick points of each run; ``st_count`` holds each run's full number
-    of stick points. Threads over blocks, not a compiled parallel loop: that would compile the
-    driver a second time. A thread's block is every ``step``-th run, not a contiguous range: the
-    cost of a run changes smoothly over a sweep or an atlas (many times over near kappa_c), so
-    interleaved blocks cost the same to within one run, where contiguous ones left a thread idle
-    while another finished an expensive stretch. On Ctrl-C or SIGTERM the rest of the block is
-    left with the status ``interrupted``."""
-    empty = np.empty(0)
-    c = np.empty(C.shape[1])
-    y0 = np.empty(Y0.shape[1])
-    atol = np.empty(ATOL.shape[1])
+    blocks in threads; each run's numbers depend on nothing else). Fills ``outputs`` (the tuple
+    ``O_*``): the summaries (n, N_SUMMARY), the first ``capacity`` stick points of each run and its
+    full number of stick points (more than ``capacity``: the caller runs it again on the full path).
+    Threads over blocks, not a compiled parallel loop: that would compile the driver a second
+    time. A thread's block is every ``step``-th run, not a contiguous range: the cost of a run
+    changes smoothly over a sweep or an atlas (many times over near kappa_c), so interleaved blocks
+    cost the same to within one run, where contiguous ones left a thread idle while another finished
+    an expensive stretch. On Ctrl-C or SIGTERM the rest of the block is left with the status
+    ``interrupted``.
+
+    The block's one workspace is made here, once; each run goes through :func:`run_point` in it,
+    without an event log, and allocates nothing."""
+    summary, st_t, st_delta, st_dwell, st_count = (outputs[O_SUMMARY], outputs[O_STICK_T], outputs[O_STICK_DELTA],
+                                                   outputs[O_STICK_DWELL], outputs[O_STICK_COUNT])
+    ws = workspace(batch[B_C].shape[1], st_t.shape[1])
+    ints, sticks = ws[W_INT], ws[W_STICKS]
     done = 0
     for i in range(start, stop, step):
         done += 1
@@ -1231,19 +1084,12 @@ def run_block(code, C, Y0, t_end, rtol, ATOL, max_step, settle, stop_kind, stop_
             for j in range(i, stop, step):
                 summary[j, S_STATUS] = INTERRUPTED
             break
-        # the run reads its own copies: a row of the shared batch arrays would share their reference
-        # count, which run (an allocating function) updates, between the threads (a contended cache line)
-        _copy(C[i], c)
-        _copy(Y0[i], y0)
-        _copy(ATOL[i], atol)
-        s, events, _, _ = _run(code, c, y0, t_end[i], rtol, atol, max_step[i], settle, stop_kind, stop_count,
-                               np.int64(SAVE_SUMMARY), empty, max_steps, max_events, stiff_after)
-        _copy(s, summary[i])
-        permanent = s[S_OUTCOME] == PERMANENT_STICK
-        st_count[i] = stick_points(events, s[S_T_STOP], permanent, st_t[i], st_delta[i], st_dwell[i])
-        if s[S_STATUS] == INTERRUPTED:
+        run_point(code, ws, batch, options, i)
+        copy_values(ws[W_SUMMARY], summary[i])
+        st_count[i] = ints[I_N_STICK]
+        for j in range(min(ints[I_N_STICK], sticks.shape[1])):
+            st_t[i, j], st_delta[i, j], st_dwell[i, j] = sticks[ST_T, j], sticks[ST_DELTA, j], sticks[ST_DWELL, j]
+        if summary[i, S_STATUS] == INTERRUPTED:
             for j in range(i + step, stop, step):
                 summary[j, S_STATUS] = INTERRUPTED
             break
-
-

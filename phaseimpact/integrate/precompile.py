@@ -11,7 +11,7 @@ import time
 from pathlib import Path
 
 from .._jit import cache_info
-from . import driver
+from . import driver, rk4
 
 __all__ = ["warmup"]
 
@@ -35,7 +35,7 @@ def warmup() -> dict:
 
     info = cache_info()
     start = time.perf_counter()
-    entries = (driver.run, driver.run_block, driver.run_rk4)
+    entries = (driver.run, driver.run_block, rk4.run_rk4)
     before = [entry.stats.cache_misses.copy() for entry in entries]
     p = seed_parameters(v=1.0, kappa=3e9, limiting_pressure=2e9)  # p_y: read by the plastic law only
     stiff = p.replace(kappa=1e14, v=5.0)  # the stiff (Radau) path

@@ -102,6 +102,31 @@ def workspace(switch_after):
 
 
 @kernel
+def clear(stiff, switch_after):
+    """The workspace as :func:`workspace` makes it, for the next run in it (nothing allocated)."""
+    ws, lu_real, lu_complex, zc, piv = stiff[WS], stiff[LU_REAL], stiff[LU_COMPLEX], stiff[ZC], stiff[PIV]
+    for i in range(ws.shape[0]):
+        for j in range(ws.shape[1]):
+            ws[i, j] = 0.0
+    for i in range(N_FEEDBACK):
+        for j in range(N_FEEDBACK):
+            lu_real[i, j] = 0.0
+            lu_complex[i, j] = 0.0
+        piv[PIV_REAL, i] = 0
+        piv[PIV_COMPLEX, i] = 0
+    for j in range(N_STATE):
+        zc[j] = 0.0
+        stiff[TMP][j] = 0.0
+        stiff[FTMP][j] = 0.0
+        stiff[START][j] = 0.0
+        stiff[F_START][j] = 0.0
+    ctl = stiff[CTL]
+    for k in range(N_CTL):
+        ctl[k] = 0.0
+    ctl[SWITCH_AFTER] = switch_after  # 0: never (DOP853 throughout)
+
+
+@kernel
 def reset(stiff):
     """A new phase starts explicit."""
     ctl = stiff[CTL]

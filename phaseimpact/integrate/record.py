@@ -1,0 +1,71 @@
+"""The state of one run: a workspace of fixed-size arrays with named rows, and the run's record
+(its scalars) in two of them.
+
+A run's whole state lives in a workspace (:func:`workspace`): made once per thread and chunk of
+runs (:func:`.driver.run_block`) or once per trajectory (:func:`.driver.run`), never inside the
+per-point kernels, which allocate nothing: the form a GPU thread needs too (numba-cuda compiles
+tuples of arrays and constant indices; it has no ``structref``). A scratch vector is a row of one
+array (an allocation costs about 30 ns, a row nothing).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .._jit import allocating
+from . import radau5
+from .dop853 import N_DENSE, N_STAGES, N_STATE
+from .events import EVENT_KINDS, N_EVENTS
+
+#: Event kinds (``events.EVENT_KINDS``): the length of a run's counts.
+N_KINDS = len(EVENT_KINDS)
+#: The summary vector's length (``driver.S_*``).
+N_SUMMARY = 19
+
+# Named rows of the workspace's arrays.
+# Physical states (5 numbers): the rate at the state, a step's end state and rate, the state and rate
+# at a root, and of the root finders; the run's state, its start and its first stick.
+Y_F, Y_NEW, Y_F_NEW, Y_ROOT, Y_F_ROOT, Y_TRIAL, Y_F_TRIAL, Y_STATE, Y_START, Y_FIRST_STICK = range(10)
+N_Y_ROWS = 10
+# Event values (N_EVENTS numbers): at a trial point, before and after the step, the roots.
+G_TRIAL, G_OLD, G_NEW, G_ROOTS = range(4)
+N_G_ROWS = 4
+# Integration states (N_STATE numbers): the state and its rate, a step's end, the state at a root,
+# at a trial point, scratch, the phase's absolute tolerances; then DOP853's stages (a flight's
+# invariants) and the step's interpolant.
+U_U, U_FU, U_NEW, U_FU_NEW, U_ROOT, U_FU_ROOT, U_TRIAL, U_TMP, U_ATOL = range(9)
+U_STAGES = 9
+U_DENSE = U_STAGES + N_STAGES
+N_U_ROWS = U_DENSE + N_DENSE
+# The running extremes of a run (``stats``), kept up to date by the kernels that take steps.
+STAT_MAX_FORCE, STAT_MAX_INDENTATION = 0, 1
+N_STATS = 2
+
+# Members of the workspace tuple (numba indexes a tuple's members of different types by constants):
+(W_REAL, W_INT, W_C, W_ATOL, W_Y, W_G, W_FIRED, W_U, W_STATS, W_COUNTS, W_SUMMARY, W_STICKS, W_STIFF) = range(13)
+# The run's record: its scalars (W_REAL) ...
+(R_S, R_H, R_H_ABS, R_H_NEXT, R_FORCE, R_FORCE_NEW, R_T_END, R_RTOL, R_MAX_STEP, R_STIFF_AFTER, R_FLIGHT_STEP,
+ R_W_FLOOR, R_ENERGY_LIMIT, R_PAIR_ENERGY, R_T_STOP, R_CONTACT_T, R_CONTACT_SPEED, R_CONTACT_DURATION, R_RESTITUTION,
+ R_STICK_T, R_T_RUN) = range(21)
+N_REAL = 21
+# ... and its integers (W_INT): phase, counters, options, log lengths (I_N_EV counts the events
+# also when no log is kept: I_LOGGING 0) and the stick points (I_N_STICK of them, those from
+# I_OPEN_STICK on still waiting for their slip).
+(I_MODE, I_SIDE, I_NSTEPS, I_NFEV, I_NEXT_POLL, I_TIME_INDEX, I_N_EV, I_N_S, I_STATUS, I_REASON, I_SETTLE,
+ I_STOP_KIND, I_STOP_COUNT, I_SAVE_KIND, I_MAX_STEPS, I_MAX_EVENTS, I_N_STICK, I_OPEN_STICK, I_LOGGING,
+ I_HAVE_DENSE) = range(20)
+N_INT = 20
+N_ATOL = 7  # absolute tolerances of (x1, x2, v1, v2, W, t, w)
+# Rows of the stick points (W_STICKS): time, depth and dwell of each stick phase.
+ST_T, ST_DELTA, ST_DWELL = range(3)
+
+
+@allocating(python=True)
+def workspace(n_coef, capacity):
+    """The arrays of one run (members ``W_*``), reused run after run; ``capacity`` stick points."""
+    return (np.empty(N_REAL), np.zeros(N_INT, np.int64), np.empty(n_coef), np.empty(N_ATOL),
+            np.empty((N_Y_ROWS, 5)), np.empty((N_G_ROWS, N_EVENTS)), np.zeros(N_EVENTS, np.bool_),
+            np.empty((N_U_ROWS, N_STATE)), np.empty(N_STATS), np.zeros(N_KINDS, np.int64), np.empty(N_SUMMARY),
+            np.empty((3, capacity)), radau5.workspace(0.0))
+
+

@@ -1,0 +1,71 @@
+"""The per-point path allocates nothing: many runs go through the driver's per-point kernels in a
+workspace made once per chunk (``driver.run_block``), counted with numba's runtime allocation
+statistics; a run whose stick points overflow the chunk's rows is run again on the full path."""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+
+import numpy as np
+
+from phaseimpact import seed_parameters, simulate
+from phaseimpact.integrate import api
+
+# numba counts its allocations only when NUMBA_NRT_STATS is set as its runtime starts: a process of its own
+COUNT = r"""
+import json
+import numpy as np
+from numba.core.runtime import rtsys
+from phaseimpact import seed_parameters, simulate_many
+from phaseimpact.integrate import api
+
+def allocations(n, threads):
+    cases = [seed_parameters(v=1.0, kappa=k) for k in np.geomspace(1e9, 1e13, n)]
+    before = rtsys.get_allocation_stats().alloc
+    columns = simulate_many(cases, "paper", n_threads=threads)
+    return rtsys.get_allocation_stats().alloc - before, int(columns.stick_count.max())
+
+simulate_many([seed_parameters(v=1.0)], "paper", n_threads=2)  # the engine loaded (or compiled) first
+print(json.dumps({"chunk": api.PACK_CHUNK, "one": allocations(1, 1), "many": allocations(10_000, 1),
+                  "many_two_threads": allocations(10_000, 2)}))
+"""
+
+
+def test_a_sweep_allocates_per_chunk_not_per_point():
+    """10 000 runs in 5 chunks of api.PACK_CHUNK (one thread; two threads: one workspace per
+    thread and chunk) make exactly as many numba allocations as 5 (10) one-run calls: the
+    workspace and the arrays handed in, nothing per run (the previous driver made ~21 per run)."""
+    env = dict(os.environ, NUMBA_NRT_STATS="1")
+    out = subprocess.run([sys.executable, "-c", COUNT], env=env, capture_output=True, text=True, timeout=900)
+    assert out.returncode == 0, out.stderr[-3000:]
+    counts = json.loads(out.stdout.strip().splitlines()[-1])
+    chunks = -(-10_000 // counts["chunk"])
+    one, _ = counts["one"]
+    many, most_sticks = counts["many"]
+    two, _ = counts["many_two_threads"]
+    assert most_sticks <= 32  # no run overflowed its stick rows (that run would go the full path)
+    assert 0 < one < 100  # one chunk's workspace and arguments
+    assert many == chunks * one
+    assert two == 2 * chunks * one
+
+
+def test_a_run_that_overflows_its_stick_rows_gives_the_full_path_result():
+    """Capacity 1 for a run with four stick phases (seed case, v = 7 m/s, kappa = 4.16865e11): the
+    run is flagged (its count above the capacity) and run again on the full path (event log), and
+    its columns equal both a roomy batch and ``simulate`` bit for bit."""
+    p = seed_parameters(v=7.0, kappa=4.16865e11)
+    batch = api.pack_batch([p], "paper", None, 1e-10)
+    tight = api.run_batch(batch, rtol=1e-10, capacity=1)
+    roomy = api.run_batch(batch, rtol=1e-10, capacity=32)
+    alone = simulate(p, "paper")
+    t, delta, dwell = alone.stick_points()
+    assert len(t) == tight.stick_count[0] == roomy.stick_count[0] == 4
+    for columns in (tight, roomy):
+        np.testing.assert_array_equal(columns.stick_t, t)
+        np.testing.assert_array_equal(columns.stick_delta, delta)
+        np.testing.assert_array_equal(columns.stick_dwell, dwell)
+        np.testing.assert_array_equal(columns.max_force, [alone.max_force])
+        np.testing.assert_array_equal(columns.t_stop, [alone.t_stop])
