@@ -30,6 +30,7 @@ STUDIES = (
     "grazing",
     "erosion",
     "plastic",
+    "impact_regime",
     "train",
     "train_bifurcations",
     "max_force_vs_kappa",

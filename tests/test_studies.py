@@ -95,3 +95,59 @@ def test_staircase_fits_regenerate_from_the_archived_data_and_ignore_last_bit_di
         assert value == plots.known(attrs[name]), name  # the fit of the archived data
         assert last_bit[name] == value, name
         assert attrs[name] == plots.known(attrs[name]), f"{name} = {attrs[name]!r}: stored beyond its digits"
+
+
+def _load_study(name, monkeypatch):
+    monkeypatch.syspath_prepend(str(STUDIES))
+    spec = importlib.util.spec_from_file_location(f"study_{name}", STUDIES / f"{name}.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+@pytest.mark.slow
+def test_impact_regime_map_agrees_with_the_mass_criterion_and_zeners_closed_form(tmp_path, monkeypatch):
+    """A quick run of studies/impact_regime.py, checked against numbers computed here from the case inputs:
+    Olsson's ratio M1 / (pi a^2 rho h) with his bounds 0.23 and 2, and, for the isotropic gelcoat panel, Zener's
+    closed form of lambda (docs/physics.md §8) with R = R1 R2 / (R1 + R2) in place of R1."""
+    import json
+
+    import h5py
+
+    from phaseimpact.case import load_case
+    from phaseimpact.plotting import for_print
+
+    study = _load_study("impact_regime", monkeypatch)
+    monkeypatch.setattr(study, "FIGURES", tmp_path)
+    with for_print():  # as studies/_cli.py runs it: PNG and PDF
+        out = Path(study.main(quick=True, jobs=1))
+    assert out.is_file() and out.with_suffix(".pdf").is_file()
+    quartz, ice = load_case("sand-gelcoat").projectile, load_case("hail-laminate").projectile
+    with h5py.File(tmp_path / "data" / "impact_regime.h5") as f:
+        R1, v = f["R1"][()], f["v"][()]
+        for key, case in (("gelcoat", "sand-gelcoat"), ("LEP", "sand-lep"), ("laminate", "sand-laminate")):
+            c = load_case(case)
+            plies = getattr(c.plate, "plies", None)
+            rho_h = sum(p.rho * p.thickness for p in plies) if plies else c.plate.rho * 0.005
+            rho1 = np.where(R1 >= 2.5e-3, ice.rho, quartz.rho)
+            ratio = rho1 * 4 / 3 * np.pi * R1**3 / (np.pi * 0.05**2 * rho_h)
+            assert np.allclose(f[f"{key}/mass_ratio"][()], ratio, rtol=1e-12)
+            expected = np.where(ratio < 0.23, "wave-controlled", np.where(ratio <= 2, "boundary-controlled",
+                                                                           "quasi-static"))
+            assert [s.decode() for s in f[f"{key}/regime"][()]] == expected.tolist()
+            assert {s.decode() for s in f[f"{key}/regime"][()]} == {"wave-controlled", "boundary-controlled",
+                                                                     "quasi-static"}
+            models = [s.decode() for s in f[f"{key}/model"][()]]
+            assert models == ["infinite" if r == "wave-controlled" else "plate" for r in expected]
+        # Zener's closed form on the isotropic gelcoat panel, each projectile material
+        g = load_case("sand-gelcoat").plate
+        c0 = np.sqrt(g.E / (g.rho * (1 - g.nu**2)))
+        for material, part in ((quartz, R1 < 2.5e-3), (ice, R1 >= 2.5e-3)):
+            R = R1[part] * 1.0 / (R1[part] + 1.0)
+            closed = (np.pi**0.6 / np.sqrt(3) * (R1[part] / 0.005) ** 2 * (v[:, None] / c0) ** 0.2
+                      * (material.rho / g.rho) ** 0.6 * (R / R1[part]) ** 0.2
+                      * (1 + g.E * (1 - material.nu**2) / (material.E * (1 - g.nu**2))) ** -0.4)
+            assert np.allclose(f["gelcoat/zener_lambda"][()][:, part], closed, rtol=1e-10)
+        cases = {c["name"]: c for c in json.loads(f.attrs["cases"])}
+    assert set(cases) == {"dust-gelcoat", "sand-gelcoat", "sand-lep", "sand-laminate", "hail-laminate"}
+    assert all(c["regime"] == "wave-controlled" and c["model"] == "infinite" and c["warns"] for c in cases.values())
