@@ -330,10 +330,35 @@ def heyoka_ratios():
     return min(ratios), max(ratios)
 
 
+def regime_json(key: str):
+    """A JSON attribute of figures/data/impact_regime.h5 (studies/impact_regime.py)."""
+    return json.loads(h5("impact_regime", key))
+
+
+def regime_dust_decades() -> tuple:
+    """How many orders of magnitude the seed's dust lies below Olsson's 0.23: (fewest, most)."""
+    return (math.log10(0.23 / h5("impact_regime", "seed_dust_mass_ratio_max")),
+            math.log10(0.23 / h5("impact_regime", "seed_dust_mass_ratio_min")))
+
+
+def regime_grains_below() -> tuple:
+    """The grain cases' factor below Olsson's 0.23, (smallest, largest), and the hailstone's factor and lambda."""
+    cases = {c["name"]: c for c in regime_json("cases")}
+    grains = [c["below_bound"] for name, c in cases.items() if name != "hail-laminate"]
+    return min(grains), max(grains), cases["hail-laminate"]["below_bound"], cases["hail-laminate"]["zener_lambda"]
+
+
+def regime_hail_diameters(which: int) -> tuple:
+    """Ice diameters (mm) at Olsson's lower (0) or upper (1) bound, over the three panels: (smallest, largest)."""
+    d = [2e3 * b["ice"][which] for b in regime_json("boundaries").values()]
+    return min(d), max(d)
+
+
 # ------------------------------------------------------------------------------------------------ table
 
 R, D, C, F = "figures/README.md", "docs/physics.md", "figures/claims.md", "docs/findings.md"
 ST, ER, PL, TR = "studies/staircase.py", "studies/erosion.py", "studies/plastic.py", "studies/train.py"
+RG = "studies/impact_regime.py"
 
 STATEMENTS = [
     # docs/findings.md, findings
@@ -398,6 +423,19 @@ STATEMENTS = [
     Statement(F, "has a contact radius of {} R1)", sand_lep_radius_ratio),
     Statement(F, "its peak pressure of {} GPa (reduced mass, plate target) is elastic only for a steel with Y ≥ {} GPa",
               lambda: (cases()["seed"]["peak_pressure_Pa"] / 1e9, cases()["seed"]["peak_pressure_Pa"] / 1.6e9)),
+    Statement(F, "has a mass ratio `M1/M_p` of {} to {}, {} to {} orders of magnitude below the bound 0.23",
+              lambda: (h5("impact_regime", "seed_dust_mass_ratio_min"), h5("impact_regime", "seed_dust_mass_ratio_max"),
+                       *regime_dust_decades())),
+    Statement(F, "a dashpot of {} to {} N s/m on these panels",
+              lambda: (min(p["impedance"] for p in regime_json("panels").values()),
+                       max(p["impedance"] for p in regime_json("panels").values()))),
+    Statement(F, "is at most {} at the seed's 13 m/s ({} at the IEA-15 tip speed)",
+              lambda: (h5("impact_regime", "seed_dust_zener_lambda_max"),
+                       max(max(s["zener_lambda_tip"]) for s in regime_json("seed_dust").values()))),
+    Statement(F, "(the dust and sand grains {} to {} times below the bound, the 15 mm hailstone {} times, with "
+                 "`lambda` = {})", regime_grains_below),
+    Statement(F, "hail becomes boundary-controlled only from {}–{} mm in diameter", lambda: regime_hail_diameters(0)),
+    Statement(F, "the quasi-static regime starts at {}–{} mm", lambda: regime_hail_diameters(1)),
     # figures/README.md, the captions
     Statement(R, "the loop area is {} J", lambda: h5("fig04_force_indentation", "loop_area_J")),
     Statement(R, "the force dropping from {} N to the {}–{} N that holds the pair",
@@ -452,6 +490,10 @@ STATEMENTS = [
                        cases()["dust-gelcoat"]["pressure_to_first_yield"])),
     Statement(R, "(shared approach: minimum {} N at κ ≈ {};", max_force),
     Statement(R, "on Hunt–Crossley it is {}–{}x its time", heyoka_ratios, kind=TIMING),
+    Statement(R, "hail is boundary-controlled (spring–mass plate) from {}–{} mm in radius; the seed's dust (13 m/s) "
+                 "lies {} to {} orders of magnitude below the bound 0.23, with λ ≤ {}.",
+              lambda: (*(d / 2 for d in regime_hail_diameters(0)), *regime_dust_decades(),
+                       h5("impact_regime", "seed_dust_zener_lambda_max"))),
     # docs/findings.md, the audit table (its numbers are those of figures/claims.md)
     Statement(F, "ends in a stick at δ = {} µm, P = {} N, for good",
               lambda: (claims_md(r"δ = ([\d.]+) µm"), claims_md(r"P = ([\d.]+) N"))),
@@ -526,6 +568,11 @@ STATEMENTS = [
               lambda: (sand_pressure(60.0) / 1e9, sand_pressure(120.0) / 1e9,
                        sand_pressure(60.0) / h5("erosion", "first_yield_pressure"),
                        sand_pressure(120.0) / h5("erosion", "first_yield_pressure"))),
+    Statement(RG, "hail up to {}-{} mm in radius", lambda: tuple(d / 2 for d in regime_hail_diameters(0))),
+    Statement(RG, "lies {} to {} orders of magnitude below that bound", regime_dust_decades),
+    Statement(RG, "is at most {}, near the rigid-wall limit",
+              lambda: h5("impact_regime", "seed_dust_zener_lambda_max")),
+    Statement(RG, "has lambda = {}.", lambda: regime_grains_below()[3]),
     Statement("studies/bifurcation.py", "up to kappa_c = {} N s/m^2.5", kc),
     Statement("studies/bifurcation.py", "the plastic stick dissipates {} mJ",
               lambda: at_exactly("bifurcation_printed", "kappa", "dissipated_energy", 1e9) * 1e3),
@@ -558,7 +605,8 @@ COVERED = {
 EXEMPT = {
     F: {"100": "the numerical guard factor (a setting), '100 times'", "7850": "input (steel density)",
         "210": "the previous release's count (history, issue 42)", "117": "the previous release's count (history)",
-        "200": "input (impacts dropped by studies/train.py)"},
+        "200": "input (impacts dropped by studies/train.py)",
+        "62.5": "input (the dust size class's upper bound, sand's lower on Wentworth's scale)"},
     D: {"100": "the confirmation's tolerance factor (a setting, continuation/confirm.py), 'rtol / 100'",
         "7850": "input (steel density)", "353": "eq. 5b's formula", "191": "eq. 5b's formula",
         "648": "eq. 5b's formula", "6.35": "the speed of an example point (input)",
@@ -568,6 +616,9 @@ EXEMPT = {
         "669": "page (Zener 1941, Phys. Rev. 59:669)", "1587": "page (Olsson 1992, AIAA J. 30:1587)",
         "879": "page (Olsson 2000, Composites A 31:879)",
         "16.7": "input (E3 of the isotropic approximation the laminate cases used before)"},
+    RG: {"879": "page (Olsson 2000, Composites A 31:879)", "2000": "year", "1922": "year",
+         "377": "page (Wentworth 1922, J. Geol. 30:377)", "62.5": "input (size class bound)",
+         "120": "input (speed range)"},
     PL: {"1997": "year", "383": "page (Thornton 1997, J. Appl. Mech. 64:383)"},
     TR: {"200": "input (impacts dropped)", "400": "input (values of T)"},
     "studies/train_bifurcations.py": {
