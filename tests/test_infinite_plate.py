@@ -161,9 +161,15 @@ def test_simulate_and_params_on_the_command_line():
     code, out, err = run(["simulate", "--target", "infinite", "--v", "1", "--law", "abrate", "--json"])
     assert code == 0, err
     result = json.loads(out)
-    e, peak, _ = hertz_on_dashpot(*(lambda p: (p.M1, p.K, p.impedance, 1.0))(infinite(1.0)))
-    text = json.dumps(result)
-    assert "infinite" in text
+    p = infinite(1.0)
+    e, peak, radiated = hertz_on_dashpot(p.M1, p.K, p.impedance, 1.0)
+    assert result["target"] == "infinite" and result["status"] == "success"
+    assert result["restitution"] == pytest.approx(e, rel=1e-8)
+    assert result["max_force"] == pytest.approx(peak, rel=1e-8)
+    assert result["loop_area"] == pytest.approx(radiated, rel=1e-8)
+    code, out, err = run(["simulate", "--target", "infinite", "--law", "paper", "--kappa", "1e9"])
+    assert code == 0, err
+    assert "on an infinite target (seed)" in out and "permanent-stick" in out
     code, out, err = run(["params", "--target", "infinite", "--json"])
     assert code == 0, err
     params = json.loads(out)
@@ -173,3 +179,24 @@ def test_simulate_and_params_on_the_command_line():
     assert params["zener_lambda"] == pytest.approx(
         infinite().M1**0.6 * infinite().K**0.4 / infinite().impedance, rel=1e-12)
     assert params["hertz_mass"] == infinite().M1
+
+
+def test_params_warns_for_an_infinite_target_out_of_its_regime():
+    """A 5 cm steel ball (4.1 kg) on the seed plate (1.23 kg): M1/M_p = 3.3 > 2, quasi-static."""
+    code, out, err = run(["params", "--target", "infinite", "--set", "R1=0.05", "--json"])
+    assert code == 0, err
+    params = json.loads(out)
+    assert params["regime"] == "quasi-static"
+    assert "the infinite plate (target infinite) is out of its range; the spring-mass plate is the model" \
+        in params["regime_warning"]
+
+
+def test_a_case_file_names_the_infinite_target(tmp_path):
+    case = tmp_path / "wave.toml"
+    case.write_text("[projectile]\nE = 2.1e11\nnu = 0.3\nrho = 7850.0\n[plate]\nE = 2.1e11\nnu = 0.3\nrho = 7850.0\n"
+                    "[geometry]\na = 0.1\nh = 0.005\nR1 = 0.02\nR2 = 2e3\n"
+                    '[impact]\nv = 1.0\ntarget = "infinite"\nlaw = "abrate"\n')
+    code, out, err = run(["simulate", "--case", case, "--json"])
+    assert code == 0, err
+    assert json.loads(out)["restitution"] == pytest.approx(hertz_on_dashpot(*(lambda p: (
+        p.M1, p.K, p.impedance, 1.0))(infinite(1.0)))[0], rel=1e-8)
