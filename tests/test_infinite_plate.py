@@ -200,3 +200,17 @@ def test_a_case_file_names_the_infinite_target(tmp_path):
     assert code == 0, err
     assert json.loads(out)["restitution"] == pytest.approx(hertz_on_dashpot(*(lambda p: (
         p.M1, p.K, p.impedance, 1.0))(infinite(1.0)))[0], rel=1e-8)
+
+
+@pytest.mark.parametrize("kappa", [1e9, 1e12, 4.83337e14, 1e15])
+def test_every_paper_impact_on_it_ends_in_a_stick(kappa):
+    """At the ``deltadot = 0`` that ends the compression the pair needs ``c x2dot = P(delta, 0+)``, the
+    stick bound itself, and then less: the stick holds for every damping (at 4.8e14 the integrated
+    ``c x2dot`` once came out above the bound by rounding, and the slip went on unlogged)."""
+    p = infinite(1.0, kappa=kappa)
+    r = simulate(p, "paper", 2e-3, stop_when_settled=False)
+    kinds = [e.kind for e in r.events]
+    assert r.status == "success" and kinds[-1] == "stick" and "separation" not in kinds, kinds
+    stick = r.events[-1]
+    bound = p.K * stick.delta**1.5
+    assert p.impedance * stick.state[3] == pytest.approx(bound, rel=1e-6)

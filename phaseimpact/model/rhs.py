@@ -134,10 +134,16 @@ def _stick_force_at(c, x2):
 
 @kernel(python=True)
 def stick_force(c, y):
-    """Force that keeps the projectile with the target while stuck, ``F_req``, N: on the infinite
-    plate the dashpot's ``c x2dot``, which the pair then needs (``x1dot = x2dot``)."""
+    """Force that keeps the projectile with the target while stuck, ``F_req``, N.
+
+    0 on the infinite plate, where a stick always holds: the pair needs the dashpot's ``c x2dot``,
+    which at the ``deltadot = 0`` that starts the stick is the slip's own force there,
+    ``P(delta, 0+-)`` (the constraint ``c x2dot = P``), at the stick bound, and which then only
+    decreases as the pair slows (``M1 x1'' = -c x1dot``). Compared with the bound, the integrated
+    ``c x2dot`` would refuse half of these sticks on rounding alone (a slip then went on through
+    ``deltadot = 0`` unlogged)."""
     if c[IMPEDANCE_] > 0:
-        return c[IMPEDANCE_] * y[V2]
+        return 0.0
     return _stick_force_at(c, y[X2])
 
 
