@@ -451,6 +451,11 @@ def jacobian(y, params: Parameters, law, mode: int = 1) -> np.ndarray:
         Shape (4, 4): ``J[i, j] = d(dy_i/dt)/dy_j`` with ``y = (x1, x2, x1dot, x2dot)`` (rows 2
         and 3 in 1/s^2 and 1/s); the target's row is zero on a rigid target.
 
+    Raises
+    ------
+    ValueError
+        For the ``infinite`` target, whose load-point equation would need the law's second partials.
+
     Examples
     --------
     >>> from phaseimpact import seed_parameters
