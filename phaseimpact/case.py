@@ -118,7 +118,7 @@ SETTABLE = {
     "kappa": ("law's unit", "damping coefficient of a law damped by kappa, in the unit its entry gives "
                             "(N s/m^2.5 for a Hunt-Crossley-type law on Hertz contact)"),
     "restitution": ("-", "coefficient of restitution (the restitution laws, hunt-crossley)"),
-    "target": ("", "what is hit: plate, rigid or free"),
+    "target": ("", "what is hit: plate, rigid, free or infinite"),
     "law": ("", "contact law"),
     "contact": ("", "law paper's reading of |delta|^alpha: printed or unilateral"),
 }

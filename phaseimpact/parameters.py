@@ -48,7 +48,7 @@ __all__ = [
     "KAPPA_MAX",
 ]
 
-TARGETS = ("plate", "rigid", "free")
+TARGETS = ("plate", "rigid", "free", "infinite")
 MEMBRANE_FORMULAS = ("printed", "shivakumar")
 BODIES = ("projectile", "plate")
 MATERIAL_FIELDS = ("E", "nu", "rho", "yield_strength")
@@ -256,7 +256,9 @@ class Parameters:
     v : float
         Impact speed of the projectile, m/s (initial condition eq. 6; :data:`V_RANGE`).
     target : str
-        ``"plate"`` (eq. 1), ``"rigid"`` (target held fixed) or ``"free"`` (no springs).
+        ``"plate"`` (eq. 1), ``"rigid"`` (target held fixed), ``"free"`` (no springs) or
+        ``"infinite"`` (the infinite plate: a dashpot of :attr:`impedance` at the load point,
+        docs/physics.md §8; ``M2``, ``Kb``, ``Km`` take no part).
     R : float or None
         Effective contact radius ``R1 R2/(R1+R2)``, m, filled by :func:`derive_parameters`; not
         used by the equations of motion, only by contact radius and pressure (Hertz). ``None``
@@ -265,6 +267,10 @@ class Parameters:
         Thornton's limiting contact pressure ``p_y``, Pa, read by the ``thornton`` law only: the
         Hertz peak pressure at first yield, ``1.60 Y`` of the weaker body with a ``yield_strength``
         (:data:`FIRST_YIELD_FACTOR`), filled by :func:`derive_parameters`; ``None`` without one.
+    impedance : float or None
+        The infinite plate's point impedance ``c = 8 sqrt(D* rho h)``, N s/m (Zener 1941;
+        ``D*`` Olsson's effective rigidity, ``D`` for an isotropic plate; docs/physics.md §8),
+        filled by :func:`derive_parameters`; read by the ``infinite`` target only, which needs it.
 
     Examples
     --------
@@ -290,6 +296,7 @@ class Parameters:
     target: str = "plate"
     R: float | None = None
     limiting_pressure: float | None = None
+    impedance: float | None = None
 
     def __post_init__(self):
         for name in ("M1", "M2", "K", "alpha"):
@@ -298,11 +305,15 @@ class Parameters:
         for name in ("Kb", "Km", "kappa"):
             require_nonnegative(name, getattr(self, name))
         require_choice("target", self.target, TARGETS)
-        for name in ("R", "limiting_pressure"):
+        for name in ("R", "limiting_pressure", "impedance"):
             value = getattr(self, name)
             if value is not None:
                 require(name, value, "a finite number > 0, or None", _is_finite(value) and value > 0)
-        _store_floats(self, ("M1", "M2", "K", "Kb", "Km", "alpha", "kappa", "v", "R", "limiting_pressure"))
+        if self.target == "infinite":
+            require("impedance", self.impedance, "a finite number > 0 (N s/m) for target 'infinite': the plate's "
+                    "point impedance 8 sqrt(D rho h), which derive_parameters fills", self.impedance is not None)
+        _store_floats(self, ("M1", "M2", "K", "Kb", "Km", "alpha", "kappa", "v", "R", "limiting_pressure",
+                             "impedance"))
 
     def replace(self, **changes) -> Parameters:
         """A copy with ``changes`` applied (and validated); unknown names raise ``ValueError``.
@@ -348,8 +359,9 @@ class Parameters:
 
     @property
     def reduced_mass(self) -> float:
-        """Mass of the relative motion during contact, kg."""
-        if self.target == "rigid":
+        """Mass of the relative motion during contact, kg (``M1`` against a rigid target or the
+        massless load point of the infinite plate)."""
+        if self.target in ("rigid", "infinite"):
             return self.M1
         return self.M1 * self.M2 / (self.M1 + self.M2)
 
@@ -436,14 +448,15 @@ def derive_parameters(
         ``Km`` with ``(1 - nu^2)`` as eq. 5b prints it, or ``(1 - nu)`` as in Shivakumar's table.
     alpha, kappa, v, target
         Passed through to :class:`Parameters`: contact exponent, damping (N s/m^(1+alpha)),
-        impact speed (m/s), ``"plate"``, ``"rigid"`` or ``"free"``.
+        impact speed (m/s), one of :data:`TARGETS`.
 
     Returns
     -------
     Parameters
         ``M1`` (kg), ``M2`` (kg, a quarter of the plate), ``K`` (N/m^1.5), ``Kb`` (N/m), ``Km``
-        (N/m^3), the effective radius ``R`` (m) and, when a material gives a ``yield_strength``,
-        the ``limiting_pressure`` ``1.6 Y`` (Pa) of the weaker one.
+        (N/m^3), the effective radius ``R`` (m), the infinite plate's ``impedance``
+        ``8 sqrt(D* rho h)`` (N s/m, docs/physics.md §8) and, when a material gives a
+        ``yield_strength``, the ``limiting_pressure`` ``1.6 Y`` (Pa) of the weaker one.
 
     Raises
     ------
@@ -471,6 +484,7 @@ def derive_parameters(
         Kb = 4.0 * math.pi * E * g.h**3 / (3.0 * (1 - nu**2) * g.a**2)  # eq. 5a with h^3
         km_denominator = (1 - nu**2) if membrane == "printed" else (1 - nu)
         Km = (353 - 191 * nu) * math.pi * E * g.h / (648 * km_denominator * g.a**2)  # eq. 5b
+        rigidity = E * g.h**3 / (12 * (1 - nu**2))
     else:  # a laminate (docs/physics.md §8); imported late: model.laminate builds on this module
         from .model import laminate as lam
 
@@ -482,6 +496,9 @@ def derive_parameters(
         plate_compliance = lam.top_ply_compliance(plate)
         Kb = lam.bending_stiffness(plate, g.a)
         Km = lam.membrane_stiffness(plate, g.a, membrane)
+        from .model.regime import olsson_rigidity
+
+        rigidity = olsson_rigidity(plate.reduced_bending_stiffness())
     M1 = projectile.rho * 4.0 / 3.0 * math.pi * g.R1**3
     M2 = 0.25 * math.pi * g.a**2 * areal_density  # a quarter of the plate takes part
     eta = (1 - projectile.nu**2) / projectile.E + plate_compliance  # eq. 4
@@ -491,8 +508,9 @@ def derive_parameters(
         Kb = _bending_shear(plate, g.a, R, K, M1 * M2 / (M1 + M2), v)
     strengths = [m.yield_strength for m in (projectile, plate) if m.yield_strength is not None]
     p_y = FIRST_YIELD_FACTOR * min(strengths) if strengths else None
+    impedance = 8 * math.sqrt(rigidity * areal_density)  # Zener's point impedance (docs/physics.md §8)
     return Parameters(M1=M1, M2=M2, K=K, Kb=Kb, Km=Km, alpha=alpha, kappa=kappa, v=v, target=target, R=R,
-                      limiting_pressure=p_y)
+                      limiting_pressure=p_y, impedance=impedance)
 
 
 def _bending_shear(laminate, a: float, R: float, K: float, reduced_mass: float, v: float) -> float:

@@ -245,6 +245,18 @@ def seed_plate_impedance():
 
 
 @functools.cache
+def infinite_seed():
+    """The seed ball at 1 m/s on the seed plate as an infinite plate, elastic Hertz: Zener's lambda,
+    restitution, peak force (N), contact time (ms) (docs/physics.md §8)."""
+    from phaseimpact import seed_parameters, simulate
+    from phaseimpact.model.regime import zener_lambda
+
+    p = seed_parameters(v=1.0, target="infinite")
+    r = simulate(p, "abrate", 2e-3)
+    return zener_lambda(p.M1, p.v, p.K, p.impedance), r.restitution, r.max_force, 1e3 * r.contact_duration
+
+
+@functools.cache
 def laminate_case_ratios():
     """The blade laminate cases against the isotropic approximation they used before (E = 16.7 GPa,
     nu = 0.17): bending alone, Kbs of sand and of hail, K of sand and of hail, Km (docs/physics.md §8)."""
@@ -536,6 +548,7 @@ STATEMENTS = [
     Statement(D, "(`m` the reduced mass; {} mJ for the seed at 1 m/s)", lambda: below_kc_energy_mj()[1]),
     Statement(D, "larger by `1/(1 - nu^2)` ({} at `nu = 0.3`)", lambda: yang_sun_over_exact(0.3)),
     Statement(D, "Seed plate: `c = {} N s/m`.", lambda: seed_plate_impedance()),
+    Statement(D, "Seed ball at 1 m/s (`lambda = {}`): `e = {}`, peak force {} N, contact {} ms.", infinite_seed),
     Statement(D, "the laminate's bending stiffness alone is {} times larger, `Kbs` {} times (sand: the 18 µm contact "
                  "makes the shear term large) and {} times (hail), `K` {} and {} times, `Km` {} times",
               laminate_case_ratios),

@@ -48,7 +48,8 @@ def run_params(args) -> int:
     # The Hertz scales are those of the relative motion: the reduced mass M1 M2/(M1+M2) unless the
     # target is rigid (docs/physics.md §4); say which, since a plate's figures differ from a rigid one's.
     out["hertz_mass"] = p.reduced_mass
-    out["hertz_mass_is"] = ("M1 (rigid target)" if p.target == "rigid"
+    out["hertz_mass_is"] = ("M1 (rigid target)" if p.target == "rigid" else
+                            "M1 (infinite target: the load point has no mass)" if p.target == "infinite"
                             else f"reduced mass M1 M2/(M1+M2) ({p.target} target)")
     out.update(hertz_scales(p, case.plate))
     out["validity"] = validity(p, case.plate, case.projectile, case.geometry)

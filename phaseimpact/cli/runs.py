@@ -115,7 +115,8 @@ def run_simulate(args) -> int:
     if args.json:
         _print_json(args, out)
     else:
-        print(f"{law.label()} on a {p.target} target ({setup.case.name}), v = {p.v:g} m/s, "
+        article = "an" if p.target == "infinite" else "a"
+        print(f"{law.label()} on {article} {p.target} target ({setup.case.name}), v = {p.v:g} m/s, "
               f"{law.entry.damping_name} = {out['kappa']:.4g} {law.damping_unit(p.alpha)}")
         print(f"  status: {trajectory.status} ({trajectory.message})")
         units = {"max_force": "N", "max_indentation": "m", "contact_duration": "s", "restitution": "",

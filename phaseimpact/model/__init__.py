@@ -13,7 +13,7 @@ The shipped laws, one with its options, and the coefficient array the engine rea
 >>> law.label(), law.damping_unit(1.5)
 ('hunt-crossley e=0.8', 'N s/m^2.5')
 >>> pack(seed_parameters(v=1.0), law).shape
-(15,)
+(16,)
 """
 
 from .. import _lazy

@@ -130,12 +130,14 @@ GUARD_ENERGY_FACTOR = 100.0
 # law keeps over a run, e.g. Thornton's largest indentation; 0 at the start, updated only by
 # :func:`remember`, in the run's own copy). Every law with memory keeps its residual indentation
 # (its dent, 0 if it leaves none) in the last slot, DENT_: the contact events read it there
-# (:func:`contact_gap`, :func:`dent_depth`).
+# (:func:`contact_gap`, :func:`dent_depth`). IMPEDANCE_, last (so that the slots before it keep their
+# places): the infinite plate's point impedance, N s/m, 0 for every other target.
 M1_, M2_, K_, KB_, KM_, DAMP_, ALPHA_, SPRINGS_, RIGID_, GUARD_ = range(10)
 LAW_, N_LAW = 10, 2
 MEMORY_, N_MEMORY = LAW_ + N_LAW, 3
 DENT_ = MEMORY_ + N_MEMORY - 1
-N_COEF = MEMORY_ + N_MEMORY
+IMPEDANCE_ = MEMORY_ + N_MEMORY
+N_COEF = IMPEDANCE_ + 1
 
 
 def make_code(form: int, flags: int, address: int = 0) -> int:

@@ -279,7 +279,8 @@ def regime_report(params, plate, geometry) -> dict:
     -------
     dict
         ``D_star`` (Olsson's rigidity of the reduced bending stiffness, N m), ``plate_impedance``
-        (N s/m), ``zener_lambda``, ``plate_mass`` (the whole plate, kg), ``mass_ratio``, ``regime``
+        (N s/m: ``params.impedance``, the one the ``infinite`` target integrates with, when given),
+        ``zener_lambda``, ``plate_mass`` (the whole plate, kg), ``mass_ratio``, ``regime``
         (one of :data:`REGIMES`), ``regime_model`` (``"infinite"`` or ``"plate"``) and
         ``regime_warning``: a sentence when ``params.target`` is a model that does not fit the
         regime, else None. A rigid target is not judged by the mass ratio (it is the ``lambda -> 0``
@@ -303,7 +304,9 @@ def regime_report(params, plate, geometry) -> dict:
 
     laminate = as_laminate(plate, geometry.h)
     D_star = olsson_rigidity(laminate.reduced_bending_stiffness())
-    impedance = infinite_plate_impedance(D_star, laminate.areal_density)
+    # the impedance the infinite target integrates with (derive_parameters), where the parameters carry one
+    impedance = params.impedance if params.impedance is not None else infinite_plate_impedance(
+        D_star, laminate.areal_density)
     M_p = plate_mass(laminate.areal_density, geometry.a)
     ratio = mass_ratio(params.M1, M_p)
     regime = impact_regime(ratio)
@@ -315,7 +318,8 @@ def regime_report(params, plate, geometry) -> dict:
                  f"between {SMALL_MASS_RATIO:g} and {LARGE_MASS_RATIO:g}")
         why = ("the plate's flexural waves do not reach its edge during the contact" if model == "infinite"
                else "the plate's edge takes part in the contact")
-        name = {"plate": "the spring-mass plate", "free": "the free plate mass"}.get(params.target, params.target)
+        name = {"plate": "the spring-mass plate", "free": "the free plate mass",
+                "infinite": "the infinite plate"}[params.target]
         warning = (f"the impact is {regime} (M1/M_p = {ratio:.3g} {bound}, Olsson 2000): {why}, so {name} "
                    f"(target {params.target}) is out of its range; the "
                    + ("infinite" if model == "infinite" else "spring-mass") + " plate is the model")

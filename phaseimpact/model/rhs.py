@@ -9,8 +9,20 @@ motion (J)::
     delta = x1 - x2,  deltadot = x1dot - x2dot,  W' = P deltadot
 
 A rigid target is held at ``x2 = 0``. While ``paper`` is stuck the bodies move as one of mass
-``M1 + M2`` and ``P = F_req = M1/(M1+M2) S(x2)``. Coefficients travel packed in one float array
-(:func:`pack`), the layout every compiled function reads.
+``M1 + M2`` and ``P = F_req = M1/(M1+M2) S(x2)``.
+
+The infinite plate (docs/physics.md §8) is a dashpot: its load point moves with ``x2dot = P / c``,
+``c`` the point impedance; its mass and springs take no part. That constraint is implicit in
+``x2dot`` for a law whose force depends on ``deltadot``; differentiated once it becomes the
+explicit equation ``(c + P_d) x2'' = P_delta deltadot + P_d x1''`` (``P_delta``, ``P_d`` the law's
+exact partials), integrated with the others: no solve per evaluation, the same code for every
+law, and the constraint holds to the integration's error (it starts exact: ``P = 0 = x2dot``). ``W``
+is then the work of the contact force on the projectile, ``W' = P x1dot = P deltadot + P x2dot``:
+the contact's own work plus the energy radiated into the plate (``P x2dot = P^2 / c``), so that the
+ledger ``E(0) - E(t) = W - (U(t) - U(0))`` with ``E = M1 x1dot^2 / 2 + U`` closes as for the other
+targets. Stuck (``paper``), the pair moves as one on the dashpot: ``P = c x1dot``,
+``M1 x1'' = -c x1dot``. Coefficients travel packed in one float array (:func:`pack`), the layout
+every compiled function reads.
 """
 
 from __future__ import annotations
@@ -25,6 +37,7 @@ from .laws import (  # noqa: F401 (the packed layout, re-exported: the engine's 
     ALPHA_,
     DAMP_,
     GUARD_,
+    IMPEDANCE_,
     K_,
     KB_,
     KM_,
@@ -75,11 +88,12 @@ def pack(params: Parameters, law: ContactLaw) -> np.ndarray:
     Returns
     -------
     numpy.ndarray
-        Shape ``(N_COEF,)`` = (15,), float: ``M1, M2, K, Kb, Km`` (the springs 0 unless the target
+        Shape ``(N_COEF,)`` = (16,), float: ``M1, M2, K, Kb, Km`` (the springs 0 unless the target
         is a plate), the law's effective damping coefficient (:meth:`ContactLaw.kappa`, N
         s/m^damping_power), ``alpha``, the flags springs and rigid (1.0 or 0.0), the runaway
         guard factor, then the law's own coefficients (from ``LAW_``) and its memory (from
-        ``MEMORY_``, zeros), each padded with zeros.
+        ``MEMORY_``, zeros), each padded with zeros, and last the infinite plate's impedance
+        ``c`` (N s/m; 0 for the other targets).
 
     Raises
     ------
@@ -92,7 +106,7 @@ def pack(params: Parameters, law: ContactLaw) -> np.ndarray:
     >>> from phaseimpact.model import ContactLaw, pack
     >>> c = pack(seed_parameters(v=1.0, kappa=1e9), ContactLaw("hunt-crossley"))
     >>> c.shape
-    (15,)
+    (16,)
     >>> print(f"M1 = {c[0]:.4g} kg, K = {c[2]:.4g} N/m^1.5, kappa = {c[5]:.4g} N s/m^2.5")
     M1 = 0.2631 kg, K = 2.176e+10 N/m^1.5, kappa = 1e+09 N s/m^2.5
     >>> pack(seed_parameters(target="rigid"), ContactLaw("abrate"))[[3, 4, 7, 8]]  # Kb, Km, springs, rigid
@@ -103,7 +117,8 @@ def pack(params: Parameters, law: ContactLaw) -> np.ndarray:
     return np.array([params.M1, params.M2, params.K, params.Kb if springs else 0.0,
                      params.Km if springs else 0.0, law.kappa(params), params.alpha,
                      1.0 if springs else 0.0, 1.0 if params.target == "rigid" else 0.0, law.runaway_factor,
-                     *own, *(0.0,) * (N_LAW - len(own)), *(0.0,) * N_MEMORY])
+                     *own, *(0.0,) * (N_LAW - len(own)), *(0.0,) * N_MEMORY,
+                     params.impedance if params.target == "infinite" else 0.0])
 
 
 @kernel
@@ -119,8 +134,26 @@ def _stick_force_at(c, x2):
 
 @kernel(python=True)
 def stick_force(c, y):
-    """Force that keeps the projectile with the target while stuck, ``F_req``, N."""
+    """Force that keeps the projectile with the target while stuck, ``F_req``, N.
+
+    0 on the infinite plate, where a stick always holds: the pair needs the dashpot's ``c x2dot``,
+    which at the ``deltadot = 0`` that starts the stick is the slip's own force there,
+    ``P(delta, 0+-)`` (the constraint ``c x2dot = P``), at the stick bound, and which then only
+    decreases as the pair slows (``M1 x1'' = -c x1dot``). Compared with the bound, the integrated
+    ``c x2dot`` would refuse half of these sticks on rounding alone (a slip then went on through
+    ``deltadot = 0`` unlogged)."""
+    if c[IMPEDANCE_] > 0:
+        return 0.0
     return _stick_force_at(c, y[X2])
+
+
+@kernel
+def _load_point_rate(code, c, delta, deltadot, accel, mode, odd):
+    """``x2''`` of the infinite plate's load point: ``c x2dot = P(delta, deltadot)`` differentiated,
+    ``(P_delta deltadot + P_d x1'') / (c + P_d)``, with the projectile's ``x1'' = accel``;
+    ``odd`` = -1 continues ``P_delta`` as an odd function past ``w = 0`` (:func:`rhs_values`)."""
+    p_delta, p_rate = partials_of(code, c, delta, deltadot, mode)
+    return (odd * p_delta * deltadot + p_rate * accel) / (c[IMPEDANCE_] + p_rate)
 
 
 #: Phase kinds of the integration (:func:`contact_side`): plain, free flight, or a regularised
@@ -184,24 +217,39 @@ def rhs_values(code, c, u0, x2, v1, v2, mode, side):
         if mode == STUCK:
             if c[RIGID_] > 0:
                 return v1, v2, 0.0, 0.0, 0.0, 1.0, 0.0
+            if c[IMPEDANCE_] > 0:  # the pair on the dashpot: the projectile's energy radiated
+                force = c[IMPEDANCE_] * v1
+                accel = -force / c[M1_]
+                return v1, v2, accel, accel, force * v1, 1.0, force
             accel = -spring_force(c, x2) / (c[M1_] + c[M2_])
             force = _stick_force_at(c, x2)
             return v1, v2, accel, accel, force * deltadot, 1.0, force
         force = force_of(code, c, u0 - x2, deltadot, mode)
-        target = 0.0 if c[RIGID_] > 0 else (force - spring_force(c, x2)) / c[M2_]
+        if c[IMPEDANCE_] > 0:
+            target = _load_point_rate(code, c, u0 - x2, deltadot, -force / c[M1_], mode, 1.0)
+            work = force * (deltadot + v2)
+        else:
+            target = 0.0 if c[RIGID_] > 0 else (force - spring_force(c, x2)) / c[M2_]
+            work = force * deltadot
         if relative:
-            return deltadot + v2, v2, -force / c[M1_] - target, target, force * deltadot, 1.0, force
-        return v1, v2, -force / c[M1_], target, force * deltadot, 1.0, force
+            return deltadot + v2, v2, -force / c[M1_] - target, target, work, 1.0, force
+        return v1, v2, -force / c[M1_], target, work, 1.0, force
     if side == FLIGHT:
         return v1, v2, 0.0, 0.0 if c[RIGID_] > 0 else -spring_force(c, x2) / c[M2_], 0.0, 1.0, 0.0
     w = u0
-    force = force_of(code, c, side * w * w, deltadot, mode)
+    delta = side * w * w
+    force = force_of(code, c, delta, deltadot, mode)
     if w < 0:
         force = -force
-    target = 0.0 if c[RIGID_] > 0 else w * (force - spring_force(c, x2)) / c[M2_]
+    if c[IMPEDANCE_] > 0:
+        target = w * _load_point_rate(code, c, delta, deltadot, -force / c[M1_], mode, -1.0 if w < 0 else 1.0)
+        work = w * force * (deltadot + v2)
+    else:
+        target = 0.0 if c[RIGID_] > 0 else w * (force - spring_force(c, x2)) / c[M2_]
+        work = w * force * deltadot
     projectile = -w * force / c[M1_]
     return (0.5 * side * deltadot, w * v2, projectile - target if relative else projectile, target,
-            w * force * deltadot, w, force)
+            work, w, force)
 
 
 @kernel(python=True)
@@ -239,17 +287,20 @@ def damping_rate(code, c, u, mode, side):
     delta = side * u[0] * u[0] if regularised else u[X1] - u[X2]
     deltadot = u[V1] if relative_slip(code, mode, side) else u[V1] - u[V2]
     partial = partials_of(code, c, delta, deltadot, mode)[1]
-    rate = partial * (1.0 / c[M1_] + (0.0 if c[RIGID_] > 0 else 1.0 / c[M2_]))
+    # the infinite plate's load point follows the contact (x2dot = P / c): the projectile's rate
+    rate = partial * (1.0 / c[M1_] + (0.0 if c[RIGID_] > 0 or c[IMPEDANCE_] > 0 else 1.0 / c[M2_]))
     return rate * abs(u[0]) if regularised else rate
 
 
 @kernel(python=True)
 def energy(code, c, y):
     """Mechanical energy (docs/physics.md §4), J: kinetic + target springs + the contact potential
-    of laws whose elastic term is conservative."""
+    of laws whose elastic term is conservative. The infinite plate's load point has no mass: what
+    the plate takes is radiated, and counted in ``W`` (module docstring)."""
     x2 = y[X2]
     x2sq = x2 * x2
-    kinetic = 0.5 * c[M1_] * y[V1] * y[V1] + 0.5 * c[M2_] * y[V2] * y[V2]
+    target_mass = 0.0 if c[IMPEDANCE_] > 0 else c[M2_]
+    kinetic = 0.5 * c[M1_] * y[V1] * y[V1] + 0.5 * target_mass * y[V2] * y[V2]
     springs = (0.5 * c[KB_] + 0.25 * c[KM_] * x2sq) * x2sq
     return kinetic + springs + potential_of(code, c, y[X1] - x2)
 
@@ -400,6 +451,11 @@ def jacobian(y, params: Parameters, law, mode: int = 1) -> np.ndarray:
         Shape (4, 4): ``J[i, j] = d(dy_i/dt)/dy_j`` with ``y = (x1, x2, x1dot, x2dot)`` (rows 2
         and 3 in 1/s^2 and 1/s); the target's row is zero on a rigid target.
 
+    Raises
+    ------
+    ValueError
+        For the ``infinite`` target, whose load-point equation would need the law's second partials.
+
     Examples
     --------
     >>> from phaseimpact import seed_parameters
@@ -413,6 +469,9 @@ def jacobian(y, params: Parameters, law, mode: int = 1) -> np.ndarray:
     >>> J[3].tolist()  # a rigid target does not move
     [0.0, 0.0, 0.0, 0.0]
     """
+    if params.target == "infinite":
+        raise ValueError("target = 'infinite' has no Jacobian here; allowed: plate, rigid, free (the infinite "
+                         "plate's load-point equation needs the law's second partials)")
     law = as_law(law)
     c = pack(params, law)
     y = np.asarray(y, dtype=float)
