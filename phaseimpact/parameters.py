@@ -480,6 +480,7 @@ def derive_parameters(
     if isinstance(plate, Material):
         E, nu = plate.E, plate.nu
         areal_density = plate.rho * g.h
+        M2 = 0.25 * plate.rho * math.pi * g.a**2 * g.h  # a quarter of the plate (this order: bit for bit)
         plate_compliance = (1 - nu**2) / E  # eq. 4
         Kb = 4.0 * math.pi * E * g.h**3 / (3.0 * (1 - nu**2) * g.a**2)  # eq. 5a with h^3
         km_denominator = (1 - nu**2) if membrane == "printed" else (1 - nu)
@@ -493,6 +494,7 @@ def derive_parameters(
         require("h", g.h, f"the plies' total thickness {plate.thickness!r} m (h of a laminate is the sum of its "
                 "plies)", math.isclose(g.h, plate.thickness, rel_tol=1e-12))
         areal_density = plate.areal_density
+        M2 = 0.25 * math.pi * g.a**2 * areal_density  # a quarter of the plate takes part
         plate_compliance = lam.top_ply_compliance(plate)
         Kb = lam.bending_stiffness(plate, g.a)
         Km = lam.membrane_stiffness(plate, g.a, membrane)
@@ -500,7 +502,6 @@ def derive_parameters(
 
         rigidity = olsson_rigidity(plate.reduced_bending_stiffness())
     M1 = projectile.rho * 4.0 / 3.0 * math.pi * g.R1**3
-    M2 = 0.25 * math.pi * g.a**2 * areal_density  # a quarter of the plate takes part
     eta = (1 - projectile.nu**2) / projectile.E + plate_compliance  # eq. 4
     R = g.effective_radius
     K = 4.0 * math.sqrt(R) / (3.0 * eta)  # eq. 3 with eta restored
