@@ -486,21 +486,13 @@ def derive_parameters(
         km_denominator = (1 - nu**2) if membrane == "printed" else (1 - nu)
         Km = (353 - 191 * nu) * math.pi * E * g.h / (648 * km_denominator * g.a**2)  # eq. 5b
         rigidity = E * g.h**3 / (12 * (1 - nu**2))
-    else:  # a laminate (docs/physics.md §8); imported late: model.laminate builds on this module
-        from .model import laminate as lam
-
-        if not isinstance(plate, lam.Laminate):
+    else:  # a laminate (model.laminate.Laminate, docs/physics.md §8): it gives its own plate terms
+        if not hasattr(plate, "plate_terms"):
             raise TypeError(f"plate has the wrong type ({type(plate).__name__}); allowed: Material or Laminate")
         require("h", g.h, f"the plies' total thickness {plate.thickness!r} m (h of a laminate is the sum of its "
                 "plies)", math.isclose(g.h, plate.thickness, rel_tol=1e-12))
-        areal_density = plate.areal_density
+        areal_density, plate_compliance, Kb, Km, rigidity = plate.plate_terms(g.a, membrane)
         M2 = 0.25 * math.pi * g.a**2 * areal_density  # a quarter of the plate takes part
-        plate_compliance = lam.top_ply_compliance(plate)
-        Kb = lam.bending_stiffness(plate, g.a)
-        Km = lam.membrane_stiffness(plate, g.a, membrane)
-        from .model.regime import olsson_rigidity
-
-        rigidity = olsson_rigidity(plate.reduced_bending_stiffness())
     M1 = projectile.rho * 4.0 / 3.0 * math.pi * g.R1**3
     eta = (1 - projectile.nu**2) / projectile.E + plate_compliance  # eq. 4
     R = g.effective_radius
@@ -518,12 +510,10 @@ def _bending_shear(laminate, a: float, R: float, K: float, reduced_mass: float, 
     """Abrate's ``Kbs`` (docs/physics.md §8): the shear stiffness's load spread over the Hertz contact
     radius ``c = sqrt(R delta)`` at the undamped impact's largest indentation ``delta`` (eq. 3, the
     plate target's reduced mass), so that ``Kb`` then depends on the impact speed."""
-    from .model import laminate as lam
-
     c = math.sqrt(R * (5.0 * reduced_mass * v**2 / (4.0 * K)) ** 0.4)
     require("contact radius", c, f"c < a = {a:g} m (the shear stiffness of plies with G13, G23 spreads the load "
             "over the Hertz contact radius at the peak; give no G13, G23 for bending alone)", c < a)
-    return lam.bending_shear_stiffness(lam.bending_stiffness(laminate, a), lam.shear_stiffness(laminate, a, c))
+    return laminate.bending_shear(a, c)
 
 
 def _replace_material(material, prefix: str, changes: Mapping):

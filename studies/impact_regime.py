@@ -32,7 +32,7 @@ from _plots import V_LABEL, claim, known, log_ticks
 
 from phaseimpact.archive import save_h5
 from phaseimpact.case import load_case
-from phaseimpact.model.laminate import as_laminate
+from phaseimpact.model.laminate import as_laminate, olsson_rigidity
 from phaseimpact.model.regime import (
     LARGE_MASS_RATIO,
     REGIMES,
@@ -41,7 +41,6 @@ from phaseimpact.model.regime import (
     infinite_plate_impedance,
     mass_ratio,
     model_for_regime,
-    olsson_rigidity,
     plate_mass,
     regime_report,
     zener_lambda,

@@ -41,7 +41,8 @@ from ..parameters import (
 )
 
 __all__ = [
-    "Ply", "Laminate", "validate_ply", "transformed_stiffness", "lekhnitskii_rigidity", "isotropic_part",
+    "Ply", "Laminate", "validate_ply", "transformed_stiffness", "lekhnitskii_rigidity", "olsson_rigidity",
+    "isotropic_part",
     "bending_stiffness", "membrane_stiffness", "shear_stiffness", "bending_shear_stiffness",
     "yang_sun_compliance", "transversely_isotropic_compliance", "top_ply_compliance", "as_laminate",
     "MEMBRANE_FORMULAS", "SHEAR_FACTOR",
@@ -406,6 +407,99 @@ class Laminate:
                 [[ply.G23 * c * c + ply.G13 * s * s, (ply.G13 - ply.G23) * c * s],
                  [(ply.G13 - ply.G23) * c * s, ply.G13 * c * c + ply.G23 * s * s]])
         return S
+
+    def plate_terms(self, a: float, membrane: str = "printed") -> tuple[float, float, float, float, float]:
+        """What :func:`phaseimpact.parameters.derive_parameters` reads of this laminate as a clamped
+        circular plate (docs/physics.md §8). The parameters layer sits below the physics: it asks the
+        plate for these, never imports this module.
+
+        Parameters
+        ----------
+        a : float
+            Plate radius, m.
+        membrane : str
+            Eq. 5b's form, ``"printed"`` or ``"shivakumar"`` (:func:`membrane_stiffness`).
+
+        Returns
+        -------
+        tuple of float
+            Areal density (kg/m^2), the top ply's half-space compliance (1/Pa,
+            :func:`top_ply_compliance`), ``Kb`` (N/m, :func:`bending_stiffness`), ``Km`` (N/m^3,
+            :func:`membrane_stiffness`) and Olsson's effective rigidity ``D*`` (N m,
+            :func:`olsson_rigidity`).
+
+        Examples
+        --------
+        >>> from phaseimpact.model.laminate import Laminate, Ply
+        >>> lam = Laminate((Ply.isotropic(2.1e11, 0.3, 7850.0, 0.005),))
+        >>> print(", ".join(f"{x:.6g}" for x in lam.plate_terms(0.1)))  # steel: eq. 5a, 5b
+        39.25, 4.33333e-12, 1.2083e+07, 1.65415e+11, 2403.85
+        """
+        return (self.areal_density, top_ply_compliance(self), bending_stiffness(self, a),
+                membrane_stiffness(self, a, membrane), olsson_rigidity(self.reduced_bending_stiffness()))
+
+    def bending_shear(self, a: float, load_radius: float) -> float:
+        """Abrate's combined bending-shear stiffness ``Kbs`` of this laminate as a clamped circular
+        plate: :func:`bending_shear_stiffness` of :func:`bending_stiffness` and :func:`shear_stiffness`.
+
+        Parameters
+        ----------
+        a : float
+            Plate radius, m.
+        load_radius : float
+            Radius of the loaded disc (the contact radius), m.
+
+        Returns
+        -------
+        float
+            ``Kbs``, N/m.
+
+        Examples
+        --------
+        >>> from phaseimpact.model.laminate import Laminate, Ply
+        >>> lam = Laminate((Ply.isotropic(2.1e11, 0.3, 7850.0, 0.005, shear=True),))
+        >>> print(f"{lam.bending_shear(0.1, 1e-4):.6g}")
+        1.15923e+07
+        """
+        return bending_shear_stiffness(bending_stiffness(self, a), shear_stiffness(self, a, load_radius))
+
+
+def olsson_rigidity(D) -> float:
+    """Olsson's effective rigidity of an orthotropic plate, ``D* = sqrt(D11 D22 (A + 1) / 2)``.
+
+    ``A = (D12 + 2 D66) / sqrt(D11 D22)`` (Olsson, 1992, AIAA J. 30:1587, and his small-mass
+    papers). ``D`` itself for an isotropic plate (``A = 1``); ``D16``, ``D26`` do not enter.
+
+    Parameters
+    ----------
+    D : array_like
+        Bending stiffness, shape (3, 3), N m.
+
+    Returns
+    -------
+    float
+        ``D*``, N m.
+
+    Raises
+    ------
+    ValueError
+        When ``D11``, ``D22`` or ``A + 1`` is not positive.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from phaseimpact.model.laminate import olsson_rigidity
+    >>> olsson_rigidity(np.array([[9.0, 1.0, 0.0], [1.0, 4.0, 0.0], [0.0, 0.0, 2.5]]))  # A = 1
+    6.0
+    """
+    D = np.asarray(D, dtype=float)
+    D11, D22 = float(D[0, 0]), float(D[1, 1])
+    for name, value in (("D11", D11), ("D22", D22)):
+        require(name, value, "a finite number > 0 (N m)", math.isfinite(value) and value > 0)
+    A = (D[0, 1] + 2 * D[2, 2]) / math.sqrt(D11 * D22)
+    require("A", float(A), "A = (D12 + 2 D66) / sqrt(D11 D22) > -1", A > -1)
+    return math.sqrt(D11 * D22 * (A + 1) / 2)
+
 
 
 def lekhnitskii_rigidity(D) -> float:

@@ -14,12 +14,11 @@ from __future__ import annotations
 
 import math
 
-import numpy as np
-
 from ..parameters import LENGTH_RANGE, is_number, require, require_in
+from .laminate import olsson_rigidity
 
 __all__ = [
-    "olsson_rigidity", "infinite_plate_impedance", "zener_lambda", "plate_mass", "mass_ratio", "impact_regime",
+    "infinite_plate_impedance", "zener_lambda", "plate_mass", "mass_ratio", "impact_regime",
     "model_for_regime", "regime_report", "REGIMES", "SMALL_MASS_RATIO", "LARGE_MASS_RATIO",
 ]
 
@@ -36,43 +35,6 @@ _MODELS = {"wave-controlled": "infinite", "boundary-controlled": "plate", "quasi
 
 def _positive(name: str, value, unit: str) -> None:
     require(name, value, f"a finite number > 0 ({unit})", is_number(value) and math.isfinite(value) and value > 0)
-
-
-def olsson_rigidity(D) -> float:
-    """Olsson's effective rigidity of an orthotropic plate, ``D* = sqrt(D11 D22 (A + 1) / 2)``.
-
-    ``A = (D12 + 2 D66) / sqrt(D11 D22)`` (Olsson, 1992, AIAA J. 30:1587, and his small-mass
-    papers). ``D`` itself for an isotropic plate (``A = 1``); ``D16``, ``D26`` do not enter.
-
-    Parameters
-    ----------
-    D : array_like
-        Bending stiffness, shape (3, 3), N m.
-
-    Returns
-    -------
-    float
-        ``D*``, N m.
-
-    Raises
-    ------
-    ValueError
-        When ``D11``, ``D22`` or ``A + 1`` is not positive.
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> from phaseimpact.model.regime import olsson_rigidity
-    >>> olsson_rigidity(np.array([[9.0, 1.0, 0.0], [1.0, 4.0, 0.0], [0.0, 0.0, 2.5]]))  # A = 1
-    6.0
-    """
-    D = np.asarray(D, dtype=float)
-    D11, D22 = float(D[0, 0]), float(D[1, 1])
-    _positive("D11", D11, "N m")
-    _positive("D22", D22, "N m")
-    A = (D[0, 1] + 2 * D[2, 2]) / math.sqrt(D11 * D22)
-    require("A", float(A), "A = (D12 + 2 D66) / sqrt(D11 D22) > -1", A > -1)
-    return math.sqrt(D11 * D22 * (A + 1) / 2)
 
 
 def infinite_plate_impedance(rigidity: float, areal_density: float) -> float:
