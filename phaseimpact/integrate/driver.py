@@ -1093,3 +1093,11 @@ def run_block(code, batch, options, start, stop, step, outputs):
             for j in range(i + step, stop, step):
                 summary[j, S_STATUS] = INTERRUPTED
             break
+
+
+@kernel(python=True, nogil=True)
+def run_held(code, ws, batch, options, i):
+    """:func:`run_point` in a workspace the caller holds, for callers that run points one at a time
+    (critical searches, the impact map: :func:`.api.summary_run`); the results stay in ``ws`` (its
+    summary, stick points and final state ``Y_STATE``). Allocates nothing."""
+    run_point(code, ws, batch, options, i)
