@@ -8,7 +8,6 @@ import json
 import os
 import subprocess
 import sys
-import threading
 
 import numpy as np
 
@@ -111,27 +110,18 @@ def test_critical_search_and_impact_map_points_allocate_nothing_per_point():
     assert counts["one"] < 10
 
 
-def test_summary_run_gives_simulate_numbers_and_overflows_to_the_full_path(monkeypatch):
-    """summary_run (the held workspace, no event log) gives simulate's summary, final state and
-    stick points bit for bit: a run with four stick phases (also beyond a capacity of 1: run again
-    on the full path for all of them) and a run stopped at its first stick."""
-    p = seed_parameters(v=7.0, kappa=4.16865e11)
-    alone = simulate(p, "paper")
-    t, delta, dwell = alone.stick_points()
-    for capacity in (api.HELD_STICKS, 1):
-        monkeypatch.setattr(api, "HELD_STICKS", capacity)
-        monkeypatch.setattr(api, "_held", threading.local())  # a workspace of that capacity
-        columns, final = api.summary_run(p, "paper")
-        assert columns.stick_count[0] == len(t) == 4
-        np.testing.assert_array_equal(columns.stick_t, t)
-        np.testing.assert_array_equal(columns.stick_delta, delta)
-        np.testing.assert_array_equal(columns.stick_dwell, dwell)
+def test_summary_run_gives_simulate_numbers():
+    """summary_run (the held workspace, no event log, no stick points kept) gives simulate's
+    summary vector and final state bit for bit: a run with four stick phases, a run stopped at its
+    first stick, a run of a unilateral law from a given state stopped at a reversal."""
+    cases = [(seed_parameters(v=7.0, kappa=4.16865e11), "paper", None, {}),
+             (seed_parameters(v=1.0, kappa=1.5e12), "paper", None, {"stop_on": "stick"}),
+             (seed_parameters(v=1.0, kappa=1e9), "hunt-crossley", 1e-2,
+              {"stop_on": ("reversal", 2), "stop_when_settled": False, "initial": (1e-6, 1e-6, 1.0, 0.01)})]
+    for params, law, t_end, options in cases:
+        alone = simulate(params, law, t_end, **options)
+        summary, final = api.summary_run(params, law, t_end, **options)
+        np.testing.assert_array_equal(summary, alone.summary)
         np.testing.assert_array_equal(final, alone.final_state)
-        np.testing.assert_array_equal(columns.max_force, [alone.max_force])
-        np.testing.assert_array_equal(columns.t_stop, [alone.t_stop])
-    case = p.replace(v=1.0, kappa=1.5e12)
-    first = simulate(case, "paper", stop_on="stick")
-    columns, final = api.summary_run(case, "paper", stop_on="stick")
-    np.testing.assert_array_equal(final, first.final_state)
-    assert columns.first_stick_margin[0] == first.first_stick_margin
-    assert columns.stop_reason[0] == api.d.ASKED_STOP
+    assert alone.stop_reason == "asked" and summary[api.d.S_REASON] == api.d.ASKED_STOP
+    assert api.summary_run(cases[0][0], "paper")[0][api.d.S_N_STICK] == 4

@@ -129,8 +129,8 @@ def refine_boundaries(result: SweepResult, axis: str = "kappa", *, refine_rtol: 
         params = grid.parameters_at(point)
         if law.is_filippov and stuck in pair:
             return stuck if first_stick_margin(params, law, rtol=rtol) >= 0 else -2
-        run = summary_run(params, law, result.t_end, rtol=rtol)[0]
-        return drv.FAILED if run.failed[0] else int(run.outcome[0])
+        summary = summary_run(params, law, result.t_end, rtol=rtol)[0]
+        return int(summary[drv.S_OUTCOME]) if summary[drv.S_STATUS] == drv.SUCCESS else drv.FAILED
 
     points, below, above = [], [], []
     moved = np.moveaxis(outcome, k, -1)

@@ -14,7 +14,7 @@ import numpy as np
 
 from ..integrate import scales, simulate
 from ..integrate.api import check_rtol, summary_run
-from ..integrate.driver import ASKED_STOP
+from ..integrate.driver import ASKED_STOP, S_N_CONTACTS, S_REASON
 from ..integrate.events import EVENT_KINDS
 from ..model.laws import ContactLaw, as_law
 from ..parameters import Parameters
@@ -152,9 +152,9 @@ def delta_extremum(params: Parameters, law: ContactLaw | str, j: int, *, rtol: f
     """
     # no stop when out of reach: the extrema go on (below zero), so each stays defined across
     # the kappa where the projectile stops getting out of reach
-    run, y = checked_summary(params, law, _extrema_horizon(params), rtol=rtol, stop_on=("reversal", j),
-                             stop_when_settled=False)
-    if run.stop_reason[0] != ASKED_STOP:
+    summary, y = checked_summary(params, law, _extrema_horizon(params), rtol=rtol, stop_on=("reversal", j),
+                                 stop_when_settled=False)
+    if summary[S_REASON] != ASKED_STOP:
         return -math.inf
     return float(y[0] - y[1])
 
@@ -215,7 +215,7 @@ def extrema(params: Parameters, law: ContactLaw | str, *, rtol: float = 1e-10) -
 
 
 def contact_count(params: Parameters, law: ContactLaw | str, *, rtol: float = 1e-10) -> int:
-    return int(summary_run(params, law, None, rtol=rtol)[0].n_contacts[0])
+    return int(summary_run(params, law, None, rtol=rtol)[0][S_N_CONTACTS])
 
 
 @renamed_tolerances("kappa_rtol")

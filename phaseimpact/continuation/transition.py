@@ -24,6 +24,7 @@ from dataclasses import asdict, dataclass, field
 import numpy as np
 
 from ..integrate.api import check_rtol
+from ..integrate.driver import S_FIRST_STICK_MARGIN
 from ..model.laws import REGISTRY, ContactLaw, as_law
 from ..parameters import KAPPA_MAX, Parameters
 from ._kappa_search import (
@@ -147,7 +148,7 @@ def first_stick_margin(params: Parameters, law: ContactLaw | str = "paper", *, r
     >>> print(f"{first_stick_margin(p.replace(kappa=1e12)):.4f} {first_stick_margin(p.replace(kappa=2e12)):.4f}")
     0.2046 -0.1795
     """
-    margin = checked_summary(params, law, None, rtol=rtol, stop_on="stick")[0].first_stick_margin[0]
+    margin = checked_summary(params, law, None, rtol=rtol, stop_on="stick")[0][S_FIRST_STICK_MARGIN]
     return -math.inf if math.isnan(margin) else float(margin)
 
 
