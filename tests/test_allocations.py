@@ -69,3 +69,59 @@ def test_a_run_that_overflows_its_stick_rows_gives_the_full_path_result():
         np.testing.assert_array_equal(columns.stick_dwell, dwell)
         np.testing.assert_array_equal(columns.max_force, [alone.max_force])
         np.testing.assert_array_equal(columns.t_stop, [alone.t_stop])
+
+
+SEARCH = r"""
+import json
+import numpy as np
+from numba.core.runtime import rtsys
+from phaseimpact import seed_parameters
+from phaseimpact.continuation import delta_extremum, first_stick_margin
+from phaseimpact.maps.impact import ModelImpactMap
+
+p = seed_parameters(v=1.0)
+hc = seed_parameters(v=1.0, kappa=1e9)
+imap = ModelImpactMap(seed_parameters(kappa=3e9), "hunt-crossley", 3e-3)
+
+def allocations(n):
+    before = rtsys.get_allocation_stats().alloc
+    margins = [first_stick_margin(p.replace(kappa=k)) for k in np.geomspace(1e12, 2e12, n)]
+    extrema = [delta_extremum(hc.replace(kappa=k), "hunt-crossley", 1) for k in np.geomspace(1e8, 1e10, n)]
+    states = [imap((x2, 0.0)) for x2 in np.linspace(0.0, 1e-6, n)]
+    assert all(np.isfinite(margins)) and all(np.isfinite(extrema)) and all(np.isfinite(states).ravel())
+    return rtsys.get_allocation_stats().alloc - before
+
+first_stick_margin(p.replace(kappa=1e12))  # the engine loaded (or compiled) and this thread's workspace made
+allocations(1)
+print(json.dumps({"one": allocations(1), "many": allocations(40)}))
+"""
+
+
+def test_critical_search_and_impact_map_points_allocate_nothing_per_point():
+    """The points of a kappa_c search (the first stick's margin), of a grazing search (an extremum
+    of delta) and impact-map steps run in this thread's held workspace (api.summary_run): 40
+    points of each make as many numba allocations as one (none per point; the full path with its
+    event log made ~21 per run)."""
+    env = dict(os.environ, NUMBA_NRT_STATS="1")
+    out = subprocess.run([sys.executable, "-c", SEARCH], env=env, capture_output=True, text=True, timeout=900)
+    assert out.returncode == 0, out.stderr[-3000:]
+    counts = json.loads(out.stdout.strip().splitlines()[-1])
+    assert counts["many"] == counts["one"]
+    assert counts["one"] < 10
+
+
+def test_summary_run_gives_simulate_numbers():
+    """summary_run (the held workspace, no event log, no stick points kept) gives simulate's
+    summary vector and final state bit for bit: a run with four stick phases, a run stopped at its
+    first stick, a run of a unilateral law from a given state stopped at a reversal."""
+    cases = [(seed_parameters(v=7.0, kappa=4.16865e11), "paper", None, {}),
+             (seed_parameters(v=1.0, kappa=1.5e12), "paper", None, {"stop_on": "stick"}),
+             (seed_parameters(v=1.0, kappa=1e9), "hunt-crossley", 1e-2,
+              {"stop_on": ("reversal", 2), "stop_when_settled": False, "initial": (1e-6, 1e-6, 1.0, 0.01)})]
+    for params, law, t_end, options in cases:
+        alone = simulate(params, law, t_end, **options)
+        summary, final = api.summary_run(params, law, t_end, **options)
+        np.testing.assert_array_equal(summary, alone.summary)
+        np.testing.assert_array_equal(final, alone.final_state)
+    assert alone.stop_reason == "asked" and summary[api.d.S_REASON] == api.d.ASKED_STOP
+    assert api.summary_run(cases[0][0], "paper")[0][api.d.S_N_STICK] == 4

@@ -635,6 +635,7 @@ def test_train_family_inputs_named_before_any_work(args, message, tmp_path, monk
         raise AssertionError("work started before the input was refused")
 
     monkeypatch.setattr(impact_module, "simulate", forbidden)
+    monkeypatch.setattr(impact_module, "summary_run", forbidden)
     monkeypatch.chdir(tmp_path)
     code, out, err = run(args)
     lines = err.strip().splitlines()

@@ -303,11 +303,11 @@ def test_a_step_to_a_root_that_cannot_converge_is_a_failure_not_a_state():
     stiff = radau5.workspace(np.int64(5))
     radau5.enter(law.code, c, 1, 1, u, fu, 1e-10, atol, stiff)
     good, f_good = np.empty(6), np.empty(6)
-    radau5.fixed_step(law.code, c, 1, 1, 0.0, u, fu, 1e-4, stiff, good, f_good)
+    radau5.fixed_step(law.code, c, 1, 1, 0.0, 1e-4, stiff, (u, fu, good, f_good))
     assert not radau5.failed(stiff) and np.all(np.isfinite(good)) and good[5] > 0
     broken = u.copy()
     broken[2] = np.nan
-    radau5.fixed_step(law.code, c, 1, 1, 0.0, broken, fu, 1e-4, stiff, good, f_good)
+    radau5.fixed_step(law.code, c, 1, 1, 0.0, 1e-4, stiff, (broken, fu, good, f_good))
     assert radau5.failed(stiff)
 
 

@@ -91,7 +91,7 @@ def test_radau_iia_is_of_order_5():
         radau5.enter(code, c, mode, side, u, fu, rtol, atol, stiff)
         h = T / n
         for i in range(n):
-            radau5.fixed_step(code, c, mode, side, i * h, u, fu, h, stiff, u_new, fu_new)
+            radau5.fixed_step(code, c, mode, side, i * h, h, stiff, (u, fu, u_new, fu_new))
             u, fu = u_new.copy(), fu_new.copy()
         assert not radau5.failed(stiff)
         steps.append(h)

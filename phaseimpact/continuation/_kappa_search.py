@@ -8,6 +8,9 @@ from __future__ import annotations
 import math
 from dataclasses import asdict, dataclass
 
+from ..integrate import simulate
+from ..integrate.api import summary_run
+from ..integrate.driver import S_STATUS, SUCCESS
 from ..parameters import KAPPA_MAX, Parameters, is_number
 
 # check_params, check_rtol_of_kappa and default_kappa_range serve the searches and the command line,
@@ -37,6 +40,18 @@ class RunFailed(RuntimeError):
     ...     print(type(error).__name__, error)
     RunFailed kappa = 1e+12: step-size-collapse: ...
     """
+
+
+def checked_summary(params: Parameters, law, t_end, **options):
+    """A search's run on the per-point path (:func:`~phaseimpact.integrate.api.summary_run`: its
+    summary vector and final state), or :class:`RunFailed` naming its ``kappa``, status and
+    message: a search must not read a failed run. The message of that (rare) failure comes from
+    the same run with its event log, which names a user law's fault."""
+    run = summary_run(params, law, t_end, **options)
+    if run[0][S_STATUS] != SUCCESS:
+        trajectory = simulate(params, law, t_end, **options)
+        raise RunFailed(f"kappa = {params.kappa:.6g}: {trajectory.status}: {trajectory.message}")
+    return run
 
 
 def check_params(params) -> Parameters:

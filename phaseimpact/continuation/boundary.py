@@ -16,8 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..integrate import driver as drv
-from ..integrate import simulate
-from ..integrate.api import check_rtol
+from ..integrate.api import check_rtol, summary_run
 from ._renamed import renamed_tolerances
 from .sweep import SweepResult
 from .transition import first_stick_margin
@@ -130,8 +129,8 @@ def refine_boundaries(result: SweepResult, axis: str = "kappa", *, refine_rtol: 
         params = grid.parameters_at(point)
         if law.is_filippov and stuck in pair:
             return stuck if first_stick_margin(params, law, rtol=rtol) >= 0 else -2
-        tr = simulate(params, law, result.t_end, rtol=rtol)
-        return drv.OUTCOMES.index(tr.outcome) if tr.ok else drv.FAILED
+        summary = summary_run(params, law, result.t_end, rtol=rtol)[0]
+        return int(summary[drv.S_OUTCOME]) if summary[drv.S_STATUS] == drv.SUCCESS else drv.FAILED
 
     points, below, above = [], [], []
     moved = np.moveaxis(outcome, k, -1)

@@ -13,11 +13,12 @@ import warnings
 import numpy as np
 
 from ..integrate import scales, simulate
-from ..integrate.api import check_rtol
+from ..integrate.api import check_rtol, summary_run
+from ..integrate.driver import ASKED_STOP, S_N_CONTACTS, S_REASON
 from ..integrate.events import EVENT_KINDS
 from ..model.laws import ContactLaw, as_law
 from ..parameters import Parameters
-from ._kappa_search import RunFailed, Transition, check_kappa_range, check_params, check_rtol_of_kappa
+from ._kappa_search import RunFailed, Transition, check_kappa_range, check_params, check_rtol_of_kappa, checked_summary
 from ._renamed import renamed_tolerances
 
 __all__ = ["SamplingWarning", "SAMPLES_RANGE", "check_samples", "delta_extremum", "extrema", "grazing_transitions"]
@@ -151,12 +152,10 @@ def delta_extremum(params: Parameters, law: ContactLaw | str, j: int, *, rtol: f
     """
     # no stop when out of reach: the extrema go on (below zero), so each stays defined across
     # the kappa where the projectile stops getting out of reach
-    trajectory = simulate(params, law, _extrema_horizon(params), rtol=rtol, stop_on=("reversal", j),
-                          stop_when_settled=False)
-    _check_ok(trajectory)
-    if trajectory.stop_reason != "asked":
+    summary, y = checked_summary(params, law, _extrema_horizon(params), rtol=rtol, stop_on=("reversal", j),
+                                 stop_when_settled=False)
+    if summary[S_REASON] != ASKED_STOP:
         return -math.inf
-    y = trajectory.final_state
     return float(y[0] - y[1])
 
 
@@ -216,7 +215,7 @@ def extrema(params: Parameters, law: ContactLaw | str, *, rtol: float = 1e-10) -
 
 
 def contact_count(params: Parameters, law: ContactLaw | str, *, rtol: float = 1e-10) -> int:
-    return simulate(params, law, None, rtol=rtol).n_contacts
+    return int(summary_run(params, law, None, rtol=rtol)[0][S_N_CONTACTS])
 
 
 @renamed_tolerances("kappa_rtol")

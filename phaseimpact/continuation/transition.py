@@ -23,8 +23,8 @@ from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
-from ..integrate import simulate
 from ..integrate.api import check_rtol
+from ..integrate.driver import S_FIRST_STICK_MARGIN
 from ..model.laws import REGISTRY, ContactLaw, as_law
 from ..parameters import KAPPA_MAX, Parameters
 from ._kappa_search import (
@@ -34,6 +34,7 @@ from ._kappa_search import (
     check_kappa_range,
     check_params,
     check_rtol_of_kappa,
+    checked_summary,
     default_kappa_range,
 )
 from ._renamed import renamed_tolerances
@@ -147,11 +148,8 @@ def first_stick_margin(params: Parameters, law: ContactLaw | str = "paper", *, r
     >>> print(f"{first_stick_margin(p.replace(kappa=1e12)):.4f} {first_stick_margin(p.replace(kappa=2e12)):.4f}")
     0.2046 -0.1795
     """
-    trajectory = simulate(params, law, None, rtol=rtol, stop_on="stick")
-    if not trajectory.ok:
-        raise RunFailed(f"kappa = {params.kappa:.6g}: {trajectory.status}: {trajectory.message}")
-    margin = trajectory.first_stick_margin
-    return -math.inf if margin is None else margin
+    margin = checked_summary(params, law, None, rtol=rtol, stop_on="stick")[0][S_FIRST_STICK_MARGIN]
+    return -math.inf if math.isnan(margin) else float(margin)
 
 
 @dataclass(frozen=True)

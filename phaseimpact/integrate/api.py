@@ -7,6 +7,7 @@ from __future__ import annotations
 import functools
 import math
 import numbers
+import threading
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 
@@ -19,6 +20,7 @@ from ..parameters import Parameters, is_number
 from . import driver as d
 from . import radau5
 from .events import EVENT_KINDS
+from .record import W_SUMMARY, W_Y, Y_STATE, workspace
 from .result import Columns, Trajectory
 from .rk4 import run_rk4
 
@@ -535,6 +537,50 @@ def _run_one(batch: Batch, i: int, rtol, settle, stop_kind, stop_count, stiff_af
         if not (woken or _signals.deferred):
             return out
         _signals.check(woken)
+
+
+_held = threading.local()  # each thread's workspace for summary_run: made once, reused run after run
+
+
+def summary_run(params: Parameters, law: ContactLaw | str = "paper", t_end: float | None = None, *,
+                rtol: float = 1e-10, stop_when_settled: bool = True, stop_on=None,
+                initial=None) -> tuple[np.ndarray, np.ndarray]:
+    """One run's summary and final state on the per-point path (:func:`.driver.run_point`, no
+    event log), for callers that run points one at a time and read only summaries (critical
+    searches, the impact map). The run goes in this thread's workspace, made at its first call:
+    nothing compiled allocates per run. Arguments as for :func:`simulate`; the numbers are
+    :func:`simulate`'s (the same inputs and kernels).
+
+    Returns ``(summary, final_state)``: the driver's summary vector (``driver.S_*``, the status
+    ``non-finite`` when a user law failed the run, as in :func:`simulate`) and the state
+    ``(x1, x2, x1dot, x2dot, W)`` at the end."""
+    law = as_law(law)
+    rtol = check_rtol(rtol)
+    settle = check_bool("stop_when_settled", stop_when_settled)
+    stop_kind, stop_count = _stop_on(stop_on)
+    c, default_atol, seed_state, s = _packed(check_params(params), law, rtol)  # simulate's inputs, cached
+    horizon = s.horizon if t_end is None else check_t_end(t_end, s.contact_time)
+    y0 = seed_state if initial is None else _initial(params, initial)
+    batch = (c[None], y0[None], np.array([horizon]), default_atol[None], np.array([s.max_step]))
+    options = (rtol, settle, stop_kind, stop_count, MAX_STEPS, MAX_EVENTS, _stiff_after(True))
+    ws = getattr(_held, "workspace", None)
+    if ws is None:
+        ws = _held.workspace = workspace(N_COEF, 0)  # no stick points kept: their count is in the summary
+    if not _signals.installed:
+        _signals.install()
+    native = law.entry.native
+    while True:
+        if native is not None:
+            native.reset()
+        d.run_held(law.code, ws, batch, options, 0)
+        woken = _woken(ws[W_SUMMARY][d.S_STATUS], native)
+        if not (woken or _signals.deferred):
+            break
+        _signals.check(woken)  # raises for Ctrl-C or SIGTERM; after an old wake-up, runs again
+    summary = ws[W_SUMMARY].copy()
+    if native is not None and native.faulted and summary[d.S_STATUS] != d.SUCCESS:
+        summary[d.S_STATUS] = d.NON_FINITE  # the law's NaN failed the run, as in simulate
+    return summary, ws[W_Y][Y_STATE].copy()
 
 
 def _mark_law_faults(batch: Batch, summary, native, rtol, settle, stop_kind, stop_count, stiff_after) -> None:

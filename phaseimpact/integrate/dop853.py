@@ -37,8 +37,13 @@ def dense_eval(F, y, t_old, h, t, out):
 
 
 @kernel
-def initial_step(code, c, mode, side, y, f, rtol, atol, interval, max_step, tmp, f1):
-    """scipy's ``select_initial_step`` (Hairer, Norsett & Wanner, II.4), one extra evaluation."""
+def initial_step(code, c, mode, side, y, f, tolerances, bounds, scratch):
+    """scipy's ``select_initial_step`` (Hairer, Norsett & Wanner, II.4), one extra evaluation:
+    ``tolerances = (rtol, atol)``, at most ``bounds = (interval, max_step)``, two scratch rows
+    ``scratch = (tmp, f1)``."""
+    rtol, atol = tolerances
+    interval, max_step = bounds
+    tmp, f1 = scratch
     d0 = 0.0
     d1 = 0.0
     for j in range(N_STATE):

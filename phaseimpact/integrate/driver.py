@@ -328,8 +328,8 @@ def _advance(code, ws, next_sample, steps_left):
             if radau5.due(stiff):  # entered from an accepted state, so that every step has one method
                 evaluations += radau5.enter(code, c, mode, side, u, fu, real[R_RTOL], ur[U_ATOL], stiff)
             if radau5.active(stiff):
-                ok, s_new, h_next, force_new, spent = radau5.attempt(code, c, mode, side, s, s_bound, u, fu, h_abs,
-                                                                     stiff, u_new, fu_new)
+                ok, s_new, h_next, force_new, spent = radau5.attempt(code, c, mode, side, s, s_bound, h_abs, stiff,
+                                                                     (u, fu, u_new, fu_new))
             else:
                 ok, s_new, h_next, force_new, spent = _dop853_attempt(code, ws, s, s_bound, h_abs)
         evaluations += spent
@@ -421,9 +421,9 @@ def _phase_step(code, ws):
         return interval  # closed form: its steps only bracket events (see _advance)
     if regularised(side):
         interval /= max(abs(u[0]), w_floor)
-    return dop853.initial_step(code, ws[W_C], mode, side, u, ur[U_FU], real[R_RTOL], ur[U_ATOL], interval,
-                               max_step if not regularised(side) else max_step / max(abs(u[0]), w_floor), ur[U_TMP],
-                               ur[U_FU_NEW])
+    cap = max_step if not regularised(side) else max_step / max(abs(u[0]), w_floor)
+    return dop853.initial_step(code, ws[W_C], mode, side, u, ur[U_FU], (real[R_RTOL], ur[U_ATOL]), (interval, cap),
+                               (ur[U_TMP], ur[U_FU_NEW]))
 
 
 @kernel
@@ -1093,3 +1093,11 @@ def run_block(code, batch, options, start, stop, step, outputs):
             for j in range(i + step, stop, step):
                 summary[j, S_STATUS] = INTERRUPTED
             break
+
+
+@kernel(python=True, nogil=True)
+def run_held(code, ws, batch, options, i):
+    """:func:`run_point` in a workspace the caller holds, for callers that run points one at a time
+    (critical searches, the impact map: :func:`.api.summary_run`); the results stay in ``ws`` (its
+    summary, stick points and final state ``Y_STATE``). Allocates nothing."""
+    run_point(code, ws, batch, options, i)

@@ -170,6 +170,6 @@ def fresh_step(code, ws, h, u_new, fu_new):
         rhs_integration(code, c, u_new, mode, side, fu_new)
         return 0
     if radau5.active(stiff):
-        return radau5.fixed_step(code, c, mode, side, s, u, fu, h, stiff, u_new, fu_new)
+        return radau5.fixed_step(code, c, mode, side, s, h, stiff, (u, fu, u_new, fu_new))
     dop853.step(code, c, mode, side, u, fu, h, K, u_new, fu_new)
     return 12

@@ -31,17 +31,18 @@ def warmup() -> dict:
     and the cache's ``files`` and ``bytes``."""
     from ..model import law_variants
     from ..parameters import seed_parameters
-    from .api import simulate, simulate_many
+    from .api import simulate, simulate_many, summary_run
 
     info = cache_info()
     start = time.perf_counter()
-    entries = (driver.run, driver.run_block, rk4.run_rk4)
+    entries = (driver.run, driver.run_block, driver.run_held, rk4.run_rk4)
     before = [entry.stats.cache_misses.copy() for entry in entries]
     p = seed_parameters(v=1.0, kappa=3e9, limiting_pressure=2e9)  # p_y: read by the plastic law only
     stiff = p.replace(kappa=1e14, v=5.0)  # the stiff (Radau) path
     for law in law_variants():
         simulate(p, law, 2e-3)
         simulate_many([p, stiff], law, 2e-3)
+        summary_run(p, law, 2e-3)  # critical searches, impact maps
     simulate(p, "paper", None, stop_on="slip")
     simulate(stiff, "paper", 2e-3)
     simulate(p, "paper", 2e-4, integrator="rk4")

@@ -386,10 +386,12 @@ def _solve_stages(code, c, mode, side, s, u, fu, h, stiff):
 
 
 @kernel
-def _finish(code, c, mode, side, s, s_end, h, u, u_new, fu_new, stiff):
-    """``u_new``, ``fu_new`` from the converged stages; the polynomial kept for the next guess.
-    Returns the contact force at ``u_new``."""
+def _finish(code, c, mode, side, span, u, ends, stiff):
+    """The step's end ``ends = (u_new, fu_new)`` from the converged stages; the polynomial kept
+    for the next guess, on ``span = (s, s_end, h)``. Returns the contact force at ``u_new``."""
     ws, ctl = stiff[WS], stiff[CTL]
+    s, s_end, h = span
+    u_new, fu_new = ends
     for j in range(N_STATE):
         u_new[j] = u[j] + ws[Z_ + 2, j]
         for k in range(3):
@@ -402,13 +404,15 @@ def _finish(code, c, mode, side, s, s_end, h, u, u_new, fu_new, stiff):
 
 
 @kernel
-def attempt(code, c, mode, side, s, s_bound, u, fu, h_abs, stiff, u_new, fu_new):
-    """One accepted step from ``(s, u)`` (at most to ``s_bound``), first try ``h_abs``.
+def attempt(code, c, mode, side, s, s_bound, h_abs, stiff, rows):
+    """One accepted step from ``(s, u)`` (at most to ``s_bound``), first try ``h_abs``, into
+    ``u_new``, ``fu_new``; ``rows = (u, fu, u_new, fu_new)``.
 
     Returns ``(ok, s_new, h_next, force_new, evaluations)``; ``ok`` False when the step size
     collapsed. The step's stages stay in the workspace for :func:`dense_coefficients`.
     """
     ws, ctl = stiff[WS], stiff[CTL]
+    u, fu, u_new, fu_new = rows
     rtol = ctl[RTOL]
     evaluations = 0
     rejected = False
@@ -456,7 +460,7 @@ def attempt(code, c, mode, side, s, s_bound, u, fu, h_abs, stiff, u_new, fu_new)
         factor = 1.0  # keep the step and with it the factorisation
     ctl[H_OLD] = h
     ctl[ERR_OLD] = max(err, 1e-2)
-    force_new = _finish(code, c, mode, side, s, s_new, h, u, u_new, fu_new, stiff)
+    force_new = _finish(code, c, mode, side, (s, s_new, h), u, (u_new, fu_new), stiff)
     evaluations += 1
     if recompute_jacobian:
         evaluations += jacobian(code, c, mode, side, u_new, fu_new, stiff)
@@ -466,9 +470,11 @@ def attempt(code, c, mode, side, s, s_bound, u, fu, h_abs, stiff, u_new, fu_new)
 
 
 @kernel(python=True)
-def fixed_step(code, c, mode, side, s, u, fu, h, stiff, u_new, fu_new):
-    """A step of exactly ``h`` (to an event's root) without error control, split into equal
-    sub-steps until Newton converges. Returns the evaluations spent."""
+def fixed_step(code, c, mode, side, s, h, stiff, rows):
+    """A step of exactly ``h`` (to an event's root) from ``u`` into ``u_new``, ``fu_new`` (``rows =
+    (u, fu, u_new, fu_new)``) without error control, split into equal sub-steps until Newton
+    converges. Returns the evaluations spent."""
+    u, fu, u_new, fu_new = rows
     evaluations = 0
     start, f_start = stiff[START], stiff[F_START]
     for pieces in (1, 2, 4, 8, 16, 32, 64):
@@ -482,7 +488,7 @@ def fixed_step(code, c, mode, side, s, u, fu, h, stiff, u_new, fu_new):
             evaluations += spent
             if not converged:
                 break
-            _finish(code, c, mode, side, s + k * part, s + (k + 1) * part, part, start, u_new, fu_new, stiff)
+            _finish(code, c, mode, side, (s + k * part, s + (k + 1) * part, part), start, (u_new, fu_new), stiff)
             evaluations += 1
             for j in range(N_STATE):
                 start[j] = u_new[j]

@@ -8,7 +8,7 @@ import math
 
 import numpy as np
 
-from .._jit import allocating
+from .._jit import allocating, kernel
 from .._signals import interrupted
 from ..model.laws import PLAIN
 from ..model.rhs import X1, X2, energy, rhs
@@ -60,6 +60,28 @@ RK_F, RK_TMP, RK_Y_NEW, RK_F_NEW, RK_K = range(5)
 N_RK_ROWS = RK_K + 4
 
 
+@kernel(inline="always")  # the loop's own arithmetic
+def _rk4_step(code, c, y, mode, h, rows):
+    """One classic RK4 step of ``h`` from ``y`` into row ``RK_Y_NEW``; returns whether it is finite."""
+    tmp, y_new, k1, k2, k3, k4 = rows[RK_TMP], rows[RK_Y_NEW], rows[RK_K], rows[RK_K + 1], rows[RK_K + 2], \
+        rows[RK_K + 3]
+    rhs(code, c, y, mode, k1)
+    for j in range(5):
+        tmp[j] = y[j] + 0.5 * h * k1[j]
+    rhs(code, c, tmp, mode, k2)
+    for j in range(5):
+        tmp[j] = y[j] + 0.5 * h * k2[j]
+    rhs(code, c, tmp, mode, k3)
+    for j in range(5):
+        tmp[j] = y[j] + h * k3[j]
+    rhs(code, c, tmp, mode, k4)
+    finite = True
+    for j in range(5):
+        y_new[j] = y[j] + h / 6.0 * (k1[j] + 2.0 * k2[j] + 2.0 * k3[j] + k4[j])
+        finite = finite and math.isfinite(y_new[j])
+    return finite
+
+
 @allocating(python=True, nogil=True)
 def run_rk4(code, c, y0, t_end, save_kind, times, max_steps, rk4_step, rk4_every):
     """The seed's classic RK4: eq. 8's plain right-hand side, fixed steps ``rk4_step``, nothing
@@ -76,13 +98,7 @@ def run_rk4(code, c, y0, t_end, save_kind, times, max_steps, rk4_step, rk4_every
     mode = np.int64(PLAIN)
     ints[I_MODE], ints[I_SAVE_KIND], ints[I_LOGGING] = mode, save_kind, 1
     rows = np.empty((N_RK_ROWS, 5))
-    tmp = rows[RK_TMP]
-    y_new = rows[RK_Y_NEW]
-    f_new = rows[RK_F_NEW]
-    k1 = rows[RK_K]
-    k2 = rows[RK_K + 1]
-    k3 = rows[RK_K + 2]
-    k4 = rows[RK_K + 3]
+    y_new, f_new = rows[RK_Y_NEW], rows[RK_F_NEW]
     force = rhs(code, c, y, mode, rows[RK_F])
     nfev = 1
     nsteps = 0
@@ -99,20 +115,7 @@ def run_rk4(code, c, y0, t_end, save_kind, times, max_steps, rk4_step, rk4_every
             status, reason = INTERRUPTED, FAILED_STOP
             break
         h = min(rk4_step, t_end - t)
-        rhs(code, c, y, mode, k1)
-        for j in range(5):
-            tmp[j] = y[j] + 0.5 * h * k1[j]
-        rhs(code, c, tmp, mode, k2)
-        for j in range(5):
-            tmp[j] = y[j] + 0.5 * h * k2[j]
-        rhs(code, c, tmp, mode, k3)
-        for j in range(5):
-            tmp[j] = y[j] + h * k3[j]
-        rhs(code, c, tmp, mode, k4)
-        finite = True
-        for j in range(5):
-            y_new[j] = y[j] + h / 6.0 * (k1[j] + 2.0 * k2[j] + 2.0 * k3[j] + k4[j])
-            finite = finite and math.isfinite(y_new[j])
+        finite = _rk4_step(code, c, y, mode, h, rows)
         nfev += 4
         nsteps += 1
         if not finite:

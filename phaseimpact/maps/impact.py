@@ -23,7 +23,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..integrate import driver as drv
 from ..integrate import simulate
+from ..integrate.api import summary_run
 from ..model import as_law
 from ..parameters import Parameters, is_number
 from .base import ImpactMap, MapFixedPoint, attracting_orbit_of, check_count, check_samples, fixed_point, lyapunov
@@ -175,13 +177,24 @@ class ModelImpactMap(ImpactMap):
         >>> run.status, f"{run.max_force:.4g} N"
         ('success', '4629 N')
         """
-        x2, x2dot = (float(state[0]), float(state[1]))
-        run = simulate(self.params, self.law, self.period, rtol=self.rtol, initial=(x2, x2, self.params.v, x2dot),
+        run = simulate(self.params, self.law, self.period, rtol=self.rtol, initial=self._arrival(state),
                        stop_when_settled=False)
         return np.array([run.final_state[1], run.final_state[3]]), run
 
+    def _arrival(self, state) -> tuple:
+        x2, x2dot = (float(state[0]), float(state[1]))
+        return (x2, x2, self.params.v, x2dot)
+
+    def _summary(self, state):
+        """:meth:`step`'s run on the per-point path (no event log: fixed points, Jacobians and
+        trains read only its summary): its summary vector (``driver.S_*``) and its state
+        ``(x1, x2, x1dot, x2dot, W)`` at the next arrival."""
+        return summary_run(self.params, self.law, self.period, rtol=self.rtol, initial=self._arrival(state),
+                           stop_when_settled=False)
+
     def __call__(self, state) -> np.ndarray:
-        return self.step(state)[0]
+        y = self._summary(state)[1]
+        return np.array([y[1], y[3]])
 
     def structure(self, record) -> tuple | None:
         """An impact's contacts, stick phases and overlap (1 when its projectile is still in contact at
@@ -460,12 +473,12 @@ def impact_train(params: Parameters, law, period: float, impacts: int, *, plate=
     overlap = np.zeros(impacts, bool)
     status = []
     for n in range(impacts):
-        states[n + 1], run = imap.step(states[n])
-        v_out = run.final_state[2]
-        rows[n] = (run.max_force, run.dissipated_energy, run.restitution if run.restitution is not None else np.nan,
-                   0.5 * params.M1 * (params.v**2 - v_out**2), run.n_contacts)
-        overlap[n] = run.final_state[0] - run.final_state[1] > 0
-        status.append(run.status)
+        summary, y = imap._summary(states[n])
+        states[n + 1] = y[1], y[3]
+        rows[n] = (summary[drv.S_MAX_FORCE], summary[drv.S_DISSIPATED], summary[drv.S_RESTITUTION],
+                   0.5 * params.M1 * (params.v**2 - y[2]**2), summary[drv.S_N_CONTACTS])
+        overlap[n] = y[0] - y[1] > 0
+        status.append(drv.STATUSES[int(summary[drv.S_STATUS])])
     omega = math.sqrt(params.Kb / params.M2) if params.target == "plate" and params.Kb > 0 else math.inf
     amplitude = np.hypot(states[:, 0], states[:, 1] / omega) if math.isfinite(omega) else np.abs(states[:, 0])
     return ImpactTrain(period, states, rows[:, 0], rows[:, 1], rows[:, 2], rows[:, 3], rows[:, 4].astype(np.int64),
