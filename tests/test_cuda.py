@@ -236,3 +236,16 @@ def test_the_device_kernel_compiles_to_ptx_for_an_h100(request):
         request.config.cache.set(key, kept)
     size, entry, target, polls = kept
     assert int(size) > 100_000 and (entry, target, polls) == ("True", "True", "False")
+
+
+def test_the_gpu_benchmark_runs_under_the_simulator(tmp_path):
+    """benchmarks/gpu.py --simulator: the three parts on a 3 x 3 grid (CI keeps the script from rotting);
+    the simulated GPU and the CPU agree in codes and counts."""
+    results = tmp_path / "gpu_simulator.md"
+    script = ROOT / "benchmarks" / "gpu.py"
+    out = subprocess.run([sys.executable, str(script), "--simulator", "--results", str(results)], capture_output=True,
+                         text=True, timeout=600, cwd=ROOT, env=dict(os.environ, PYTHONPATH=str(ROOT)))
+    assert out.returncode == 0, out.stderr[-3000:]
+    text = results.read_text()
+    assert "GPU vs CPU equal in codes and counts" in text
+    assert text.count("| (a) paper atlas | 9 |") == 3 and "| (b) hunt-crossley" in text
