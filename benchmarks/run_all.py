@@ -29,7 +29,8 @@ from _common import FIGURES, RESULTS, emit, load, machine  # noqa: E402
 SCRIPTS = ("startup", "trajectory", "throughput", "critical", "peers", "work_precision", "scene_savings", "stress",
            "stiff", "atlas", "train", "scale")
 SECTIONS = ("trajectory", "throughput", "critical", "startup", "work_precision", "peers", "stiff", "atlas",
-            "scene_savings", "stress", "train", "scale")
+            "scene_savings", "stress", "train", "scale", "gpu")
+#: gpu.py is not in SCRIPTS: it is run on a GPU machine (its section says where it was, or that it was not).
 
 
 def _pick(name: str, suffix: str, quick_first: bool = False):

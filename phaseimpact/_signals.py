@@ -67,10 +67,13 @@ llvm.add_symbol(_POLL_SYMBOL, ctypes.cast(ctypes.CDLL(None).poll, ctypes.c_void_
 def interrupted(typingctx):
     """Compiled code only: has a signal arrived (does the wakeup pipe hold a byte)?
     ``poll({fd, POLLIN}, 1, 0)``, about 0.3 us, skipped without a pipe. Only symbols are referenced,
-    no addresses, so numba's disk cache stays valid."""
+    no addresses, so numba's disk cache stays valid. On a GPU (numba's CUDA target) always False:
+    the device has no system calls, and a signal stops the host between kernel launches instead."""
     def codegen(context, builder, sig, args):
         i16, i32, i64 = ir.IntType(16), ir.IntType(32), ir.IntType(64)
         module = builder.module
+        if module.triple.startswith("nvptx"):
+            return ir.Constant(ir.IntType(1), 0)
         fd_var = module.globals.get(_FD_SYMBOL)
         if fd_var is None:
             fd_var = ir.GlobalVariable(module, i32, _FD_SYMBOL)

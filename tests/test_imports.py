@@ -22,7 +22,7 @@ LAYERS = (
     ("_jit",),  # the compiler's hooks and cache (the engine's sources import it)
     ("parameters",),
     ("model",),  # all physics: laws, equations of motion, restitution, contact mechanics
-    ("integrate", "_oracle"),  # trajectories (and the independent scipy oracle of the checks)
+    ("integrate", "_oracle", "cuda"),  # trajectories (the scipy oracle of the checks; the GPU's launches)
     ("case",),  # case files and settings (read the laws' names)
     ("analysis", "quantities", "checks"),  # one trajectory or one law at a time
     ("continuation",),  # sweeps, atlases, transitions, curves (the only joblib/Dask importer)

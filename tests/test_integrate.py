@@ -353,7 +353,8 @@ def _python_calls_of_compiled_functions():
         return obj if isinstance(obj, CPUDispatcher) else None
 
     def is_compiled_function(node):
-        return any(ast.unparse(d).startswith(("kernel", "allocating")) for d in node.decorator_list)
+        # cuda.jit: the GPU kernel (phaseimpact/cuda.py), which numba compiles with what it calls
+        return any(ast.unparse(d).startswith(("kernel", "allocating", "cuda.jit")) for d in node.decorator_list)
 
     calls = []
     for folder in ("phaseimpact", "tests", "benchmarks", "studies"):

@@ -40,7 +40,8 @@ MAX_PANELS = 12
 MAX_JOBS = 4 * (os.cpu_count() or 1)
 #: Tasks in flight on a Dask cluster (phaseimpact.continuation._parallel.MAX_DASK_TASKS).
 MAX_DASK_TASKS = 100_000
-BACKENDS = ("threads", "loky", "dask")
+#: --backend's choices, phaseimpact.continuation._parallel.BACKENDS (the parser imports no NumPy).
+BACKENDS = ("threads", "loky", "dask", "cuda")
 #: Statuses of critical_damping that are answers (anything else is a failure: exit 1).
 CRITICAL_ANSWERS = ("success", "not-found", "unconfirmed")
 #: What a critical curve continues.

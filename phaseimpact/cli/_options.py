@@ -153,8 +153,8 @@ def parallel(p):
                         f"in flight, up to {MAX_DASK_TASKS}, -1 for every thread of the cluster's workers "
                         "(default: %(default)s)")
     p.add_argument("--backend", choices=BACKENDS, default="threads",
-                   help="threads of this process, joblib processes (loky) or a Dask cluster "
-                        "(default: %(default)s)")
+                   help="threads of this process, joblib processes (loky), a Dask cluster, or a GPU (cuda: one "
+                        "thread per point; phaseimpact backends says whether it works here) (default: %(default)s)")
     p.add_argument("--scheduler", default=None, metavar="ADDRESS",
                    help="Dask scheduler address, e.g. tcp://host:8786 (only with --backend dask; default: a "
                         "local in-process cluster)")

@@ -55,7 +55,7 @@ import dataclasses
 from collections.abc import Callable
 
 from .._version import __version__
-from . import curves, environment, figures, grids, inputs, runs, trains
+from . import backends, curves, environment, figures, grids, inputs, runs, trains
 from ._common import _Parser
 from ._options import settable_epilog
 
@@ -89,6 +89,11 @@ COMMANDS: list[Command] = [
                         "would otherwise do it, about a minute on 2 cores), and say where the cache is: for "
                         "containers, cluster workers and a fresh install (each user who cannot write the install "
                         "compiles once into ~/.cache/phaseimpact). On a warm cache it only loads."),
+    Command("backends", backends.add_backends, backends.run_backends,
+            help="which --backend choices work on this machine, and why not",
+            description="Lists each backend of sweep and atlas (--backend) with whether it can run here: threads, "
+                        "joblib processes (loky), a Dask cluster (dask), and a GPU (cuda, with what is missing "
+                        "when there is none: the CUDA driver, NVVM or a device)."),
     Command("check-law", inputs.add_check_law, inputs.run_check_law,
             help="run the law conformance suite on a law or a law file",
             description="The checks every shipped law passes (force, repulsive on loading, partials against finite "

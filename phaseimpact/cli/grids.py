@@ -88,6 +88,10 @@ def _run_grid(args, setup: Setup, axes: list):
     from ..continuation._parallel import check_scheduler
 
     Grid(setup.case, setup.law, tuple(axes))  # every check of the grid, before any work
+    if args.backend == "cuda":
+        from .. import cuda
+
+        cuda.check(setup.law)  # a user law, or no GPU: one line and exit 2, nothing computed
     out = args.out
     archive.created_timestamp()  # a bad SOURCE_DATE_EPOCH is refused now, not at the first checkpoint
     if args.backend == "dask" and args.scheduler is not None:

@@ -2,7 +2,8 @@
 
 ``threads`` (default) runs chunks in this process on ``n_jobs`` numba threads; ``loky`` runs
 chunks in ``n_jobs`` joblib worker processes; ``dask`` sends them to a ``dask.distributed``
-cluster: a ``Client`` the caller holds, a scheduler's address, or an in-process local cluster.
+cluster: a ``Client`` the caller holds, a scheduler's address, or an in-process local cluster;
+``cuda`` runs each chunk on a GPU, one thread per point (:mod:`phaseimpact.cuda`).
 With Dask, ``n_jobs`` is the number of tasks in flight (any number up to :data:`MAX_DASK_TASKS`,
 -1 for every thread of the cluster's workers), not this machine's cores, and every worker loads
 or compiles the engine once before the first chunk (:func:`warm_workers`). Every run is
@@ -26,7 +27,7 @@ from ..integrate.api import run_batch
 __all__ = ["BACKENDS", "run_chunks", "check_jobs", "check_scheduler", "connect", "warm_workers", "tasks_in_flight",
            "MAX_DASK_TASKS"]
 
-BACKENDS = ("threads", "loky", "dask")
+BACKENDS = ("threads", "loky", "dask", "cuda")
 MAX_JOBS = 4 * (os.cpu_count() or 1)
 #: Tasks in flight on a Dask cluster (its size is not this machine's).
 MAX_DASK_TASKS = 100_000
@@ -34,10 +35,15 @@ MAX_DASK_TASKS = 100_000
 CONNECT_TIMEOUT = 5
 
 
-def check_jobs(n_jobs, backend: str, scheduler) -> int:
-    """Validate the parallel settings before any work; returns the job count (>= 1)."""
+def check_jobs(n_jobs, backend: str, scheduler, law=None) -> int:
+    """Validate the parallel settings before any work (for ``cuda``: the ``law`` and the GPU);
+    returns the job count (>= 1)."""
     if backend not in BACKENDS:
         raise ValueError(f"backend = {backend!r} is out of range; allowed: one of {', '.join(BACKENDS)}")
+    if backend == "cuda":
+        from .. import cuda
+
+        cuda.check(law)
     top = MAX_DASK_TASKS if backend == "dask" else MAX_JOBS
     if isinstance(n_jobs, bool) or not isinstance(n_jobs, (int, np.integer)) or not (
             n_jobs == -1 or 1 <= n_jobs <= top):
@@ -134,10 +140,6 @@ def tasks_in_flight(n_jobs: int, scheduler) -> int:
     return os.cpu_count() or 1
 
 
-def _run_chunk(batch, rtol, settle, stop_on, threads):
-    return run_batch(batch, rtol=rtol, settle=settle, stop_on=stop_on, n_threads=threads)
-
-
 def _run_task(batch, rtol, settle, stop_on):
     """A chunk as a worker's task (a joblib process or a Dask worker's thread). After Ctrl-C or
     SIGTERM its run ends at once without running again (:func:`._signals.stopping_with_the_caller`)
@@ -145,7 +147,7 @@ def _run_task(batch, rtol, settle, stop_on):
     ``KeyboardInterrupt`` would print a worker's traceback or break Dask's event loop."""
     with _signals.stopping_with_the_caller():
         try:
-            return _run_chunk(batch, rtol, settle, stop_on, 1)
+            return run_batch(batch, rtol=rtol, settle=settle, stop_on=stop_on)
         except KeyboardInterrupt:
             return None
 
@@ -172,9 +174,9 @@ def _quiet_teardown():
 
 def run_chunks(batches, *, rtol: float, settle: bool, stop_on, n_jobs: int, backend: str, scheduler=None):
     """Yield the :class:`~phaseimpact.integrate.Columns` of each batch, in order."""
-    if backend == "threads":
+    if backend in ("threads", "cuda"):
         for batch in batches:
-            yield _run_chunk(batch, rtol, settle, stop_on, n_jobs)
+            yield run_batch(batch, rtol=rtol, settle=settle, stop_on=stop_on, n_threads=n_jobs, backend=backend)
         return
     import joblib
 

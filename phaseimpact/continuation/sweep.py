@@ -32,6 +32,9 @@ __all__ = ["SweepResult", "sweep", "atlas", "ENGINE"]
 ENGINE = "phaseimpact driver: DOP853 (scipy tableau) with located events, numba"
 #: Points per chunk: large enough that a chunk's µs-per-point work outweighs its dispatch.
 CHUNK_THREADS, CHUNK_MIN, CHUNK_MAX = 4096, 256, 65536
+#: Points of one GPU launch: about as many threads as an H100 holds at once (132 x 2048); their
+#: workspaces (5.7 kB a point) take 1.5 GB on the device and, while they are made, on the host.
+CHUNK_CUDA = 1 << 18
 
 
 #: The outcome classes and, last, the label of points not computed yet.
@@ -376,9 +379,10 @@ def atlas(base: Parameters | Case, law: ContactLaw | str, axes, *, t_end: float 
         Integrator tolerance, within :data:`~phaseimpact.integrate.RTOL_RANGE`.
     n_jobs : int, default 1
         Workers: an integer from 1 to 4 times the CPU count, or -1 for all cores.
-    backend : {"threads", "loky", "dask"}, default "threads"
-        Threads of this process (``threads``), joblib processes (``loky``) or a Dask cluster
-        (``dask``, at ``scheduler`` or a local one).
+    backend : {"threads", "loky", "dask", "cuda"}, default "threads"
+        Threads of this process (``threads``), joblib processes (``loky``), a Dask cluster
+        (``dask``, at ``scheduler`` or a local one) or a GPU (``cuda``: one thread per point;
+        refused before any work for a user law or without a usable GPU).
     scheduler : str or dask.distributed.Client, optional
         ``dask`` only: a scheduler's address (``tcp://host:8786``), or a ``Client`` you hold (left
         open); default an in-process local cluster. ``n_jobs`` is then the number of tasks in
@@ -435,7 +439,7 @@ def atlas(base: Parameters | Case, law: ContactLaw | str, axes, *, t_end: float 
     rtol = check_rtol(rtol)
     if t_end is not None:
         t_end = check_t_end(t_end, scales(grid.base_parameters()).contact_time)
-    jobs = check_jobs(n_jobs, backend, scheduler)
+    jobs = check_jobs(n_jobs, backend, scheduler, law)
     check_bool("progress", progress)
     if on_chunk is not None and not callable(on_chunk):
         raise TypeError(f"on_chunk = {on_chunk!r} has the wrong type ({type(on_chunk).__name__}); allowed: a "
@@ -448,6 +452,8 @@ def atlas(base: Parameters | Case, law: ContactLaw | str, axes, *, t_end: float 
     todo = np.flatnonzero(result.status != drv.SUCCESS)
     if backend == "threads":
         chunk = CHUNK_THREADS
+    elif backend == "cuda":  # a launch fills the GPU's threads: as many points as fit its memory at once
+        chunk = CHUNK_CUDA
     else:  # four chunks per worker thread (Dask: per task in flight, from the cluster's size for -1)
         jobs = tasks_in_flight(jobs, scheduler) if backend == "dask" else jobs
         chunk = int(np.clip(math.ceil(len(todo) / (4 * jobs)), CHUNK_MIN, CHUNK_MAX))

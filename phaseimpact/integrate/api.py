@@ -438,6 +438,8 @@ class Batch:
         return len(self.C)
 
 
+#: Where :func:`simulate_many` runs: threads of this process, or a GPU (:mod:`phaseimpact.cuda`).
+SIMULATE_MANY_BACKENDS = ("threads", "cuda")
 #: Runs packed at a time by :func:`simulate_many` (any size gives the same numbers: runs are independent).
 PACK_CHUNK = 2048
 
@@ -479,9 +481,10 @@ def _pack(params_seq: list, law: ContactLaw, t_end, rtol: float, initial) -> Bat
 
 
 def run_batch(batch: Batch, *, rtol: float, settle: bool = True, stop_on=None, n_threads: int = 1,
-              capacity: int = 32, stiff: bool = True) -> Columns:
-    """Run a packed batch in ``n_threads`` threads; each run is independent of the others, so
-    the columns do not depend on the thread count or on how a sweep was cut into batches."""
+              capacity: int = 32, stiff: bool = True, backend: str = "threads") -> Columns:
+    """Run a packed batch in ``n_threads`` threads, or one GPU thread per run (``backend="cuda"``,
+    checked by :func:`phaseimpact.cuda.check` first); each run is independent of the others, so the columns
+    do not depend on the thread count or on how a sweep was cut into batches."""
     stop_kind, stop_count = _stop_on(stop_on)
     stiff_after = _stiff_after(stiff)
     n = len(batch)
@@ -498,7 +501,11 @@ def run_batch(batch: Batch, *, rtol: float, settle: bool = True, stop_on=None, n
     while True:
         if native is not None:
             native.reset()
-        if threads == 1:
+        if backend == "cuda":
+            from .. import cuda
+
+            cuda.run_batch_cuda(*args, outputs)
+        elif threads == 1:
             d.run_block(*args, 0, n, 1, outputs)
         else:  # thread k runs k, k + threads, ...: equal loads (run_block); the driver releases the GIL
             with ThreadPoolExecutor(threads) as pool:
@@ -598,7 +605,7 @@ def _mark_law_faults(batch: Batch, summary, native, rtol, settle, stop_kind, sto
 
 def simulate_many(params_seq, law: ContactLaw | str = "paper", t_end: float | None = None, *,
                   rtol: float = 1e-10, stop_when_settled: bool = True, stop_on=None, initial=None,
-                  n_threads: int = 1, stiff: bool = True) -> Columns:
+                  n_threads: int = 1, stiff: bool = True, backend: str = "threads") -> Columns:
     """Many impacts (one per :class:`Parameters` of ``params_seq``), summaries only, as columns.
 
     Same driver and arguments as :func:`simulate`; runs go in ``n_threads`` threads inside this
@@ -625,6 +632,10 @@ def simulate_many(params_seq, law: ContactLaw | str = "paper", t_end: float | No
         Threads of this process (>= 1); the compiled driver releases the GIL.
     stiff : bool, default True
         Radau IIA for stiff phases, as for :func:`simulate`.
+    backend : {"threads", "cuda"}, default "threads"
+        ``cuda``: one GPU thread per run, the same per-point kernel compiled for the GPU
+        (``n_threads`` is then not read); refused before any work for a user law or without a
+        usable GPU.
 
     Returns
     -------
@@ -659,13 +670,19 @@ def simulate_many(params_seq, law: ContactLaw | str = "paper", t_end: float | No
     _stiff_after(stiff)
     check_bool("stop_when_settled", stop_when_settled)
     _stop_on(stop_on)
-    law = as_law(law)
+    if backend not in SIMULATE_MANY_BACKENDS:
+        raise ValueError(f"backend = {backend!r} is out of range; allowed: one of {', '.join(SIMULATE_MANY_BACKENDS)}")
+    if backend == "cuda":
+        from .. import cuda
+
+        cuda.check(law)
     params_seq = _checked_sequence(params_seq)  # every case, before any run
     if t_end is not None:  # long enough for the case of the longest contact
         check_t_end(t_end, max(hertz_contact_time(p.alpha, p.hertz_indentation, p.v) for p in params_seq))
     chunks = [params_seq[i:i + PACK_CHUNK] for i in range(0, len(params_seq), PACK_CHUNK)]
-    options = {"rtol": rtol, "settle": stop_when_settled, "stop_on": stop_on, "n_threads": n_threads, "stiff": stiff}
-    if n_threads == 1 or len(chunks) == 1:
+    options = {"rtol": rtol, "settle": stop_when_settled, "stop_on": stop_on, "n_threads": n_threads, "stiff": stiff,
+               "backend": backend}
+    if n_threads == 1 or len(chunks) == 1 or backend == "cuda":
         return _joined([run_batch(_pack(chunk, law, t_end, rtol, initial), **options) for chunk in chunks])
     # Packing is Python, serial and a fifth of the work: a second thread packs the next chunks while
     # this one runs the last in the worker threads (whose compiled runs release the GIL), so the

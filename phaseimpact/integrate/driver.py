@@ -174,6 +174,7 @@ from .record import (
     workspace,
 )
 from .rootfind import brent, locate, polish_root, s_at_time
+from .spacing import ulp_above
 
 # Run status (numerical health) and why the run stopped.
 SUCCESS, STEP_SIZE_COLLAPSE, TOO_MANY_STEPS, NON_FINITE, INTERRUPTED = range(5)
@@ -260,7 +261,7 @@ def _dop853_attempt(code, ws, s, s_bound, h_abs):
     rejected = False
     h_rejected = err_rejected = 0.0
     while True:
-        if h_abs < 10.0 * (np.nextafter(s, np.inf) - s):
+        if h_abs < 10.0 * ulp_above(s):
             return False, s, h_abs, 0.0, evaluations
         s_new = min(s + h_abs, s_bound)
         h = s_new - s
@@ -445,7 +446,7 @@ def _locate_events(code, ws, s_horizon):
         if fired[col]:
             roots[col] = locate(code, ws, col, g_old[col], g_new[col])
             if roots[col] == -math.inf:
-                if h > 1e3 * (np.nextafter(s, np.inf) - s):
+                if h > 1e3 * ulp_above(s):
                     unresolved = True
                 else:  # nothing smaller to try: the excursion did not happen
                     fired[col] = False
@@ -1058,6 +1059,20 @@ def run_point(code, ws, batch, options, i):
     summarize(code, ws)
 
 
+@kernel
+def run_point_into(code, ws, batch, options, i, outputs):
+    """:func:`run_point`, then its summary and first stick points into row ``i`` of ``outputs``
+    (the tuple ``O_*``): one point's whole work in a CPU thread's block or a GPU thread
+    (:mod:`phaseimpact.cuda`)."""
+    run_point(code, ws, batch, options, i)
+    ints, sticks = ws[W_INT], ws[W_STICKS]
+    st_t, st_delta, st_dwell = outputs[O_STICK_T], outputs[O_STICK_DELTA], outputs[O_STICK_DWELL]
+    copy_values(ws[W_SUMMARY], outputs[O_SUMMARY][i])
+    outputs[O_STICK_COUNT][i] = ints[I_N_STICK]
+    for j in range(min(ints[I_N_STICK], sticks.shape[1])):
+        st_t[i, j], st_delta[i, j], st_dwell[i, j] = sticks[ST_T, j], sticks[ST_DELTA, j], sticks[ST_DWELL, j]
+
+
 @allocating(python=True, nogil=True)
 def run_block(code, batch, options, start, stop, step, outputs):
     """Runs ``start, start + step, ...`` (below ``stop``) of a batch, without the GIL (callers run
@@ -1073,10 +1088,8 @@ def run_block(code, batch, options, start, stop, step, outputs):
 
     The block's one workspace is made here, once; each run goes through :func:`run_point` in it,
     without an event log, and allocates nothing."""
-    summary, st_t, st_delta, st_dwell, st_count = (outputs[O_SUMMARY], outputs[O_STICK_T], outputs[O_STICK_DELTA],
-                                                   outputs[O_STICK_DWELL], outputs[O_STICK_COUNT])
-    ws = workspace(batch[B_C].shape[1], st_t.shape[1])
-    ints, sticks = ws[W_INT], ws[W_STICKS]
+    summary = outputs[O_SUMMARY]
+    ws = workspace(batch[B_C].shape[1], outputs[O_STICK_T].shape[1])
     done = 0
     for i in range(start, stop, step):
         done += 1
@@ -1084,11 +1097,7 @@ def run_block(code, batch, options, start, stop, step, outputs):
             for j in range(i, stop, step):
                 summary[j, S_STATUS] = INTERRUPTED
             break
-        run_point(code, ws, batch, options, i)
-        copy_values(ws[W_SUMMARY], summary[i])
-        st_count[i] = ints[I_N_STICK]
-        for j in range(min(ints[I_N_STICK], sticks.shape[1])):
-            st_t[i, j], st_delta[i, j], st_dwell[i, j] = sticks[ST_T, j], sticks[ST_DELTA, j], sticks[ST_DWELL, j]
+        run_point_into(code, ws, batch, options, i, outputs)
         if summary[i, S_STATUS] == INTERRUPTED:
             for j in range(i + step, stop, step):
                 summary[j, S_STATUS] = INTERRUPTED

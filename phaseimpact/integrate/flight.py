@@ -17,10 +17,9 @@ the target passes its centre (:func:`next_centre`). Between two such passes ``x2
 ``delta`` at most one extremum in a step: no pair of events can hide inside one. Once no event
 can happen any more the phase goes to its end in one step (:func:`unreachable`).
 
-``sn, cn, dn`` and the integrals ``F(phi | m)``, ``K(m)`` are scipy's (``scipy.special.ellipj``,
-``ellipkinc``, ``ellipk``; Cephes), called from compiled code through their C entry points in
-``scipy.special.cython_special``, registered under a fixed symbol name so that numba's on-disk
-cache stays valid across processes.
+``sn, cn, dn`` and the integrals ``F(phi | m)``, ``K(m)`` are :mod:`.elliptic`'s, plain arithmetic
+that numba compiles for the CPU and the GPU alike (scipy's Cephes routines, which they match to
+a few ulps, have no device version).
 
 The orbit's invariants (kind, ``A``, ``omega``, ``m``, ``psi`` at a reference ``s``, and the
 quarter period ``K(m)`` of the elliptic argument) are computed once per flight, at its start
@@ -32,55 +31,13 @@ from __future__ import annotations
 
 import math
 
-import llvmlite.binding as llvm
-import numba
-import scipy.special
-from numba import types
-from numba.extending import get_cython_function_address
-
 from .._jit import kernel
 from ..model.rhs import KB_, KM_, M2_, RIGID_, SPRINGS_, V1, V2, WORK, X1, X2, target_reach
+from .elliptic import complete as _complete
+from .elliptic import first_kind as _first_kind
+from .elliptic import jacobi as _jacobi
 
 __all__ = ["coefficients", "state_at", "next_centre", "unreachable"]
-
-if numba.config.DISABLE_JIT:  # the uncompiled engine (tests): scipy's Python functions
-    def _jacobi(u, m, out):
-        """``sn, cn, dn`` of ``(u | m)`` into ``out[:3]`` (``out[3]``: the amplitude ``phi``)."""
-        out[0], out[1], out[2], out[3] = scipy.special.ellipj(u, m)
-
-    def _first_kind(phi, m):
-        """``F(phi | m)``."""
-        return scipy.special.ellipkinc(phi, m)
-
-    def _complete(m):
-        """``K(m)``."""
-        return scipy.special.ellipk(m)
-else:
-    llvm.add_symbol("phaseimpact_ellipj", get_cython_function_address("scipy.special.cython_special", "ellipj"))
-    llvm.add_symbol("phaseimpact_ellipkinc",
-                    get_cython_function_address("scipy.special.cython_special", "ellipkinc"))
-    llvm.add_symbol("phaseimpact_ellipk", get_cython_function_address("scipy.special.cython_special", "ellipk"))
-    _DOUBLE_P = types.CPointer(types.double)
-    _ellipj = types.ExternalFunction("phaseimpact_ellipj", types.void(types.double, types.double, _DOUBLE_P,
-                                                                       _DOUBLE_P, _DOUBLE_P, _DOUBLE_P))
-    _ellipkinc = types.ExternalFunction("phaseimpact_ellipkinc",
-                                        types.double(types.double, types.double, types.intc))
-    _ellipk = types.ExternalFunction("phaseimpact_ellipk", types.double(types.double, types.intc))
-
-    @kernel
-    def _jacobi(u, m, out):
-        """``sn, cn, dn`` of ``(u | m)`` into ``out[:3]`` (``out[3]``: the amplitude ``phi``)."""
-        _ellipj(u, m, out[0:].ctypes, out[1:].ctypes, out[2:].ctypes, out[3:].ctypes)
-
-    @kernel
-    def _first_kind(phi, m):
-        """``F(phi | m)``."""
-        return _ellipkinc(phi, m, 0)
-
-    @kernel
-    def _complete(m):
-        """``K(m)``."""
-        return _ellipk(m, 0)
 
 
 TIME = 5

@@ -34,6 +34,7 @@ import numpy as np
 from .._jit import allocating, kernel
 from ..model.rhs import rhs_integration
 from .dop853 import N_STATE
+from .spacing import ulp_above
 
 S6 = math.sqrt(6.0)
 C1, C2 = (4.0 - S6) / 10.0, (4.0 + S6) / 10.0  # collocation points (the third is 1)
@@ -422,7 +423,7 @@ def attempt(code, c, mode, side, s, s_bound, h_abs, stiff, rows):
     s_new = s
     h = 0.0
     while True:
-        if h_abs < 10.0 * (np.nextafter(s, np.inf) - s):
+        if h_abs < 10.0 * ulp_above(s):
             return False, s, h_abs, 0.0, evaluations
         s_new = min(s + h_abs, s_bound)
         h = s_new - s

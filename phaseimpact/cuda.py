@@ -1,0 +1,167 @@
+"""The GPU backend (``backend="cuda"``): one CUDA thread per point of a batch, each running
+:func:`.integrate.driver.run_point_into`, the per-point kernel of the CPU threads, compiled by numba's CUDA
+target from the same source (numba compiles the engine's ``@njit`` functions a CUDA kernel calls
+as device functions; no second copy of any kernel).
+
+A launch allocates every thread's workspace at once: each member of :func:`.integrate.record.workspace`
+with a leading axis of one row per point, as the CPU's workspace starts, and a thread runs in its
+rows. The inputs go to the device once, the outputs come back once; the workspaces stay there.
+This module is host code and the CUDA kernel: it lies outside ``integrate/`` so that it is not
+part of the CPU engine's cache digest (``_jit.ENGINE_SOURCES``).
+
+Without a usable GPU, :func:`unavailable` says what is missing (one line) and the callers refuse
+before any work. numba's CUDA simulator (``NUMBA_ENABLE_CUDASIM=1``) runs the kernel in Python
+threads; it calls the engine as Python, so it needs ``NUMBA_DISABLE_JIT=1`` too (the compiled
+kernels have no entry from Python): the tests run it so, on small grids.
+"""
+
+from __future__ import annotations
+
+import functools
+
+import numba
+import numpy as np
+
+from .integrate.record import workspace
+
+try:  # a module global: the simulator swaps it for its own in the kernel's globals
+    from numba import cuda
+except ImportError as missing:  # a numba built without its CUDA target
+    cuda, _MISSING = None, missing
+
+__all__ = ["unavailable", "check", "run_batch_cuda", "THREADS_PER_BLOCK"]
+
+#: Threads of a block. The per-point kernel is long and holds many registers: small blocks keep
+#: the multiprocessors' register files from limiting the blocks resident at once.
+THREADS_PER_BLOCK = 64
+
+
+def unavailable() -> str | None:
+    """None when the CUDA backend can run here, else one line naming CUDA and what is missing."""
+    if cuda is None:
+        return f"CUDA is not usable: numba {numba.__version__} has no CUDA target ({_MISSING})"
+    if numba.config.ENABLE_CUDASIM:
+        if not numba.config.DISABLE_JIT:
+            return ("CUDA is not usable: numba's CUDA simulator (NUMBA_ENABLE_CUDASIM=1) runs the engine as "
+                    "Python and needs NUMBA_DISABLE_JIT=1 as well")
+        return None
+    from numba.cuda.cudadrv.driver import driver
+
+    if not driver.is_available:
+        # numba's message, first sentence only ("CUDA driver library cannot be found.")
+        why = " ".join((driver.initialization_error or "unknown error").split()).split(". ")[0].rstrip(".")
+        return f"CUDA is not usable: no working CUDA driver ({why})"
+    from numba.cuda.cudadrv import nvvm
+
+    if not nvvm.is_available():
+        return "CUDA is not usable: no NVVM (the CUDA toolkit's compiler library) to compile the kernels with"
+    if len(cuda.gpus) == 0:
+        return "CUDA is not usable: the CUDA driver finds no device"
+    return None
+
+
+def check(law) -> None:
+    """Refuse the CUDA backend before any work: a user law (a Python function, which a GPU
+    cannot call), or no usable GPU (:func:`unavailable`). ValueError, one line."""
+    if law.entry.native is not None:
+        raise ValueError(f"backend = 'cuda' cannot run the user law {law.name!r}: its Python function cannot run "
+                         "on a GPU; allowed: a built-in law (phaseimpact laws), or backend 'threads'")
+    why = unavailable()
+    if why is not None:
+        raise ValueError(f"backend = 'cuda': {why}")
+
+
+def _flat(members):
+    """The workspace's arrays in order, its nested tuple (Radau's) flattened."""
+    for member in members:
+        if isinstance(member, tuple):
+            yield from _flat(member)
+        else:
+            yield member
+
+
+@functools.cache
+def _device_min_max() -> None:
+    """``max`` and ``min`` of 2 to 4 numbers on the CUDA target. numba's own (an overload taking
+    ``*args``) does not compile as a device function (its arity is lost: "2 argument types given,
+    but function takes 1"); these keep its order of comparisons (Python's: the first of equal
+    values; a NaN only where it comes first), so results are those of the CPU's."""
+    from numba import types
+    from numba.extending import overload, register_jitable
+
+    def numbers(*values):
+        return all(isinstance(v, (types.Number, types.Boolean)) for v in values)
+
+    # one overload per arity: the device compile checks the implementation's argument count
+    # against the call's (``*args`` counts as one argument there)
+    def define(builtin, later):
+        @overload(builtin, target="cuda")
+        def two(a, b):
+            if numbers(a, b):
+                return lambda a, b: b if later(b, a) else a
+
+        @overload(builtin, target="cuda")
+        def three(a, b, c):
+            if numbers(a, b, c):
+                def three_(a, b, c):
+                    first = b if later(b, a) else a
+                    return c if later(c, first) else first
+                return three_
+
+        @overload(builtin, target="cuda")
+        def four(a, b, c, d):
+            if numbers(a, b, c, d):
+                def four_(a, b, c, d):
+                    first = b if later(b, a) else a
+                    second = c if later(c, first) else first
+                    return d if later(d, second) else second
+                return four_
+
+    define(max, register_jitable(inline="always")(lambda x, y: x > y))
+    define(min, register_jitable(inline="always")(lambda x, y: x < y))
+
+
+@functools.cache
+def _kernel():
+    """The CUDA kernel (compiled on first launch): thread ``i`` runs point ``i`` in row ``i`` of
+    each workspace array (``w``: the 12 arrays of the run, ``r``: Radau's 10)."""
+    from .integrate.driver import run_point_into
+
+    _device_min_max()
+
+    @cuda.jit
+    def points(code, batch, options, outputs, w, r):
+        i = cuda.grid(1)
+        if i < batch[0].shape[0]:
+            ws = (w[0][i], w[1][i], w[2][i], w[3][i], w[4][i], w[5][i], w[6][i], w[7][i], w[8][i], w[9][i], w[10][i],
+                  w[11][i], (r[0][i], r[1][i], r[2][i], r[3][i], r[4][i], r[5][i], r[6][i], r[7][i], r[8][i], r[9][i]))
+            run_point_into(code, ws, batch, options, i, outputs)
+
+    return points
+
+
+def workspaces(n: int, n_coef: int, capacity: int) -> tuple[tuple, tuple]:
+    """One workspace row per point (host arrays): the run's 12 arrays and Radau's 10, each as
+    :func:`.integrate.record.workspace` makes it, repeated ``n`` times."""
+    template = workspace(n_coef, capacity)
+    rows = [np.broadcast_to(a, (n, *a.shape)).copy() for a in _flat(template)]
+    return tuple(rows[:12]), tuple(rows[12:])
+
+
+def run_batch_cuda(code: int, batch: tuple, options: tuple, outputs: tuple) -> None:
+    """Run every point of ``batch`` (the tuple ``integrate.driver.B_*``) on the GPU, one thread each, and fill
+    ``outputs`` (the tuple ``integrate.driver.O_*``) as :func:`.integrate.driver.run_block` does. Call
+    :func:`unavailable` first."""
+    from numba import cuda
+
+    n = batch[0].shape[0]
+    w, r = workspaces(n, batch[0].shape[1], outputs[1].shape[1])
+    device_batch = tuple(cuda.to_device(np.ascontiguousarray(a)) for a in batch)
+    device_outputs = tuple(cuda.to_device(a) for a in outputs)
+    device_w = tuple(cuda.to_device(a) for a in w)
+    device_r = tuple(cuda.to_device(a) for a in r)
+    blocks = (n + THREADS_PER_BLOCK - 1) // THREADS_PER_BLOCK
+    _kernel()[blocks, THREADS_PER_BLOCK](np.int64(code), device_batch, options, device_outputs, device_w, device_r)
+    cuda.synchronize()
+    for host, device in zip(outputs, device_outputs, strict=True):
+        device.copy_to_host(host)
