@@ -26,8 +26,6 @@ import math
 from collections.abc import Mapping
 from dataclasses import dataclass
 
-import numpy as np
-
 from ..parameters import (
     DENSITY_RANGE,
     LENGTH_RANGE,
@@ -39,6 +37,20 @@ from ..parameters import (
     require_choice,
     require_in,
 )
+
+
+class _NumPyOnFirstUse:
+    """NumPy, imported when a laminate is first computed with: the commands that integrate nothing
+    (``cases``, ``params`` of an isotropic plate) import this module but never NumPy."""
+
+    def __getattr__(self, name):
+        import numpy
+
+        globals()["np"] = numpy
+        return getattr(numpy, name)
+
+
+np = _NumPyOnFirstUse()
 
 __all__ = [
     "Ply", "Laminate", "validate_ply", "transformed_stiffness", "lekhnitskii_rigidity", "olsson_rigidity",

@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import math
 
-from ..parameters import LENGTH_RANGE, is_number, require, require_in
+from ..parameters import LENGTH_RANGE, Material, is_number, require, require_in
 from .laminate import olsson_rigidity
 
 __all__ = [
@@ -262,14 +262,16 @@ def regime_report(params, plate, geometry) -> dict:
     its edge during the contact, so the spring-mass plate (target plate) is out of its range; the infinite plate is
     the model
     """
-    from .laminate import as_laminate
-
-    laminate = as_laminate(plate, geometry.h)
-    D_star = olsson_rigidity(laminate.reduced_bending_stiffness())
+    if isinstance(plate, Material):  # D* = D: closed form (no lamination theory, no NumPy)
+        D_star = plate.E * geometry.h**3 / (12 * (1 - plate.nu**2))
+        areal_density = plate.rho * geometry.h
+    else:
+        D_star = olsson_rigidity(plate.reduced_bending_stiffness())
+        areal_density = plate.areal_density
     # the impedance the infinite target integrates with (derive_parameters), where the parameters carry one
     impedance = params.impedance if params.impedance is not None else infinite_plate_impedance(
-        D_star, laminate.areal_density)
-    M_p = plate_mass(laminate.areal_density, geometry.a)
+        D_star, areal_density)
+    M_p = plate_mass(areal_density, geometry.a)
     ratio = mass_ratio(params.M1, M_p)
     regime = impact_regime(ratio)
     model = model_for_regime(regime)
