@@ -6,7 +6,7 @@ STAMP := $(VENV)/.installed
 QUICK ?=
 JOBS ?= 2
 
-.PHONY: test test-sdist test-numba-range docs reproduce lint benchmarks stress peers clean
+.PHONY: test test-sdist test-ptx test-numba-range docs reproduce lint benchmarks stress peers clean
 
 $(BIN)/python:
 	$(PYTHON) -m venv $(VENV)
@@ -56,6 +56,11 @@ NUMBA_RANGE_TESTS ?= tests/test_integrate.py tests/test_laws.py tests/test_cache
 # sample of it: every test file, and every quick test of the files that read figures, studies and docs).
 test-sdist: $(STAMP)
 	PHASEIMPACT_SDIST_ALL=1 $(BIN)/python -m pytest -q tests/test_packaging.py -k sdist_has_every
+
+# The GPU kernel compiled for an H100 (sm_90) by the real CUDA target, without a GPU (needs the CUDA
+# toolkit's NVVM; about 10 minutes on 2 cores). make test runs the kernel on numba's CUDA simulator.
+test-ptx: $(STAMP)
+	PHASEIMPACT_PTX=1 $(BIN)/python -m pytest -q tests/test_cuda.py -k ptx
 
 test-numba-range: .venv-numba-oldest/.installed .venv-numba-newest/.installed
 	@for end in oldest newest; do \
