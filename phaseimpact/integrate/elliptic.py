@@ -58,30 +58,48 @@ def jacobi(u, m, out):
     if not 0.0 <= m <= 1.0:
         out[0] = out[1] = out[2] = out[3] = math.nan
         return
-    if m < 1e-9:  # A&S 16.13: first order in m
-        t = math.sin(u)
-        b = math.cos(u)
-        ai = 0.25 * m * (u - t * b)
-        out[0] = t - ai * b
-        out[1] = b + ai * t
-        out[2] = 1.0 - 0.5 * m * t * t
-        out[3] = u - ai
+    if m < 1e-9:
+        _jacobi_near_zero(u, m, out)
+    elif m >= 0.9999999999:
+        _jacobi_near_one(u, m, out)
+    else:
+        _jacobi_landen(u, m, out)
+
+
+@kernel(inline="always")
+def _jacobi_near_zero(u, m, out):
+    """:func:`jacobi` for ``0 <= m < 1e-9``: A&S 16.13, first order in ``m``."""
+    t = math.sin(u)
+    b = math.cos(u)
+    ai = 0.25 * m * (u - t * b)
+    out[0] = t - ai * b
+    out[1] = b + ai * t
+    out[2] = 1.0 - 0.5 * m * t * t
+    out[3] = u - ai
+
+
+@kernel(inline="always")
+def _jacobi_near_one(u, m, out):
+    """:func:`jacobi` for ``1 - 1e-10 <= m <= 1``: A&S 16.15, first order in ``1 - m``."""
+    if abs(u) > 709.0:  # cosh, sinh, exp overflow (Python's math raises): NaN, as scipy's mostly is
+        out[0] = out[1] = out[2] = out[3] = math.nan
         return
-    if m >= 0.9999999999:  # A&S 16.15: first order in 1 - m
-        if abs(u) > 709.0:  # cosh, sinh, exp overflow (Python's math raises): NaN, as scipy's mostly is
-            out[0] = out[1] = out[2] = out[3] = math.nan
-            return
-        ai = 0.25 * (1.0 - m)
-        b = math.cosh(u)
-        t = math.tanh(u)
-        phi = 1.0 / b
-        twon = b * math.sinh(u)
-        out[0] = t + ai * (twon - u) / (b * b)
-        out[3] = 2.0 * math.atan(math.exp(u)) - 0.5 * math.pi + ai * (twon - u) / b
-        ai *= t * phi
-        out[1] = phi - ai * (twon - u)
-        out[2] = phi + ai * (twon + u)
-        return
+    ai = 0.25 * (1.0 - m)
+    b = math.cosh(u)
+    t = math.tanh(u)
+    phi = 1.0 / b
+    twon = b * math.sinh(u)
+    out[0] = t + ai * (twon - u) / (b * b)
+    out[3] = 2.0 * math.atan(math.exp(u)) - 0.5 * math.pi + ai * (twon - u) / b
+    ai *= t * phi
+    out[1] = phi - ai * (twon - u)
+    out[2] = phi + ai * (twon + u)
+
+
+@kernel(inline="always")
+def _jacobi_landen(u, m, out):
+    """:func:`jacobi` for ``1e-9 <= m < 1 - 1e-10``: the AGM's descending Landen transformation and
+    the backward recurrence for the amplitude."""
     # The AGM's levels 1 to 8 (a_i, c_i), in scalars: a kernel holds no array of its own. Eight
     # levels reach c / a <= 2^-53 for every m below 1 - 1e-10.
     a1 = a2 = a3 = a4 = a5 = a6 = a7 = a8 = 1.0
@@ -140,17 +158,23 @@ def jacobi(u, m, out):
         phi = (math.asin(t) + phi) / 2.0
     sn = math.sin(phi)
     cn = math.cos(phi)
+    out[0] = sn
+    out[1] = cn
+    out[2] = _delta_amplitude(m, sn, cn, phi, previous)
+    out[3] = phi
+
+
+@kernel(inline="always")
+def _delta_amplitude(m, sn, cn, phi, previous):
+    """:func:`jacobi`'s ``dn`` from the Landen branch's ``sn, cn``, its amplitude ``phi`` (``phi_0``)
+    and that of the first level, ``previous`` (``phi_1``)."""
     # dn = sqrt(1 - m sn^2) wherever that is well conditioned (dn^2 >= 1/4: always for m <= 3/4);
     # Cephes takes it only where cn / cos(phi_1 - phi_0) (DLMF 22.20.5) divides by less than 0.1,
     # a quotient whose error grows with |u| (the amplitudes' difference loses digits). Where dn is
     # small (m -> 1, sn -> +-1) the quotient is the accurate one.
     square = 1.0 - m * sn * sn
     divisor = math.cos(phi - previous)
-    dn = math.sqrt(square) if square >= 0.25 or abs(divisor) < 0.1 else cn / divisor
-    out[0] = sn
-    out[1] = cn
-    out[2] = dn
-    out[3] = phi
+    return math.sqrt(square) if square >= 0.25 or abs(divisor) < 0.1 else cn / divisor
 
 
 @kernel(python=True)
