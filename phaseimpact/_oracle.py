@@ -313,13 +313,7 @@ def oracle(params, law, t_end=None, *, rtol=1e-12, method="DOP853", settle=True,
     limit = limit if limit > 0 else math.inf
     stop_kind, stop_count = (stop_on, 1) if isinstance(stop_on, str) else (stop_on or (None, 0))
 
-    # mode: +1/-1 (sign factor while slipping; +1 for laws without stick), or "stuck"
-    if case.filippov and z[DD] == 0 and case.holds(z):
-        mode = "stuck"
-    elif case.filippov:
-        mode = 1 if z[DD] > 0 else (-1 if z[DD] < 0 else case.slip_mode(z))
-    else:
-        mode = 1
+    mode = _initial_mode(case, z)
     log = []  # (t, kind, z, force)
     max_force = case.force(z[D], z[DD], mode) if mode != "stuck" else case.required(z[X2])
     if z[D] == 0 and z[DD] > 0:
@@ -337,43 +331,7 @@ def oracle(params, law, t_end=None, *, rtol=1e-12, method="DOP853", settle=True,
         if t >= horizon or reason != "horizon":
             break
         t0 = t
-        flight = mode != "stuck" and case.unilateral and _side(z) < 0
-        events = []  # (event, kind or action tag)
-        if mode == "stuck":
-            def fun(_t, zz):
-                budget.spend()
-                return case.stuck_rates(zz)
-            # the pair's next turning point; from a turning point, the next one on the other side
-            # (without springs the pair moves on uniformly and nothing pulls it apart)
-            going = z[V2] if z[V2] != 0 else -case.spring(z[X2])
-            turn_dir = -1 if going > 0 else 1
-            if case.springs:
-                events.append((_event(lambda _t, zz: zz[V2], True, turn_dir, "turn"), "turn"))
-        else:
-            m = mode
-
-            def fun(_t, zz, m=m):
-                budget.spend()
-                return case.rates(zz, m)[0]
-
-            side = _side(z)
-            events.append((_event(lambda _t, zz: zz[D], True, -side, "delta"), "delta"))
-            if case.filippov and not flight:
-                events.append((_event(lambda _t, zz: zz[DD], True, -m, "deltadot"), "deltadot"))
-            else:
-                events.append((_event(lambda _t, zz: zz[DD], False, 0, "reversal"), "reversal"))
-            if not flight:
-                def rate(_t, zz, m=m):
-                    return case.force_rate(zz, m) if case.force(zz[D], zz[DD], m) != 0.0 else -1.0
-                events.append((_event(rate, False, -1, "force-peak"), "force-peak"))
-                if math.isfinite(limit):
-                    events.append((_event(lambda _t, zz: limit - case.energy(zz), True, -1, "runaway"), "runaway"))
-            elif case.springs and z[DD] + z[V2] < 0:
-                def reach(_t, zz):
-                    A = case.amplitude(0.5 * case.M2 * zz[V2] ** 2 + case.spring_energy(zz[X2]))
-                    return -(zz[D] + zz[X2] + A)
-                events.append((_event(reach, settle, 1, "settled"), "settled"))
-
+        fun, events, turn_dir = _phase(case, z, mode, limit, settle, budget)
         with np.errstate(over="ignore", invalid="ignore"):  # trial steps of a runaway overflow
             sol = solve_ivp(fun, (t, horizon), z, method=method, rtol=rtol, atol=atol,
                             events=[e for e, _ in events], dense_output=mode == "stuck")
@@ -393,19 +351,8 @@ def oracle(params, law, t_end=None, *, rtol=1e-12, method="DOP853", settle=True,
         terminal = next((e for e in found if e[3] and sol.status == 1 and e[0] == t_last), None)
         recorded = [e for e in found if not e[3] and (terminal is None or e[0] <= terminal[0])]
         if mode == "stuck":
-            # a stuck stretch: did the stick break in it? (its margin is smallest at its end)
-            if case.bound(z[D]) - abs(case.required(z_last[X2])) < 0:
-                t_b = _break_point(case, sol, t_last, z[D])
-                z_b = sol.sol(t_b)
-                z_b[D], z_b[DD] = z[D], 0.0
-                mode = case.slip_mode(z_b)
-                log.append((t_b, "slip", z_b.copy(), case.force(z_b[D], 0.0, mode)))
-                t, z = t_b, z_b
-            else:
-                t, z = t_last, z_last
-                if terminal is not None and turn_dir < 0 and not case.rigid:
-                    log.append((t, "force-peak", z.copy(), case.required(z[X2])))
-                    max_force = max(max_force, case.required(z[X2]))
+            t, z, mode, max_force = _end_stuck(case, sol, z, t_last, z_last, terminal is not None and turn_dir < 0,
+                                               log, max_force)
             if asked():
                 reason = "asked"
             continue
@@ -424,40 +371,118 @@ def oracle(params, law, t_end=None, *, rtol=1e-12, method="DOP853", settle=True,
         t, z = t_last, z_last
         if terminal is None:
             continue  # the horizon
-        tag = terminal[1]
-        if tag == "delta":
-            z[D] = 0.0  # the event is delta = 0
-            kind = "contact" if z[DD] > 0 else "separation"
-            if case.filippov and z[DD] != 0:
-                mode = 1 if z[DD] > 0 else -1
-            log.append((t, kind, z.copy(), case.force(0.0, z[DD], mode)))
-            if kind == "separation" and case.unilateral and not case.springs and settle:
-                reason = "settled"
-        elif tag == "deltadot":  # a Filippov slip comes to relative rest
-            if case.holds(z):
-                z = case.common_velocity(z)
-                mode = "stuck"
-                log.append((t, "stick", z.copy(), case.required(z[X2])))
-                max_force = max(max_force, case.required(z[X2]))
-                if settle and case.permanent(z):
-                    reason = "settled"
-            else:
-                new = case.slip_mode(z)
-                z = case.common_velocity(z)
-                if new != mode:
-                    mode = new
-                    log.append((t, "reversal", z.copy(), case.force(z[D], 0.0, mode)))
-        elif tag == "runaway":
-            log.append((t, "runaway", z.copy(), case.force(z[D], z[DD], mode)))
-            reason = "runaway"
-        elif tag == "settled":
-            log.append((t, "settled", z.copy(), 0.0))
-            reason = "settled"
+        z, mode, max_force, reason = _at_terminal(case, terminal[1], t, z, mode, log, max_force, settle)
         if reason == "horizon" and asked():
             reason = "asked"
     log.sort(key=lambda e: e[0])
     return OracleRun([e[1] for e in log], [float(e[0]) for e in log], [case.physical(e[2]) for e in log],
                      [float(e[3]) for e in log], case.physical(z), float(t), float(max_force), reason, nfev)
+
+
+def _initial_mode(case, z):
+    """The mode at the start: +1/-1 (sign factor while slipping; +1 for laws without stick), or
+    ``"stuck"``."""
+    if case.filippov and z[DD] == 0 and case.holds(z):
+        return "stuck"
+    if case.filippov:
+        return 1 if z[DD] > 0 else (-1 if z[DD] < 0 else case.slip_mode(z))
+    return 1
+
+
+def _phase(case, z, mode, limit, settle, budget):
+    """One phase of :func:`oracle` from ``z`` in ``mode``: its right-hand side for scipy, its events
+    ``[(event, kind or action tag)]`` and, while stuck, the direction of the turning point it looks
+    for (None otherwise)."""
+    flight = mode != "stuck" and case.unilateral and _side(z) < 0
+    events = []
+    turn_dir = None
+    if mode == "stuck":
+        def fun(_t, zz):
+            budget.spend()
+            return case.stuck_rates(zz)
+        # the pair's next turning point; from a turning point, the next one on the other side
+        # (without springs the pair moves on uniformly and nothing pulls it apart)
+        going = z[V2] if z[V2] != 0 else -case.spring(z[X2])
+        turn_dir = -1 if going > 0 else 1
+        if case.springs:
+            events.append((_event(lambda _t, zz: zz[V2], True, turn_dir, "turn"), "turn"))
+        return fun, events, turn_dir
+    m = mode
+
+    def fun(_t, zz, m=m):
+        budget.spend()
+        return case.rates(zz, m)[0]
+
+    side = _side(z)
+    events.append((_event(lambda _t, zz: zz[D], True, -side, "delta"), "delta"))
+    if case.filippov and not flight:
+        events.append((_event(lambda _t, zz: zz[DD], True, -m, "deltadot"), "deltadot"))
+    else:
+        events.append((_event(lambda _t, zz: zz[DD], False, 0, "reversal"), "reversal"))
+    if not flight:
+        def rate(_t, zz, m=m):
+            return case.force_rate(zz, m) if case.force(zz[D], zz[DD], m) != 0.0 else -1.0
+        events.append((_event(rate, False, -1, "force-peak"), "force-peak"))
+        if math.isfinite(limit):
+            events.append((_event(lambda _t, zz: limit - case.energy(zz), True, -1, "runaway"), "runaway"))
+    elif case.springs and z[DD] + z[V2] < 0:
+        def reach(_t, zz):
+            A = case.amplitude(0.5 * case.M2 * zz[V2] ** 2 + case.spring_energy(zz[X2]))
+            return -(zz[D] + zz[X2] + A)
+        events.append((_event(reach, settle, 1, "settled"), "settled"))
+    return fun, events, turn_dir
+
+
+def _end_stuck(case, sol, z, t_last, z_last, peaked, log, max_force):
+    """The end of a stuck stretch from ``z`` (scipy's ``sol``, to ``t_last, z_last``): did the stick
+    break in it? (its margin is smallest at its end) ``peaked``: it ended at the pair's turning
+    point towards the target. Logs what happened; returns ``t, z, mode, max_force``."""
+    if case.bound(z[D]) - abs(case.required(z_last[X2])) < 0:
+        t_b = _break_point(case, sol, t_last, z[D])
+        z_b = sol.sol(t_b)
+        z_b[D], z_b[DD] = z[D], 0.0
+        mode = case.slip_mode(z_b)
+        log.append((t_b, "slip", z_b.copy(), case.force(z_b[D], 0.0, mode)))
+        return t_b, z_b, mode, max_force
+    if peaked and not case.rigid:
+        log.append((t_last, "force-peak", z_last.copy(), case.required(z_last[X2])))
+        max_force = max(max_force, case.required(z_last[X2]))
+    return t_last, z_last, "stuck", max_force
+
+
+def _at_terminal(case, tag, t, z, mode, log, max_force, settle):
+    """The terminal event ``tag`` of a slipping phase at ``t, z``: logs it; returns ``z, mode,
+    max_force`` after it and the run's reason (``"horizon"``: it goes on)."""
+    reason = "horizon"
+    if tag == "delta":
+        z[D] = 0.0  # the event is delta = 0
+        kind = "contact" if z[DD] > 0 else "separation"
+        if case.filippov and z[DD] != 0:
+            mode = 1 if z[DD] > 0 else -1
+        log.append((t, kind, z.copy(), case.force(0.0, z[DD], mode)))
+        if kind == "separation" and case.unilateral and not case.springs and settle:
+            reason = "settled"
+    elif tag == "deltadot":  # a Filippov slip comes to relative rest
+        if case.holds(z):
+            z = case.common_velocity(z)
+            mode = "stuck"
+            log.append((t, "stick", z.copy(), case.required(z[X2])))
+            max_force = max(max_force, case.required(z[X2]))
+            if settle and case.permanent(z):
+                reason = "settled"
+        else:
+            new = case.slip_mode(z)
+            z = case.common_velocity(z)
+            if new != mode:
+                mode = new
+                log.append((t, "reversal", z.copy(), case.force(z[D], 0.0, mode)))
+    elif tag == "runaway":
+        log.append((t, "runaway", z.copy(), case.force(z[D], z[DD], mode)))
+        reason = "runaway"
+    elif tag == "settled":
+        log.append((t, "settled", z.copy(), 0.0))
+        reason = "settled"
+    return z, mode, max_force, reason
 
 
 @dataclass
