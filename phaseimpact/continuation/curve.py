@@ -194,8 +194,25 @@ def critical_curve(base: Parameters | Case, law: ContactLaw | str, param: str, v
     >>> [f"{k:.4g}" for k in c.kappa]
     ['1.36e+12', '1.499e+12']
     """
-    from scipy.optimize import brentq  # imported where used: 0.5 s at start-up
     law = as_law(law)
+    values, rtol = _checked(base, law, param, values, what, kappa_rtol, rtol)
+    correct = _corrector(law, what, contact_index, kappa_rtol, rtol)
+    first = _first_point(base, law, param, values, what, kappa_start, correct, kappa_rtol, rtol)
+    walk_x, walk_k, walk_req, walk_pred, message = _walk(base, param, values, first, correct, max_halvings,
+                                                         f"{what}({param})", progress)
+    walk_k = np.asarray(walk_k, dtype=float)
+    if what == "kappa_2":
+        walk_k, message = _kappa_2_along(base, law, param, walk_x, walk_k, rtol, message)
+    walk_x = np.asarray(walk_x)
+    closed = np.array([(closed_form_kappa_c(_parameters(base, param, x)) or math.nan) if what != "grazing"
+                       else math.nan for x in walk_x])
+    return CriticalCurve(param, walk_x, walk_k, np.asarray(walk_req), closed, np.asarray(walk_pred),
+                         what, law, base, kappa_rtol, contact_index, message)
+
+
+def _checked(base, law, param, values, what, kappa_rtol, rtol):
+    """:func:`critical_curve`'s arguments checked before any work: ``values`` as an array and the
+    integrator's ``rtol``."""
     if what not in CURVE_QUANTITIES:
         raise ValueError(f"what = {what!r} is out of range; allowed: one of {', '.join(CURVE_QUANTITIES)}")
     if what in ("kappa_c", "kappa_2") and not law.is_filippov:
@@ -211,6 +228,13 @@ def critical_curve(base: Parameters | Case, law: ContactLaw | str, param: str, v
     check_rtol_of_kappa(kappa_rtol)
     rtol = check_rtol(rtol)
     _parameters(base, param, values[0]), _parameters(base, param, values[-1])  # both ends valid: check first
+    return values, rtol
+
+
+def _corrector(law, what, contact_index, kappa_rtol, rtol):
+    """The corrector ``correct(p, guess, width)``: the root of the defining function within
+    ``guess * exp(+-width)``, None when it has none there."""
+    from scipy.optimize import brentq  # imported where used: 0.5 s at start-up
 
     def defining(p: Parameters, quantity: str):
         """The smooth function whose root in log(kappa) is the quantity (kappa_2 rides on kappa_c)."""
@@ -219,34 +243,40 @@ def critical_curve(base: Parameters | Case, law: ContactLaw | str, param: str, v
         return lambda x: first_stick_margin(p.replace(kappa=math.exp(x)), law, rtol=rtol)
 
     def correct(p: Parameters, guess: float, width: float) -> float | None:
-        """Corrector: the root of the defining function within ``guess * exp(+-width)``."""
         f = defining(p, "grazing" if what == "grazing" else "kappa_c")
         lo, hi = math.log(guess) - width, math.log(guess) + width
         f_lo, f_hi = f(lo), f(hi)
         if not (math.isfinite(f_lo) and math.isfinite(f_hi)) or (f_lo > 0) == (f_hi > 0):
             return None
         return math.exp(brentq(f, lo, hi, xtol=kappa_rtol / 4, rtol=4 * np.finfo(float).eps))
+    return correct
 
-    # the first point: an independent search (or the caller's start for a grazing value)
+
+def _first_point(base, law, param, values, what, kappa_start, correct, kappa_rtol, rtol) -> float:
+    """The curve's first point: an independent search (or the caller's start for a grazing value)."""
     p0 = _parameters(base, param, values[0])
     if what == "grazing":
         if kappa_start is None:
             raise ValueError("what = 'grazing' needs kappa_start (a grazing value at the first point, e.g. "
                              "from transitions())")
-        first = correct(p0, kappa_start, 1e-3) or kappa_start
-    else:
-        found = critical_damping(p0, law, kappa_rtol=kappa_rtol, rtol=rtol)
-        if found.kappa_c is None:
-            raise RunFailed(f"no kappa_c at {param} = {values[0]:g} to start from: {found.message}")
-        first = found.kappa_c
+        return correct(p0, kappa_start, 1e-3) or kappa_start
+    found = critical_damping(p0, law, kappa_rtol=kappa_rtol, rtol=rtol)
+    if found.kappa_c is None:
+        raise RunFailed(f"no kappa_c at {param} = {values[0]:g} to start from: {found.message}")
+    return found.kappa_c
+
+
+def _walk(base, param, values, first, correct, max_halvings, desc, progress):
+    """The walk from ``first`` over ``values`` (kappa_c or the grazing value; kappa_2 is located
+    from each kappa_c): the values walked, the roots, whether each was asked for, the predictions
+    and where the curve was lost ("" when it was not)."""
     log_x = bool(np.all(values > 0))
 
     def coordinate(x):
         return math.log(x) if log_x else x
 
-    # the walk continues kappa_c (or the grazing value); kappa_2 is located from each kappa_c
     walk_x, walk_k, walk_req, walk_pred = [float(values[0])], [first], [True], [first]
-    bar = tqdm(total=len(values), desc=f"{what}({param})", unit="pt", disable=not progress)
+    bar = tqdm(total=len(values), desc=desc, unit="pt", disable=not progress)
     bar.update(1)
     message = ""
     for target in values[1:]:
@@ -278,18 +308,17 @@ def critical_curve(base: Parameters | Case, law: ContactLaw | str, param: str, v
         if message:
             break
     bar.close()
-    walk_k = np.asarray(walk_k, dtype=float)
-    if what == "kappa_2":
-        found = [locate_kappa_2(_parameters(base, param, x), law, kc, kappa_rtol=KAPPA_2_RTOL, rtol=rtol, samples=0)
-                 for x, kc in zip(walk_x, walk_k, strict=True)]
-        # an unconfirmed kappa_2 (its bracket's counts move at a tighter tolerance) is left out, never guessed
-        walk_k = np.array([f.kappa_2 if f.kappa_2 is not None and not f.reason else math.nan for f in found])
-        unconfirmed = [f"{param} = {x:g} ({f.reason})" for x, f in zip(walk_x, found, strict=True) if f.reason]
-        if unconfirmed:
-            note = f"kappa_2 unconfirmed (left NaN) at {', '.join(unconfirmed)}"
-            message = f"{message}; {note}" if message else note
-    walk_x = np.asarray(walk_x)
-    closed = np.array([(closed_form_kappa_c(_parameters(base, param, x)) or math.nan) if what != "grazing"
-                       else math.nan for x in walk_x])
-    return CriticalCurve(param, walk_x, walk_k, np.asarray(walk_req), closed, np.asarray(walk_pred),
-                         what, law, base, kappa_rtol, contact_index, message)
+    return walk_x, walk_k, walk_req, walk_pred, message
+
+
+def _kappa_2_along(base, law, param, walk_x, walk_k, rtol, message):
+    """``kappa_2`` located from each continued ``kappa_c``, and the message with the unconfirmed ones."""
+    found = [locate_kappa_2(_parameters(base, param, x), law, kc, kappa_rtol=KAPPA_2_RTOL, rtol=rtol, samples=0)
+             for x, kc in zip(walk_x, walk_k, strict=True)]
+    # an unconfirmed kappa_2 (its bracket's counts move at a tighter tolerance) is left out, never guessed
+    kappa_2 = np.array([f.kappa_2 if f.kappa_2 is not None and not f.reason else math.nan for f in found])
+    unconfirmed = [f"{param} = {x:g} ({f.reason})" for x, f in zip(walk_x, found, strict=True) if f.reason]
+    if unconfirmed:
+        note = f"kappa_2 unconfirmed (left NaN) at {', '.join(unconfirmed)}"
+        message = f"{message}; {note}" if message else note
+    return kappa_2, message
