@@ -318,12 +318,25 @@ def test_engine_kernels_are_compiled_without_reference_counting():
     time of a trajectory)."""
     from numba.core.registry import CPUDispatcher
 
-    from phaseimpact.integrate import _dop853_stages, dop853, driver, events, phase, radau5, record, rk4, rootfind
+    from phaseimpact.integrate import (
+        _dop853_stages,
+        dop853,
+        driver,
+        events,
+        logs,
+        phase,
+        radau5,
+        record,
+        rk4,
+        rootfind,
+        step,
+    )
     from phaseimpact.model import laws
     from phaseimpact.model import rhs as rhs_module
 
     counted = set()
-    for module in (laws, rhs_module, events, _dop853_stages, dop853, radau5, record, phase, rootfind, driver, rk4):
+    for module in (laws, rhs_module, events, _dop853_stages, dop853, radau5, record, phase, rootfind, logs, step,
+                   driver, rk4):
         for name, obj in vars(module).items():
             if isinstance(obj, CPUDispatcher) and obj.py_func.__module__ == module.__name__:
                 assert "_nrt" in obj.targetoptions, f"{module.__name__}.{name} is not declared through _jit"
@@ -420,7 +433,19 @@ def test_no_kernel_returns_an_array():
     from numba.core import types
     from numba.core.registry import CPUDispatcher
 
-    from phaseimpact.integrate import _dop853_stages, dop853, driver, events, phase, radau5, record, rk4, rootfind
+    from phaseimpact.integrate import (
+        _dop853_stages,
+        dop853,
+        driver,
+        events,
+        logs,
+        phase,
+        radau5,
+        record,
+        rk4,
+        rootfind,
+        step,
+    )
     from phaseimpact.model import laws
     from phaseimpact.model import rhs as rhs_module
 
@@ -437,9 +462,10 @@ def test_no_kernel_returns_an_array():
         index = dispatcher._cache._cache_file._load_index()
         return [dispatcher._cache.load_overload(key[0], dispatcher.targetctx).signature.return_type for key in index]
 
-    assert any(holds_array(t) for t in return_types(driver.grow))  # the check sees an array return
+    assert any(holds_array(t) for t in return_types(logs.grow))  # the check sees an array return
     checked = 0
-    for module in (laws, rhs_module, events, _dop853_stages, dop853, radau5, record, phase, rootfind, driver, rk4):
+    for module in (laws, rhs_module, events, _dop853_stages, dop853, radau5, record, phase, rootfind, logs, step,
+                   driver, rk4):
         for name, obj in vars(module).items():
             if isinstance(obj, CPUDispatcher) and obj.py_func.__module__ == module.__name__ \
                     and not obj.targetoptions["_nrt"]:

@@ -11,6 +11,7 @@ import numpy as np
 from ..continuation import Transition
 from ..integrate import OUTCOMES, STATUSES
 from ..integrate import driver as _driver
+from ..integrate import logs as _logs
 from ..integrate.events import EVENT_KINDS
 from ..integrate.result import SUMMARY_COLUMNS, Trajectory
 from ..parameters import Parameters
@@ -113,19 +114,19 @@ def _write_transitions(f, items, created: str, context: _Context) -> None:
 
 def _read_trajectory(f) -> Trajectory:
     t = _data(f, "t", ndim=1, kinds="f")
-    samples = np.empty((len(t), _driver.N_SMP_COLUMNS))
-    samples[:, _driver.SMP_T] = t
+    samples = np.empty((len(t), _logs.N_SMP_COLUMNS))
+    samples[:, _logs.SMP_T] = t
     m = _data(f, "event_time", ndim=1, kinds="f").shape[0]
-    events = np.empty((m, _driver.N_EV_COLUMNS))
-    events[:, _driver.EV_T] = _shaped(f, "event_time", (m,))
-    events[:, _driver.EV_KIND] = _checked_codes(f, "event_kind", EVENT_KINDS, (m,))
-    events[:, _driver.EV_MODE] = _shaped(f, "event_mode", (m,), "i")
+    events = np.empty((m, _logs.N_EV_COLUMNS))
+    events[:, _logs.EV_T] = _shaped(f, "event_time", (m,))
+    events[:, _logs.EV_KIND] = _checked_codes(f, "event_kind", EVENT_KINDS, (m,))
+    events[:, _logs.EV_MODE] = _shaped(f, "event_mode", (m,), "i")
     for i, (name, _, _) in enumerate(_STATE):
-        samples[:, _driver.SMP_Y + i] = _shaped(f, name, t.shape)
-        events[:, _driver.EV_Y + i] = _shaped(f, f"event_{name}", (m,))
-    samples[:, _driver.SMP_FORCE] = _shaped(f, "force", t.shape)
-    samples[:, _driver.SMP_MODE] = _shaped(f, "mode", t.shape, "i")
-    events[:, _driver.EV_FORCE] = _shaped(f, "event_force", (m,))
+        samples[:, _logs.SMP_Y + i] = _shaped(f, name, t.shape)
+        events[:, _logs.EV_Y + i] = _shaped(f, f"event_{name}", (m,))
+    samples[:, _logs.SMP_FORCE] = _shaped(f, "force", t.shape)
+    samples[:, _logs.SMP_MODE] = _shaped(f, "mode", t.shape, "i")
+    events[:, _logs.EV_FORCE] = _shaped(f, "event_force", (m,))
     summary = np.empty(_driver.N_SUMMARY)
     names = {}
     for name, index, table in (("status", _driver.S_STATUS, STATUSES), ("outcome", _driver.S_OUTCOME, OUTCOMES),

@@ -18,7 +18,7 @@ from ..model.laws import ContactLaw, as_law
 from ..model.rhs import N_COEF, initial_state, pack
 from ..parameters import Parameters, is_number
 from . import driver as d
-from . import radau5
+from . import logs, radau5
 from .events import EVENT_KINDS
 from .record import W_SUMMARY, W_Y, Y_STATE, workspace
 from .result import Columns, Trajectory
@@ -526,7 +526,7 @@ def run_batch(batch: Batch, *, rtol: float, settle: bool = True, stop_on=None, n
         k = int(count[i])
         full = np.empty((3, k))
         s = out[0]
-        d.stick_points(out[1], s[d.S_T_STOP], s[d.S_OUTCOME] == d.PERMANENT_STICK, full[0], full[1], full[2])
+        logs.stick_points(out[1], s[d.S_T_STOP], s[d.S_OUTCOME] == d.PERMANENT_STICK, full[0], full[1], full[2])
         offset = int(np.minimum(count[:i], capacity).sum())
         points = [np.concatenate([p[:offset], full[j], p[offset + capacity:]]) for j, p in enumerate(points)]
     return Columns.from_summary(summary, count, *points)

@@ -12,6 +12,7 @@ from ..model.laws import ContactLaw
 from ..model.rhs import V1, V2, X1, X2
 from ..parameters import Parameters
 from . import driver as d
+from . import logs
 from .events import EVENT_KINDS
 
 __all__ = ["Event", "Trajectory", "Columns", "STATUSES", "OUTCOMES", "EVENT_KINDS", "run_message"]
@@ -141,7 +142,7 @@ class Trajectory:
         The event log as arrays (``event_kind`` indexes :data:`EVENT_KINDS`).
     samples, event_log : ndarray
         Both as the driver returns them, one row per sample or event (columns ``SMP_*`` and
-        ``EV_*`` of :mod:`.driver`); the arrays above are views of them (kinds and modes as integers).
+        ``EV_*`` of :mod:`.logs`); the arrays above are views of them (kinds and modes as integers).
     params, law : Parameters, ContactLaw
         What was integrated.
     initial_state, final_state : ndarray, shape (5,)
@@ -191,47 +192,47 @@ class Trajectory:
     @property
     def t(self) -> np.ndarray:
         """Sample times, s (empty for a summary run)."""
-        return self.samples[:, d.SMP_T]
+        return self.samples[:, logs.SMP_T]
 
     @property
     def y(self) -> np.ndarray:
         """Sampled states ``(x1, x2, x1dot, x2dot, W)``, shape ``(n, 5)``: m, m, m/s, m/s, J."""
-        return self.samples[:, d.SMP_Y:d.SMP_Y + 5]
+        return self.samples[:, logs.SMP_Y:logs.SMP_Y + 5]
 
     @property
     def force(self) -> np.ndarray:
         """Contact force at the samples, N."""
-        return self.samples[:, d.SMP_FORCE]
+        return self.samples[:, logs.SMP_FORCE]
 
     @cached_property
     def mode(self) -> np.ndarray:
         """Mode at the samples (``paper``: +-1 slipping, 0 stuck)."""
-        return self.samples[:, d.SMP_MODE].astype(np.int64)
+        return self.samples[:, logs.SMP_MODE].astype(np.int64)
 
     @property
     def event_t(self) -> np.ndarray:
         """Event times, s."""
-        return self.event_log[:, d.EV_T]
+        return self.event_log[:, logs.EV_T]
 
     @cached_property
     def event_kind(self) -> np.ndarray:
         """Event kinds as indices into :data:`EVENT_KINDS`."""
-        return self.event_log[:, d.EV_KIND].astype(np.int64)
+        return self.event_log[:, logs.EV_KIND].astype(np.int64)
 
     @cached_property
     def event_mode(self) -> np.ndarray:
         """Mode after each event."""
-        return self.event_log[:, d.EV_MODE].astype(np.int64)
+        return self.event_log[:, logs.EV_MODE].astype(np.int64)
 
     @property
     def event_y(self) -> np.ndarray:
         """States ``(x1, x2, x1dot, x2dot, W)`` at the events, shape ``(n_events, 5)``."""
-        return self.event_log[:, d.EV_Y:d.EV_Y + 5]
+        return self.event_log[:, logs.EV_Y:logs.EV_Y + 5]
 
     @property
     def event_force(self) -> np.ndarray:
         """Contact force at the events, N."""
-        return self.event_log[:, d.EV_FORCE]
+        return self.event_log[:, logs.EV_FORCE]
 
     @property
     def message(self) -> str:
@@ -400,7 +401,7 @@ class Trajectory:
         """
         n = int(np.count_nonzero(self.event_kind == EVENT_KINDS.index("stick")))
         out = np.empty((3, n))
-        d.stick_points(self.event_log, self.t_stop, self.outcome == "permanent-stick", out[0], out[1], out[2])
+        logs.stick_points(self.event_log, self.t_stop, self.outcome == "permanent-stick", out[0], out[1], out[2])
         return out[0], out[1], out[2]
 
 

@@ -22,14 +22,12 @@ from .driver import (
     SAVE_STEPS,
     SUCCESS,
     TOO_MANY_STEPS,
-    add_sample,
-    grow,
-    log_event,
     new_logs,
     open_logs,
     summarize,
 )
 from .events import CONTACT, SEPARATION, energy_limit_of
+from .logs import add_sample, grow, log_event
 from .phase import copy_values
 from .record import (
     I_LOGGING,
