@@ -365,7 +365,7 @@ def test_laminate_case_round_trips_and_takes_settings(tmp_path):
 def test_laminate_cases_state_the_isotropic_approximations_error(name):
     """The numbers each laminate case's source quotes: the isotropic approximation it used before
     (E = E3 = 16.7 GPa, nu = 0.17, derived here through the isotropic path) against its plies."""
-    from phaseimpact.model.laminate import bending_stiffness
+    from phaseimpact.model.plate_stiffness import bending_stiffness
     from phaseimpact.parameters import derive_parameters
 
     case = load_case(name)
