@@ -18,18 +18,10 @@ import numpy as np
 import pytest
 
 from phaseimpact import seed_parameters
-from phaseimpact.case import (
-    SETTABLE,
-    Case,
-    apply_settings,
-    case_from_dict,
-    list_cases,
-    load_case,
-    parse_setting,
-    seed_case,
-)
+from phaseimpact.case import Case, case_from_dict, list_cases, load_case, seed_case
 from phaseimpact.model.contact import hertz_scales, validity
 from phaseimpact.parameters import Geometry, Material
+from phaseimpact.settings import SETTABLE, apply_settings, parse_setting
 
 CASES_DIR = Path(__file__).resolve().parents[1] / "phaseimpact" / "cases"
 SHIPPED = sorted(p.stem for p in CASES_DIR.glob("*.toml"))
