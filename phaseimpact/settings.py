@@ -10,7 +10,7 @@ from collections.abc import Mapping
 
 from .parameters import V_RANGE, Geometry, _replace_material, is_number, require_in, validate_geometry
 
-__all__ = ["SETTABLE", "QUANTITIES", "GEOMETRY_KEYS", "apply_settings", "parse_setting", "setting_name"]
+__all__ = ["SETTABLE", "QUANTITIES", "GEOMETRY_KEYS", "apply_settings", "parse_setting"]
 
 #: Every name ``--set NAME=VALUE`` accepts (each key of the case schema but the text ones):
 #: ``{name: (unit, description)}`` (SI units). The schema's own spellings ``geometry.a`` and

@@ -7,6 +7,15 @@ side, the Jacobian, the event functions and the energy ledger (:mod:`phaseimpact
 composed from them. How to add a form: the guide of :mod:`phaseimpact.model.laws` ("Adding a law";
 its inlining rule holds here).
 
+Examples
+--------
+Hertz's force ``K delta^(3/2)`` of ``abrate`` at ``delta = 10 um``, ``K = 1e10 N/m^1.5``:
+
+>>> from phaseimpact.model import ContactLaw
+>>> from phaseimpact.model.forms import contact_force
+>>> print(f"{contact_force(ContactLaw('abrate').code, 1e-5, 0.0, 1, 1e10, 0.0, 1.5):.6g} N")
+316.228 N
+
 The engine's compiled cache is keyed on a digest of these sources: the next run recompiles.
 """
 
@@ -20,7 +29,7 @@ from .._jit import kernel
 __all__ = [
     "contact_force", "force_partials", "contact_potential", "stick_bound", "hertz_power", "is_filippov",
     "is_unilateral", "has_memory", "contact_gap", "dent_depth", "remember", "force_of", "partials_of", "potential_of",
-    "make_code", "FORMS", "STUCK", "PLAIN",
+    "STUCK", "PLAIN",
 ]
 
 # A kernel code is an integer (the compiled loop reads no strings): its low bits are the law's
