@@ -40,7 +40,7 @@ from phaseimpact._oracle import oracle  # noqa: E402
 from phaseimpact.integrate import api  # noqa: E402
 from phaseimpact.integrate import driver as d  # noqa: E402
 from phaseimpact.model import as_law, pack  # noqa: E402
-from phaseimpact.model.laws import PLAIN  # noqa: E402
+from phaseimpact.model.forms import PLAIN  # noqa: E402
 from phaseimpact.model.rhs import rhs  # noqa: E402
 
 RTOL = 1e-10

@@ -44,7 +44,7 @@ from phaseimpact import _oracle as oracle_module  # noqa: E402
 from phaseimpact import seed_parameters, simulate  # noqa: E402
 from phaseimpact.integrate import api  # noqa: E402
 from phaseimpact.model import as_law, pack  # noqa: E402
-from phaseimpact.model.laws import PLAIN  # noqa: E402
+from phaseimpact.model.forms import PLAIN  # noqa: E402
 from phaseimpact.model.rhs import rhs  # noqa: E402
 
 T_END = 2e-3

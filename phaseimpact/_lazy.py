@@ -23,3 +23,18 @@ def attach(package: str, namespace: dict, exports: dict[str, str]):
         return sorted(set(namespace) | set(exports))
 
     return __getattr__, __dir__
+
+
+class NumPyOnFirstUse:
+    """NumPy, imported when a module first reads an attribute of it: ``np = NumPyOnFirstUse(globals())``
+    (the commands that integrate nothing import such a module but never NumPy). The first access
+    replaces ``np`` in ``namespace`` by NumPy itself, so later accesses cost nothing."""
+
+    def __init__(self, namespace: dict):
+        self._namespace = namespace
+
+    def __getattr__(self, name):
+        import numpy
+
+        self._namespace["np"] = numpy
+        return getattr(numpy, name)

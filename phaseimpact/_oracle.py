@@ -3,7 +3,7 @@
 functions and restart logic.
 
 It shares exactly one thing with the engine: the law's force function
-:func:`phaseimpact.model.laws.contact_force` (the law under test). Everything else (the plate,
+:func:`phaseimpact.model.forms.contact_force` (the law under test). Everything else (the plate,
 the stuck pair, the event functions, the force rate, the stick/slip decisions, the energy, the
 settling rules, tolerances and horizon) is written here from the physics, so that a bug in the
 engine's event table or transitions shows up as a disagreement instead of being copied. Even the
@@ -69,7 +69,8 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from phaseimpact.model.laws import ContactLaw, contact_force
+from phaseimpact.model.forms import contact_force
+from phaseimpact.model.laws import ContactLaw
 
 __all__ = ["OracleRun", "oracle", "compare", "Agreement", "Budget", "BudgetExceeded"]
 

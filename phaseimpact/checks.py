@@ -169,7 +169,8 @@ def damping_number(params, law) -> float:
     >>> damping_number(p, "abrate")
     0.0
     """
-    from .model.laws import as_law, contact_force
+    from .model.forms import contact_force
+    from .model.laws import as_law
     from .model.rhs import pack
 
     law = as_law(law)
@@ -263,7 +264,7 @@ def _simulate(params, law, t_end=None, **options):
 
 
 def _force(law, params):
-    from .model.laws import force_of
+    from .model.forms import force_of
     from .model.rhs import pack
 
     c = pack(params, law)
@@ -297,7 +298,7 @@ def _force(law, params):
 def _repulsive(law, params):
     """On loading (``delta > 0``, ``deltadot >= 0``) the force pushes the bodies apart: ``P >= 0``,
     and ``P > 0`` somewhere (at depths up to twice the Hertz indentation, speeds up to ``v``)."""
-    from .model.laws import force_of
+    from .model.forms import force_of
     from .model.rhs import pack
 
     c = pack(params, law)
@@ -318,7 +319,7 @@ def _repulsive(law, params):
 
 
 def _partials(law, params):
-    from .model.laws import force_of, partials_of
+    from .model.forms import force_of, partials_of
     from .model.rhs import pack
 
     c = pack(params, law)
@@ -346,7 +347,7 @@ def _partials(law, params):
 
 
 def _energy(law, params):
-    from .model.laws import potential_of
+    from .model.forms import potential_of
     from .model.rhs import energy, pack
 
     tr, failed = _simulate(params, law, 4e-3)
@@ -395,7 +396,7 @@ def _scipy(law, params):
     from scipy.integrate import solve_ivp
 
     from ._oracle import Budget
-    from .model.laws import force_of, remember
+    from .model.forms import force_of, remember
     from .model.rhs import pack
 
     if law.is_filippov:

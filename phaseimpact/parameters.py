@@ -79,18 +79,18 @@ def require(name: str, value, allowed: str, ok: bool) -> None:
 
 
 def require_positive(name: str, value) -> None:
-    require(name, value, "a finite number > 0", _is_finite(value) and value > 0)
+    require(name, value, "a finite number > 0", is_finite_number(value) and value > 0)
 
 
 def require_nonnegative(name: str, value) -> None:
-    require(name, value, "a finite number >= 0", _is_finite(value) and value >= 0)
+    require(name, value, "a finite number >= 0", is_finite_number(value) and value >= 0)
 
 
 def require_in(name: str, value, bounds: tuple, unit: str = "") -> None:
     """``low <= value <= high`` for finite numbers; the message gives the range and the unit."""
     low, high = bounds
     require(name, value, f"{low:g} <= {name} <= {high:g}" + (f" ({unit})" if unit else ""),
-            _is_finite(value) and low <= value <= high)
+            is_finite_number(value) and low <= value <= high)
 
 
 def require_choice(name: str, value, choices) -> None:
@@ -105,7 +105,8 @@ def is_number(value) -> bool:
     return isinstance(value, numbers.Real) and not isinstance(value, bool)
 
 
-def _is_finite(value) -> bool:
+def is_finite_number(value) -> bool:
+    """True for a finite real number (:func:`is_number`)."""
     return is_number(value) and math.isfinite(value)
 
 
@@ -135,13 +136,13 @@ def validate_material(values: Mapping, prefix: str = "") -> None:
     """
     require_in(prefix + "E", values["E"], MODULUS_RANGE, "Pa")
     nu = values["nu"]
-    require(prefix + "nu", nu, "0 <= nu < 0.5", _is_finite(nu) and 0 <= nu < 0.5)
+    require(prefix + "nu", nu, "0 <= nu < 0.5", is_finite_number(nu) and 0 <= nu < 0.5)
     require_in(prefix + "rho", values["rho"], DENSITY_RANGE, "kg/m^3")
     strength = values.get("yield_strength")
     if strength is not None:
         low, high = STRENGTH_RANGE
         require(prefix + "yield_strength", strength, f"{low:g} <= {prefix}yield_strength <= {high:g} (Pa), or absent",
-                _is_finite(strength) and low <= strength <= high)
+                is_finite_number(strength) and low <= strength <= high)
 
 
 def validate_geometry(values: Mapping, prefix: str = "") -> None:
@@ -308,7 +309,7 @@ class Parameters:
         for name in ("R", "limiting_pressure", "impedance"):
             value = getattr(self, name)
             if value is not None:
-                require(name, value, "a finite number > 0, or None", _is_finite(value) and value > 0)
+                require(name, value, "a finite number > 0, or None", is_finite_number(value) and value > 0)
         if self.target == "infinite":
             require("impedance", self.impedance, "a finite number > 0 (N s/m) for target 'infinite': the plate's "
                     "point impedance 8 sqrt(D rho h), which derive_parameters fills", self.impedance is not None)
@@ -588,7 +589,7 @@ def parameters_with(
     passed = {name: overrides.pop(name) for name in ("alpha", "kappa", "target", "membrane") if name in overrides}
     if "kappa" in passed:  # an input: bounded as on the command line (searches may go beyond it)
         require("kappa", passed["kappa"], f"0 <= kappa <= {KAPPA_MAX:g} (N s/m^(1+alpha))",
-                _is_finite(passed["kappa"]) and 0 <= passed["kappa"] <= KAPPA_MAX)
+                is_finite_number(passed["kappa"]) and 0 <= passed["kappa"] <= KAPPA_MAX)
     if "v" in overrides:
         v = overrides.pop("v")
     params = derive_parameters(materials["projectile"], materials["plate"], geometry, v=v, **passed)

@@ -23,9 +23,10 @@ from matplotlib.ticker import NullFormatter
 
 from phaseimpact import scales
 from phaseimpact.archive import save_h5
-from phaseimpact.case import apply_settings, load_case
+from phaseimpact.case import load_case
 from phaseimpact.continuation import critical_curve, critical_damping
 from phaseimpact.plotting import figure, save, style
+from phaseimpact.settings import apply_settings
 
 FIGURES = Path(__file__).resolve().parents[1] / "figures"
 NAME = "critical_surface"

@@ -32,7 +32,8 @@ from _plots import V_LABEL, claim, known, log_ticks
 
 from phaseimpact.archive import save_h5
 from phaseimpact.case import load_case
-from phaseimpact.model.laminate import as_laminate, olsson_rigidity
+from phaseimpact.model.laminate import as_laminate
+from phaseimpact.model.plate_stiffness import olsson_rigidity
 from phaseimpact.model.regime import (
     LARGE_MASS_RATIO,
     REGIMES,

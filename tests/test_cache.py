@@ -20,7 +20,7 @@ from phaseimpact import _jit
 ROOT = Path(__file__).resolve().parents[1]
 
 # One Hunt-Crossley run through the driver's cached machine code (the stale path of issue 22:
-# numba checked only driver.py, while the force is compiled into the driver from model/laws.py).
+# numba checked only driver.py, while the force is compiled into the driver from model/forms.py).
 RUN = r"""
 import json, sys
 import phaseimpact
@@ -60,7 +60,7 @@ def test_the_digest_covers_every_engine_file_and_only_those(tmp_path):
 
 @pytest.mark.slow
 def test_editing_a_kernel_in_a_copy_changes_the_next_run(tmp_path):
-    """Copy the package, run, double the Hertz power in model/laws.py (a kernel the driver inlines),
+    """Copy the package, run, double the Hertz power in model/forms.py (a kernel the driver inlines),
     run again in a fresh process on the same cache root: the new force, not the cached one. (Two
     first compiles: numba keys its files on each source folder's absolute path, so the copy cannot
     start from the checkout's cache.)"""
@@ -78,12 +78,12 @@ def test_editing_a_kernel_in_a_copy_changes_the_next_run(tmp_path):
     assert first["cache"] == str(root / _jit.cache_name())
     assert first["max_force"] == expected
 
-    laws = package / "model" / "laws.py"
-    text = laws.read_text()
+    forms = package / "model" / "forms.py"
+    text = forms.read_text()
     edited = re.sub(r"(def hertz_power\(ad, alpha\):\n(?:    .*\n)*?)(    )(if alpha == 1\.5:)",
                     r"\1\2return 2.0 * ad**alpha\n\2\3", text, count=1)
     assert edited != text, "hertz_power's body was not found: update this test's edit"
-    laws.write_text(edited)
+    forms.write_text(edited)
     second = _run(RUN, package.parent, NUMBA_CACHE_DIR=str(root))
     assert second.returncode == 0, second.stderr[-3000:]
     assert "compiling the engine once for this machine" in second.stderr
@@ -164,13 +164,13 @@ def test_a_read_only_install_with_no_home_never_crashes(tmp_path):
         assert cases.returncode == 0 and "seed" in cases.stdout and cases.stderr == "", cases.stderr
         # every compiled module imports (before: "cannot cache function ...: no locator available"),
         # and a kernel compiles, for this process only
-        kernel = run("-c", "import json, phaseimpact.integrate.api; from phaseimpact.model import laws; "
+        kernel = run("-c", "import json, phaseimpact.integrate.api; from phaseimpact.model import forms; "
                            "from phaseimpact._jit import cache_info; "
-                           "print(json.dumps([laws.__file__, str(cache_info().path), "
-                           "laws.contact_force(2, 1e-5, 0.1, 1, 1e10, 3e9, 1.5)]))")
+                           "print(json.dumps([forms.__file__, str(cache_info().path), "
+                           "forms.contact_force(2, 1e-5, 0.1, 1, 1e10, 3e9, 1.5)]))")
         assert kernel.returncode == 0, kernel.stderr[-3000:]
         file, cache, force = json.loads(kernel.stdout)
-        assert file == str(package / "model" / "laws.py") and cache == "None" and force > 0
+        assert file == str(package / "model" / "forms.py") and cache == "None" and force > 0
     finally:
         for path in [base, *base.rglob("*")]:
             path.chmod(0o755)

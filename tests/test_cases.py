@@ -18,18 +18,10 @@ import numpy as np
 import pytest
 
 from phaseimpact import seed_parameters
-from phaseimpact.case import (
-    SETTABLE,
-    Case,
-    apply_settings,
-    case_from_dict,
-    list_cases,
-    load_case,
-    parse_setting,
-    seed_case,
-)
+from phaseimpact.case import Case, case_from_dict, list_cases, load_case, seed_case
 from phaseimpact.model.contact import hertz_scales, validity
 from phaseimpact.parameters import Geometry, Material
+from phaseimpact.settings import SETTABLE, apply_settings, parse_setting
 
 CASES_DIR = Path(__file__).resolve().parents[1] / "phaseimpact" / "cases"
 SHIPPED = sorted(p.stem for p in CASES_DIR.glob("*.toml"))
@@ -365,7 +357,7 @@ def test_laminate_case_round_trips_and_takes_settings(tmp_path):
 def test_laminate_cases_state_the_isotropic_approximations_error(name):
     """The numbers each laminate case's source quotes: the isotropic approximation it used before
     (E = E3 = 16.7 GPa, nu = 0.17, derived here through the isotropic path) against its plies."""
-    from phaseimpact.model.laminate import bending_stiffness
+    from phaseimpact.model.plate_stiffness import bending_stiffness
     from phaseimpact.parameters import derive_parameters
 
     case = load_case(name)

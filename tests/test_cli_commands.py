@@ -26,8 +26,8 @@ import phaseimpact.analysis as analysis
 import phaseimpact.continuation as continuation
 import phaseimpact.integrate as integrate
 from phaseimpact import archive
-from phaseimpact.case import SETTABLE
 from phaseimpact.plotting import OUTCOME_COLOURS
+from phaseimpact.settings import SETTABLE
 
 CASES_DIR = Path(__file__).resolve().parents[1] / "phaseimpact" / "cases"
 SHIPPED = sorted(p.stem for p in CASES_DIR.glob("*.toml"))

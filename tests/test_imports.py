@@ -23,7 +23,7 @@ LAYERS = (
     ("parameters",),
     ("model",),  # all physics: laws, equations of motion, restitution, contact mechanics
     ("integrate", "_oracle", "cuda"),  # trajectories (the scipy oracle of the checks; the GPU's launches)
-    ("case",),  # case files and settings (read the laws' names)
+    ("case", "settings"),  # case files (read the laws' names) and their --set settings
     ("analysis", "quantities", "checks"),  # one trajectory or one law at a time
     ("continuation",),  # sweeps, atlases, transitions, curves (the only joblib/Dask importer)
     ("maps", "train"),  # maps of a state to the next (ImpactMap), trains of impacts; train is the face

@@ -10,8 +10,8 @@ import jsonschema
 import pytest
 from _cli import run
 
-from phaseimpact.case import QUANTITIES
 from phaseimpact.cli import CURVE_PARAMETERS, CURVE_WHATS, JSON_SCHEMA_VERSION, build_parser
+from phaseimpact.settings import QUANTITIES
 
 SCHEMA = json.loads(resources.files("phaseimpact").joinpath(f"schemas/cli-{JSON_SCHEMA_VERSION}.json").read_text())
 VALIDATOR = jsonschema.Draft202012Validator(SCHEMA)

@@ -10,7 +10,7 @@ from _registry import restored_registry
 from phaseimpact import ContactLaw, seed_parameters, simulate
 from phaseimpact.checks import check_law, damping_number, with_damping_number
 from phaseimpact.model import REGISTRY, jacobian, law_variants, pack
-from phaseimpact.model.laws import (
+from phaseimpact.model.forms import (
     ADDRESS_SHIFT,
     ELASTIC,
     FORM_MASK,
@@ -22,7 +22,6 @@ from phaseimpact.model.laws import (
     STUCK,
     THORNTON,
     UNILATERAL,
-    LawEntry,
     contact_force,
     contact_potential,
     force_of,
@@ -31,10 +30,10 @@ from phaseimpact.model.laws import (
     make_code,
     partials_of,
     potential_of,
-    register,
     remember,
     stick_bound,
 )
+from phaseimpact.model.laws import LawEntry, register
 from phaseimpact.model.rhs import energy
 
 VARIANTS = law_variants()

@@ -13,7 +13,8 @@ from scipy.linalg import expm
 from phaseimpact import seed_parameters
 from phaseimpact._jit import kernel
 from phaseimpact.integrate import dop853, radau5
-from phaseimpact.model.laws import PLAIN, ContactLaw
+from phaseimpact.model.forms import PLAIN
+from phaseimpact.model.laws import ContactLaw
 from phaseimpact.model.rhs import ALPHA_, K_, KB_, KM_, M1_, M2_, PLAIN_PHASE, pack, rhs_integration
 
 #: The system's fastest angular frequency times the horizon: a few radians, so that the largest

@@ -228,7 +228,8 @@ def undamped_max_force():
 @functools.cache
 def yang_sun_over_exact(nu):
     """Yang-Sun's half-space compliance of an isotropic face over the exact one (docs/physics.md §8)."""
-    from phaseimpact.model.laminate import Ply, transversely_isotropic_compliance, yang_sun_compliance
+    from phaseimpact.model.laminate import Ply
+    from phaseimpact.model.plate_stiffness import transversely_isotropic_compliance, yang_sun_compliance
 
     E = 2.1e11
     return (yang_sun_compliance(Ply.isotropic(E, nu, 7850.0, 1e-3))
@@ -261,7 +262,7 @@ def laminate_case_ratios():
     """The blade laminate cases against the isotropic approximation they used before (E = 16.7 GPa,
     nu = 0.17): bending alone, Kbs of sand and of hail, K of sand and of hail, Km (docs/physics.md §8)."""
     from phaseimpact.case import load_case
-    from phaseimpact.model.laminate import bending_stiffness
+    from phaseimpact.model.plate_stiffness import bending_stiffness
     from phaseimpact.parameters import Material, derive_parameters
 
     ratios = {}

@@ -12,7 +12,12 @@ from phaseimpact.cli import main
 from phaseimpact.continuation import Axis, atlas
 from phaseimpact.model import pack
 from phaseimpact.model.contact import hertz_scales, plastic_validity
-from phaseimpact.model.laws import DENT_, force_of, partials_of, remember
+from phaseimpact.model.forms import (
+    DENT_,
+    force_of,
+    partials_of,
+    remember,
+)
 from phaseimpact.parameters import FIRST_YIELD_FACTOR, STEEL, seed_parameters
 
 P_Y = 1.6e9  # Pa: the seed's steel ball then yields at about 0.14 m/s on a rigid wall

@@ -106,7 +106,7 @@ def test_a_bilateral_user_law_acts_in_tension():
     define_law("spring", linear, unilateral=False, potential=lambda d, K, a: 0.5e6 * d * d)
     law = ContactLaw("spring")
     assert not law.is_unilateral
-    from phaseimpact.model.laws import contact_force
+    from phaseimpact.model.forms import contact_force
 
     assert contact_force(law.code, -1e-3, 0.0, 1, 1.0, 0.0, 1.5) == pytest.approx(-1e3)
     p = seed_parameters(v=1.0, target="free")

@@ -70,7 +70,7 @@ def kappa_units(alpha: float, law=None) -> str:
 def axis_units(name: str, alpha: float, law=None) -> str:
     """Units of a grid axis or curve parameter in UDUNITS syntax (``alpha``: the base case's
     exponent; ``law``: whose entry gives the damping's unit); see :func:`unit_attributes`."""
-    from ..case import SETTABLE
+    from ..settings import SETTABLE
 
     fixed = {"kappa": kappa_units(alpha, law), "K": f"N m-{_g(alpha)}", "v": "m s-1", "M1": "kg", "M2": "kg",
              "Kb": "N m-1", "Km": "N m-3", "alpha": "1", "R": "m"}

@@ -6,8 +6,8 @@ from __future__ import annotations
 import dataclasses
 import math
 
-from ..case import setting_name
 from ..parameters import KAPPA_MAX, V_RANGE
+from ..settings import setting_name
 from ._common import KAPPA_UNIT, RESTITUTION_RANGE
 
 

@@ -208,7 +208,7 @@ _case.__name__ = "case"
 
 def _setting(text):
     """argparse type: ``NAME=VALUE`` with a settable name and a number (its range is checked with the case)."""
-    from ..case import parse_setting
+    from ..settings import parse_setting
 
     try:
         parse_setting(text)

@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import argparse
 
-from ..case import SETTABLE
 from ..parameters import KAPPA_MAX, TARGETS, V_RANGE
+from ..settings import SETTABLE
 from ._common import (
     _KAPPA,
     _KAPPA_RTOL,

@@ -5,8 +5,8 @@ from __future__ import annotations
 import sys
 
 from .._atomic import exclusive
-from ..case import QUANTITIES, SETTABLE
 from ..parameters import V_RANGE
+from ..settings import QUANTITIES, SETTABLE
 from . import _options as options
 from ._case import (
     Setup,

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import argparse
 
-from ..case import SETTABLE
+from ..settings import SETTABLE
 from . import _options as options
 from ._common import EXIT_OK, _print_json
 

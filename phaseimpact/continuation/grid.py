@@ -14,11 +14,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..case import QUANTITIES, SETTABLE, Case
+from ..case import Case
 from ..integrate.api import Batch, check_rtol, hertz_contact_time, pack_batch, scales, state_tolerances
 from ..model.laws import ContactLaw
 from ..model.rhs import ALPHA_, DAMP_, K_, M1_, pack
 from ..parameters import KAPPA_MAX, PARAMETER_NAMES, V_RANGE, Parameters, is_number
+from ..settings import QUANTITIES, SETTABLE
 
 __all__ = ["Axis", "Grid", "parse_axis", "MAX_POINTS"]
 

@@ -29,7 +29,7 @@ import numpy as np
 
 from .._jit import allocating, kernel
 from .._signals import interrupted
-from ..model.laws import STUCK
+from ..model.forms import STUCK
 from ..model.rhs import (
     FLIGHT,
     V1,
@@ -249,7 +249,7 @@ def open_logs(ws, ev, smp, times, force):
 @kernel
 def _start(code, ws, ev, smp, times):
     """A run from the start state (row ``Y_START``), coefficients (``W_C``, the run's own: a law's
-    memory is written into them, model.laws.remember), tolerances (``W_ATOL``) and options of its
+    memory is written into them, model.forms.remember), tolerances (``W_ATOL``) and options of its
     workspace, at t = 0: its mode, logs, phase and first step."""
     real, ints, c, yr, ur = ws[W_REAL], ws[W_INT], ws[W_C], ws[W_Y], ws[W_U]
     y, f, u, fu, atol_u = yr[Y_STATE], yr[Y_F], ur[U_U], ur[U_FU], ur[U_ATOL]

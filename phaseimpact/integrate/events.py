@@ -28,9 +28,7 @@ from __future__ import annotations
 import math
 
 from .._jit import kernel
-from ..model.laws import (
-    GUARD_ENERGY_FACTOR,  # noqa: F401 (re-exported)
-    RUNAWAY_ENERGY_FACTOR,  # noqa: F401 (re-exported)
+from ..model.forms import (
     STUCK,
     contact_gap,
     dent_depth,
@@ -40,6 +38,10 @@ from ..model.laws import (
     partials_of,
     remember,
     stick_bound,
+)
+from ..model.laws import (
+    GUARD_ENERGY_FACTOR,  # noqa: F401 (re-exported)
+    RUNAWAY_ENERGY_FACTOR,  # noqa: F401 (re-exported)
 )
 from ..model.rhs import (
     ALPHA_,

@@ -12,7 +12,7 @@ from __future__ import annotations
 import math
 
 from .._jit import kernel
-from ..model.laws import dent_depth
+from ..model.forms import dent_depth
 from ..model.rhs import FLIGHT, V1, V2, WORK, X1, X2, relative_slip, rhs, rhs_integration
 from . import dop853, flight, radau5
 from .events import DELTA, DELTADOT, FORCE_RATE, N_EVENTS, event_value, event_values

@@ -10,7 +10,7 @@ import numpy as np
 
 from .._jit import allocating, kernel
 from .._signals import interrupted
-from ..model.laws import PLAIN
+from ..model.forms import PLAIN
 from ..model.rhs import X1, X2, energy, rhs
 from .driver import (
     FAILED_STOP,

@@ -17,7 +17,16 @@ The shipped laws, one with its options, and the coefficient array the engine rea
 """
 
 from .. import _lazy
-from .laws import CONTACT_READINGS, LAWS, PLAIN, REGISTRY, STUCK, ContactLaw, LawEntry, as_law, law_variants
+from .forms import PLAIN, STUCK
+from .laws import (
+    CONTACT_READINGS,
+    LAWS,
+    REGISTRY,
+    ContactLaw,
+    LawEntry,
+    as_law,
+    law_variants,
+)
 
 # Imported on first use: they need NumPy and SciPy, which the command line's parser (it lists the
 # laws) and the commands that integrate nothing do not pay for.

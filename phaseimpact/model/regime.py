@@ -15,7 +15,7 @@ from __future__ import annotations
 import math
 
 from ..parameters import LENGTH_RANGE, Material, is_number, require, require_in
-from .laminate import olsson_rigidity
+from .plate_stiffness import olsson_rigidity
 
 __all__ = [
     "infinite_plate_impedance", "zener_lambda", "plate_mass", "mass_ratio", "impact_regime",

@@ -33,7 +33,7 @@ import numpy as np
 
 from .._jit import kernel
 from ..parameters import Parameters
-from .laws import (  # noqa: F401 (the packed layout, re-exported: the engine's modules read it here)
+from .forms import (  # noqa: F401 (the packed layout, re-exported: the engine's modules read it here)
     ALPHA_,
     DAMP_,
     GUARD_,
@@ -52,14 +52,16 @@ from .laws import (  # noqa: F401 (the packed layout, re-exported: the engine's 
     RIGID_,
     SPRINGS_,
     STUCK,
-    ContactLaw,
-    as_law,
     contact_gap,
     force_of,
     is_filippov,
     partials_of,
     potential_of,
     stick_bound,
+)
+from .laws import (
+    ContactLaw,
+    as_law,
 )
 
 __all__ = [
@@ -166,7 +168,7 @@ def contact_side(code, c, y, mode):
     """How the driver integrates the phase that starts at ``y`` in ``mode``.
 
     ``+1`` or ``-1`` (the sign of ``delta``, or of ``deltadot`` at ``delta = 0``; past a law's dent, of
-    :func:`~phaseimpact.model.laws.contact_gap`) while a Hertz
+    :func:`~phaseimpact.model.forms.contact_gap`) while a Hertz
     power law (``alpha = 3/2``) acts: a regularised contact, where the driver integrates
     ``u = (w, x2, x1dot, x2dot, W, t)`` with ``delta = side w^2`` in the time ``s`` with
     ``dt = w ds`` (:func:`rhs_integration`): the ``delta^(3/2)`` singularity at the contact's onset

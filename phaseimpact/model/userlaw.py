@@ -47,15 +47,17 @@ import sys
 import types
 from dataclasses import dataclass, field
 
-from .laws import (
+from .forms import (
     D_DELTA,
     D_RATE,
     FORCE,
-    GUARD_ENERGY_FACTOR,
-    LAWS,
     NATIVE,
     PLAIN,
     POTENTIAL,
+)
+from .laws import (
+    GUARD_ENERGY_FACTOR,
+    LAWS,
     REGISTRY,
     RUNAWAY_ENERGY_FACTOR,
     LawEntry,

@@ -69,7 +69,7 @@ def axis_label(name: str, law=None, base=None) -> str:
     >>> print(axis_label("kappa", as_law("kuwabara-kono"), seed_parameters()))
     $\\gamma$ (N s/m$^{1.5}$)
     """
-    from ..case import SETTABLE
+    from ..settings import SETTABLE
 
     if name == "kappa" and law is not None:
         symbol = law.entry.damping_name
