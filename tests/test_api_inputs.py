@@ -113,9 +113,10 @@ def test_the_grid_checks_every_value_not_only_the_corners():
 
 
 def test_restitution_attainable_by_a_law():
+    from phaseimpact.model.laws import REGISTRY
     from phaseimpact.model.restitution import attainable_restitution, check_attainable
 
-    lowest, _ = attainable_restitution("lankarani-nikravesh")
+    lowest, _ = attainable_restitution(REGISTRY["lankarani-nikravesh"].chi)
     assert 0.6 < lowest < 0.7  # chi <= 3/4: the damping number of e = 0.66 at most
     with pytest.raises(ValueError, match=r"restitution = 1e-06 .* allowed: 0.66\d* <= restitution <= 1"):
         check_attainable(ContactLaw("lankarani-nikravesh", restitution=1e-6))

@@ -35,16 +35,7 @@ LAYERS = (
 
 #: Cycles through imports inside functions (a module-level cycle is never allowed) that are known and
 #: due to be broken, each with the edit that breaks it. An entry that no longer occurs fails the test.
-KNOWN_CYCLES = {
-    # Two cycles through model.laws, one component. (1) laws <-> restitution: ContactLaw's damping
-    # imports restitution.kappa_for_restitution, and restitution.attainable_restitution(name) looks
-    # the law's chi up in laws.REGISTRY; taking the chi itself (check_attainable passes
-    # law.entry.chi) drops restitution's import of laws. (2) laws <-> userlaw: ContactLaw.__setstate__
-    # imports userlaw.ensure_defined to define a user law in a worker; a recipe object of userlaw's
-    # whose unpickling calls ensure_defined (its __reduce__) drops laws' import of userlaw. Breaking
-    # one leaves the other: replace this entry by the cycle that remains.
-    ("phaseimpact.model.laws", "phaseimpact.model.restitution", "phaseimpact.model.userlaw"),
-}
+KNOWN_CYCLES: set = set()
 
 
 def _module(package_root: Path, path: Path) -> str:

@@ -484,11 +484,7 @@ class ContactLaw:
 
     def __setstate__(self, state):
         state = dict(state)
-        recipe = state.pop("_recipe", None)
-        if recipe is not None:
-            from .userlaw import ensure_defined
-
-            ensure_defined(recipe)
+        state.pop("_recipe", None)  # its unpickling defined the user law in this process already
         self.__dict__.update(state)
 
     @property

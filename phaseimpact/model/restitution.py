@@ -114,18 +114,15 @@ def kappa_for_restitution(e: float, params: Parameters) -> float:
 
 
 @functools.cache
-def attainable_restitution(name: str) -> tuple[float, float]:
-    """The restitution a restitution law (:data:`~phaseimpact.model.laws.REGISTRY` name) delivers
-    over the allowed ``e`` (:data:`RESTITUTION_RANGE`), as ``(lowest, 1)``.
+def attainable_restitution(chi) -> tuple[float, float]:
+    """The restitution a restitution law with damping factor ``chi`` (its entry's ``chi``, a
+    function of ``e``) delivers over the allowed ``e`` (:data:`RESTITUTION_RANGE`), as ``(lowest, 1)``.
 
     Its damping ``kappa = chi(e) K / v`` is Hunt-Crossley's with ``a = chi(e)``, whose exact
     restitution (rigid or free target) is :func:`hunt_crossley_restitution` of ``chi(e)``; ``chi``
     falls with ``e``, so the smallest ``e`` gives the lowest restitution. A bounded ``chi``
     (``3(1-e^2)/4``: at most 0.75) cannot restitute less than its bound does.
     """
-    from .laws import REGISTRY
-
-    chi = REGISTRY[name].chi
     return float(hunt_crossley_restitution(chi(RESTITUTION_RANGE[0]))), 1.0
 
 
@@ -159,7 +156,7 @@ def check_attainable(law) -> None:
     """
     if law.restitution is None or law.entry.chi is None:
         return
-    lowest, _ = attainable_restitution(law.name)
+    lowest, _ = attainable_restitution(law.entry.chi)
     if law.restitution < lowest:
         raise ValueError(f"restitution = {law.restitution!r} is out of range for law {law.name!r}: its damping "
                          f"{law.entry.description.split(', ')[-1]} restitutes at least e = {lowest:.3g} on a rigid "

@@ -162,11 +162,28 @@ class NativeLaw:
             what = "returned nan" if kind == NOT_A_NUMBER else "returned an infinity"
         return f"law {name!r}: its {label} {what} at delta = {delta:.6g} m (deltadot = {deltadot:.6g} m/s)"
 
-    def recipe(self, name: str) -> tuple:
-        """What a worker process needs to define the law again (:func:`ensure_defined`)."""
+    def recipe(self, name: str) -> DefinedWhereUnpickled:
+        """What a worker process needs to define the law again (:func:`ensure_defined`): an object
+        whose unpickling defines it there, before the :class:`ContactLaw` carrying it is restored."""
         if self.path is not None:
-            return ("file", name, self.path, self.identity)
-        return ("python", name, self.definition, self.identity)
+            return DefinedWhereUnpickled(("file", name, self.path, self.identity))
+        return DefinedWhereUnpickled(("python", name, self.definition, self.identity))
+
+
+class DefinedWhereUnpickled:
+    """A user law's recipe that defines the law in the process that unpickles it (its
+    ``__reduce__`` calls :func:`ensure_defined`), so that the law table never imports this module."""
+
+    def __init__(self, recipe: tuple):
+        self.recipe = recipe
+
+    def __reduce__(self):
+        return (_define_and_keep, (self.recipe,))
+
+
+def _define_and_keep(recipe: tuple) -> DefinedWhereUnpickled:
+    ensure_defined(recipe)
+    return DefinedWhereUnpickled(recipe)
 
 
 def _check_signature(name: str, function) -> None:
