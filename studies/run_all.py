@@ -31,6 +31,7 @@ STUDIES = (
     "erosion",
     "plastic",
     "impact_regime",
+    "zener_restitution",
     "train",
     "train_bifurcations",
     "max_force_vs_kappa",
