@@ -126,6 +126,8 @@ def main(quick=False, jobs=1):
             {"max_abs_difference_e": known(largest_e, 2), "max_rel_difference_contact_time": known(largest_t, 2),
              "zener_rtol": ZENER_RTOL, "engine_rtol": 1e-10, "rigid_wall_contact_time": RIGID_WALL_CONTACT,
              "restitution_at_lambda_3": known(zener_restitution(3.0)[0], 4),
+             "restitution_at_lambda_1e-4": known(zener_restitution(1e-4)[0], 6),
+             "curve_lambda_max": float(curve_lambda[-1]), "curve_positive": bool(np.all(curve[:, 0] > 0)),
              "series": str([label for label, *_ in SERIES]), "claim": claim(__doc__)})
     return out
 

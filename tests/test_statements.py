@@ -361,6 +361,26 @@ def regime_grains_below() -> tuple:
     return min(grains), max(grains), cases["hail-laminate"]["below_bound"], cases["hail-laminate"]["zener_lambda"]
 
 
+def zener(key: str) -> float:
+    """An attribute of figures/data/zener_restitution.h5 (studies/zener_restitution.py)."""
+    return h5("zener_restitution", key)
+
+
+def zener_differences() -> tuple:
+    return zener("max_abs_difference_e"), zener("max_rel_difference_contact_time")
+
+
+def zener_falls() -> tuple:
+    return zener("restitution_at_lambda_1e-4"), zener("restitution_at_lambda_3")
+
+
+def blade_restitutions() -> tuple:
+    """Zener's e of the seed's dust (largest lambda), the sand cases (smallest, largest) and the hailstone."""
+    cases = {c["name"]: c["zener_restitution"] for c in regime_json("cases")}
+    sand = [e for name, e in cases.items() if name.startswith("sand")]
+    return h5("impact_regime", "seed_dust_zener_restitution"), min(sand), max(sand), cases["hail-laminate"]
+
+
 def regime_hail_diameters(which: int) -> tuple:
     """Ice diameters (mm) at Olsson's lower (0) or upper (1) bound, over the three panels: (smallest, largest)."""
     d = [2e3 * b["ice"][which] for b in regime_json("boundaries").values()]
@@ -372,6 +392,7 @@ def regime_hail_diameters(which: int) -> tuple:
 R, D, C, F = "figures/README.md", "docs/physics.md", "figures/claims.md", "docs/findings.md"
 ST, ER, PL, TR = "studies/staircase.py", "studies/erosion.py", "studies/plastic.py", "studies/train.py"
 RG = "studies/impact_regime.py"
+ZR = "studies/zener_restitution.py"
 
 STATEMENTS = [
     # docs/findings.md, findings
@@ -449,7 +470,19 @@ STATEMENTS = [
                  "`lambda` = {})", regime_grains_below),
     Statement(F, "hail becomes boundary-controlled only from {}–{} mm in diameter", lambda: regime_hail_diameters(0)),
     Statement(F, "the quasi-static regime starts at {}–{} mm", lambda: regime_hail_diameters(1)),
+    Statement(F, "Zener's curve gives it `e` = {}", lambda: blade_restitutions()[0]),
+    Statement(F, "`e` to {} and the contact time to {} relative (the engine runs at rtol 1e-10)", zener_differences),
+    Statement(F, "`e` falls from {} at `lambda` = 1e-4 to {} at 3", zener_falls),
+    Statement(F, "positive along the computed curve (up to `lambda` = {})", lambda: zener("curve_lambda_max")),
+    Statement(F, "seed's dust `e` = {} (its largest `lambda`), the shipped sand cases {}–{} and the 15 mm hailstone "
+                 "of `hail-laminate` {}", blade_restitutions),
+    Statement(D, "`e` to {} and the contact time to {} relative", zener_differences),
+    Statement(D, "`e` falls from {} at `lambda = 1e-4` to {} at `lambda = 3`", zener_falls),
+    Statement(D, "the rigid-wall `{} delta*/v`", lambda: zener("rigid_wall_contact_time")),
+    Statement(D, "(up to `lambda = {}`)", lambda: zener("curve_lambda_max")),
     # figures/README.md, the captions
+    Statement(R, "e to {}, the contact time to {} relative; e falls from {} at λ = 1e-4 to {} at λ = 3",
+              lambda: (*zener_differences(), *zener_falls())),
     Statement(R, "the loop area is {} J", lambda: h5("fig04_force_indentation", "loop_area_J")),
     Statement(R, "the force dropping from {} N to the {}–{} N that holds the pair",
               lambda: (undamped_max_force(), first_stick_force(0.0), first_stick_force(3e9))),
@@ -587,6 +620,9 @@ STATEMENTS = [
     Statement(RG, "is at most {}, near the rigid-wall limit",
               lambda: h5("impact_regime", "seed_dust_zener_lambda_max")),
     Statement(RG, "has lambda = {}.", lambda: regime_grains_below()[3]),
+    Statement(RG, "gives e = {} at the dust's largest lambda and e = {} for the hailstone",
+              lambda: (blade_restitutions()[0], blade_restitutions()[3])),
+    Statement(ZR, "({} at lambda = 3)", lambda: zener("restitution_at_lambda_3")),
     Statement("studies/bifurcation.py", "up to kappa_c = {} N s/m^2.5", kc),
     Statement("studies/bifurcation.py", "the plastic stick dissipates {} mJ",
               lambda: at_exactly("bifurcation_printed", "kappa", "dissipated_energy", 1e9) * 1e3),
@@ -634,6 +670,7 @@ EXEMPT = {
          "377": "page (Wentworth 1922, J. Geol. 30:377)", "62.5": "input (size class bound)",
          "120": "input (speed range)"},
     PL: {"1997": "year", "383": "page (Thornton 1997, J. Appl. Mech. 64:383)"},
+    ZR: {"1941": "year", "669": "page (Zener 1941, Phys. Rev. 59:669)"},
     TR: {"200": "input (impacts dropped)", "400": "input (values of T)"},
     "studies/train_bifurcations.py": {
         "0.9830": "checked by tests/test_train.py::test_a_located_period_doubling_gives_birth_to_a_period_2_orbit",

@@ -60,3 +60,18 @@ def test_the_engine_reproduces_zeners_curve(study, R1, v, lam):
     assert e == pytest.approx(e_zener, abs=1e-8)
     assert contact == pytest.approx(contact_zener, rel=1e-8)
     assert 0.0 < e < 1.0
+
+
+def test_the_committed_curve_stays_positive():
+    """What docs/physics.md §8 and docs/findings.md say of figures/data/zener_restitution.h5: e > 0 at every
+    point of the curve and of both engine series, and e falls along each series as lambda grows."""
+    import h5py
+    import numpy as np
+
+    with h5py.File(STUDIES.parent / "figures" / "data" / "zener_restitution.h5", "r") as f:
+        assert bool(f.attrs["curve_positive"]) is True
+        assert (f["curve/restitution"][()] > 0).all() and f["curve/lambda"][-1] == f.attrs["curve_lambda_max"]
+        for key in ("R1_20mm", "R1_2mm"):
+            order = np.argsort(f[f"{key}/lambda"][()])
+            e = f[f"{key}/restitution"][()][order]
+            assert (e > 0).all() and (np.diff(e) < 0).all()
