@@ -608,6 +608,8 @@ STATEMENTS = [
               lambda: (undamped_max_force(), first_stick_force(3e9)), 0.02),
     Statement(F, "finds {} of the {} values period-1 (the count found 210), {} a stable orbit of period 2 to 8, "
                  "and {} with no stable orbit", lambda: train_counts(), EXACT),
+    Statement(F, "the archive marks {} of the {} values so", lambda: (int(np.sum(h5("train", "near_basin_edge"))),
+                                                                    len(h5("train", "orbit_period"))), EXACT),
 ]
 
 #: Regions whose every number of three or more significant digits must be checked by a row or exempt.
