@@ -12,10 +12,12 @@ checkout stays clean). What is "the same within tolerance" (:func:`equivalent`):
   attributes named ``*digest`` or ``*sha256``, ``created`` and ``history`` are not compared (they follow the
   data, or say when, not what).
 - Values that a study declares sensitive to last-bit differences: an archive whose attribute
-  ``last_bit_sensitive`` names a dataset and ``last_bit_mask`` a boolean dataset of the same shape
-  (why: ``last_bit_reason``) has that dataset compared only where the mask is false; the mask itself
-  is compared exactly. Where only masked values differ, the figures the archive names in ``drawn_in``
-  (paths under the target folder, drawn from those values) keep their committed files too.
+  ``last_bit_sensitive`` names datasets (separated by spaces) and ``last_bit_mask`` a boolean dataset
+  whose shape is their leading shape (why: ``last_bit_reason``) has those datasets compared only
+  where neither archive's mask is true; the mask itself is compared exactly unless it is among the
+  names (a mask the run estimates, which last bits move as well). Where only masked values differ,
+  the figures the archive names in ``drawn_in`` (paths under the target folder, drawn from those
+  values) keep their committed files too.
 - Tables and other texts (``.md``, ``.txt``, ``.json``, ``.csv``): equal apart from numbers, each
   within ``RTOL`` relative, or printed with the same digits and one unit of the last apart (a
   rounding flip).
@@ -101,6 +103,20 @@ def _declared(f, name: str) -> str:
     return value.decode() if isinstance(value, bytes) else str(value)
 
 
+def _unmasked(old, new) -> tuple[tuple[str, ...], np.ndarray | None]:
+    """The declared last-bit-sensitive datasets and where neither archive's mask marks them (None
+    where the declaration does not hold: a mask missing, not boolean or not their leading shape)."""
+    sensitive, mask = tuple(_declared(new, "last_bit_sensitive").split()), _declared(new, "last_bit_mask")
+    if not sensitive or not all(name in f for f in (old, new) for name in (*sensitive, mask)):
+        return (), None
+    masks = old[mask][()], new[mask][()]
+    shape = masks[0].shape
+    if any(m.dtype != bool or m.shape != shape for m in masks) or any(
+            f[name].shape[:len(shape)] != shape for f in (old, new) for name in sensitive):
+        return (), None
+    return sensitive, ~(masks[0] | masks[1])
+
+
 def _h5_equivalent(old_path: Path, new_path: Path, masked: bool = True) -> bool:
     """Equivalent archives; ``masked``: the declared last-bit-sensitive values are not compared."""
     import h5py
@@ -127,10 +143,7 @@ def _h5_equivalent(old_path: Path, new_path: Path, masked: bool = True) -> bool:
         a, b = tree(old), tree(new)
         if a.keys() != b.keys():
             return False
-        sensitive, mask = _declared(new, "last_bit_sensitive"), _declared(new, "last_bit_mask")
-        unmasked = (np.logical_not(old[mask][()]) if masked and sensitive in a and mask in a
-                    and np.array_equal(old[mask][()], new[mask][()]) and old[mask].shape == old[sensitive].shape
-                    else None)
+        sensitive, unmasked = _unmasked(old, new) if masked else ((), None)
         for name, obj in a.items():
             other = b[name]
             if isinstance(obj, h5py.Dataset) != isinstance(other, h5py.Dataset):
@@ -145,7 +158,7 @@ def _h5_equivalent(old_path: Path, new_path: Path, masked: bool = True) -> bool:
                     if not _values_equivalent(np.asarray(resolve(old, obj[()]), dtype=object),
                                               np.asarray(resolve(new, other[()]), dtype=object)):
                         return False
-                elif name == sensitive and unmasked is not None:
+                elif name in sensitive:
                     if not arrays_equivalent(obj[()][unmasked], other[()][unmasked]):
                         return False
                 elif not arrays_equivalent(obj[()], other[()]):

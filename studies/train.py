@@ -16,7 +16,16 @@ a period-doubling sequence, which this grid resolves only to period 4. From abou
 to about 0.15 past each multiple, stable orbits of period 2 to 8 (and a few of period 1) alternate
 with values where no stable orbit of period up to 8 is approached (irregular, a longer period, or a
 transient still far from its orbit). At exactly one plate period the train from rest settles on a
-period-2 orbit (bottom panel). The counts of each kind are in the data file (attribute "counts").
+period-2 orbit (bottom panel). The counts of each kind are those of the data file's orbit_period.
+
+Some values lie where the 200 dropped impacts pass close to a basin's edge, or on an irregular
+attractor, so that last-bit differences (another machine, a one-ulp change of M2) move where the
+train settles or its samples, and with them the value's class. The data file marks them
+(near_basin_edge): the values where the trains at T (1 - 1e-12) and T (1 + 1e-12) part by more
+than 1e-6 of the state's scales at some impact of the 240 (their linear response to the nudge is
+mostly about 1e-10; the values that a one-ulp change of M2 moved beyond make reproduce's tolerance
+parted by far more, tests/test_train_study.py). Make reproduce compares these values' samples and
+classes only where neither archive marks them.
 """
 
 from pathlib import Path
@@ -28,6 +37,7 @@ from phaseimpact import seed_parameters
 from phaseimpact.archive import save_h5
 from phaseimpact.continuation._parallel import map_in_threads
 from phaseimpact.integrate import scales
+from phaseimpact.maps import ModelImpactMap
 from phaseimpact.plotting import figure, save, style
 from phaseimpact.train import attracting_orbit, impact_train, orbit_diagram
 
@@ -37,6 +47,12 @@ LAW = "hunt-crossley"
 KAPPA = 3e9
 #: Longest period of a stable orbit looked for from each value's last sample.
 MAX_PERIOD = 8
+#: Relative change of T to either side of each value for the two trains that mark it near a basin's edge.
+NUDGE = 1e-12
+#: Parting of the two trains (in the state's scales) at some impact that marks a value near a basin's edge:
+#: far above their usual linear response to the nudge (about 1e-10), far below that of the values whose
+#: samples or class a one-ulp change of M2 moved (tests/test_train_study.py).
+PARTED = 1e-6
 
 
 def main(quick=False, jobs=1):
@@ -58,6 +74,7 @@ def main(quick=False, jobs=1):
     fixed = orbit_period == 1
     longer = orbit_period > 1
     irregular = orbit_period == 0
+    near_edge = near_basin_edge(params, ratios * plate_period, transients + samples, jobs)
     examples = (0.5, 1.0, 2.3)  # T / plate period: one impact per half swing, per swing, in between
     build = {r: impact_train(params, LAW, r * plate_period, 60) for r in examples}
 
@@ -89,7 +106,8 @@ def main(quick=False, jobs=1):
         out = save(fig, FIGURES / f"{NAME}.png")
 
     counts = {"period-1": int(fixed.sum()), f"period-k (1 < k <= {MAX_PERIOD})": int(longer.sum()),
-              f"no stable orbit of period <= {MAX_PERIOD} approached": int(irregular.sum())}
+              f"no stable orbit of period <= {MAX_PERIOD} approached": int(irregular.sum()),
+              "near a basin's edge": int(near_edge.sum())}
     half = fixed & (np.abs(ratios - np.round(ratios - 0.5) - 0.5) < 0.03)  # period-1 within 0.03 of a half multiple
     print(counts, "largest multiplier of period-1 orbits near half multiples:",
           known(largest[half].max(), 3) if half.any() else None)
@@ -97,10 +115,29 @@ def main(quick=False, jobs=1):
             {"T_over_plate_period": (ratios, "1"), "x2": (diagram.plate[:, :, 0], "m"),
              "x2dot": (diagram.plate[:, :, 1], "m/s"), "peak_force": (diagram.peak_force, "N"),
              "distinct": (diagram.distinct, "1"), "orbit_period": (orbit_period, "1"),
-             "largest_multiplier": (np.array([known(m) for m in largest]), "1"), "steady_amplitude": (steady, "m")},
+             "largest_multiplier": (np.array([known(m) for m in largest]), "1"), "steady_amplitude": (steady, "m"),
+             "near_basin_edge": (near_edge, "1")},
             {"law": LAW, "kappa": KAPPA, "v": 1.0, "plate_period": known(plate_period), "transients": transients,
-             "samples": samples, "max_period": MAX_PERIOD, "counts": str(counts), "claim": claim(__doc__)})
+             "samples": samples, "max_period": MAX_PERIOD, "nudge": NUDGE, "parted": PARTED, "claim": claim(__doc__),
+             # studies/_settle.py: a value near a basin's edge is compared only where neither archive marks it
+             "last_bit_sensitive": " ".join(PER_VALUE), "last_bit_mask": "near_basin_edge", "drawn_in": f"{NAME}.png",
+             "last_bit_reason": "where a train settles near a basin's edge moves with last-bit differences "
+                                "(a one-ulp change of M2 moved the class of a few values)"})
     return out
+
+
+#: The archive's datasets of each value that move with it when last bits move where its train settles.
+PER_VALUE = ("x2", "x2dot", "peak_force", "distinct", "orbit_period", "largest_multiplier", "steady_amplitude",
+             "near_basin_edge")
+
+
+def near_basin_edge(params, periods, impacts, jobs):
+    """Whether the trains at ``T (1 - NUDGE)`` and ``T (1 + NUDGE)`` part by more than ``PARTED`` of the
+    state's scales at some impact of ``impacts`` from rest, for each period ``T`` of ``periods``."""
+    low, high = (orbit_diagram(params, LAW, "T", periods * (1 + side * NUDGE), transients=0, samples=impacts,
+                               n_jobs=max(1, jobs)).plate for side in (-1, 1))
+    scale = ModelImpactMap(params, LAW, None).scale
+    return np.max(np.abs(high - low) / scale, axis=(1, 2)) > PARTED
 
 
 if __name__ == "__main__":

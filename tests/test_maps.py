@@ -1,8 +1,10 @@
-"""The analyses of phaseimpact.maps over maps a user writes (the guide of phaseimpact/maps/base.py):
-the Hénon and logistic maps, whose fixed points, multipliers, period doubling, fold and Lyapunov
-exponents have closed forms computed here, independently of the code under test."""
+"""The analyses of phaseimpact.maps over maps a user writes: the Hénon map of the guide of
+phaseimpact/maps/base.py (read from the guide and run as written) and the logistic map, whose fixed
+points, multipliers, period doubling, fold and Lyapunov exponents have closed forms computed here,
+independently of the code under test."""
 
 import math
+import textwrap
 
 import numpy as np
 import pytest
@@ -11,6 +13,7 @@ from phaseimpact.maps import (
     AffineMap,
     ImpactMap,
     attracting_orbit_of,
+    base,
     continue_bifurcation,
     continue_orbit,
     find_basins,
@@ -21,24 +24,15 @@ from phaseimpact.maps import (
 )
 
 
-class Henon(ImpactMap):
-    """The guide's example (phaseimpact/maps/base.py), word for word."""
+def guide_example() -> type:
+    """The guide's Hénon map (phaseimpact/maps/base.py), executed as written there."""
+    code = textwrap.dedent(base.__doc__.split("::\n", 1)[1].split("\nThen ", 1)[0])
+    namespace = {"ImpactMap": ImpactMap, "np": np}
+    exec(compile(code, "guide of phaseimpact/maps/base.py", "exec"), namespace)
+    return namespace["Henon"]
 
-    parameters = ("a", "b")
-    scale = np.array([1.0, 1.0])
 
-    def __init__(self, a=1.4, b=0.3):
-        self.a, self.b = a, b
-
-    def __call__(self, state):
-        x, y = state
-        return np.array([1 - self.a * x * x + y, self.b * x])
-
-    def derivative(self, state):
-        return np.array([[-2 * self.a * state[0], 1.0], [self.b, 0.0]])
-
-    def at(self, name, value):
-        return Henon(**{"a": self.a, "b": self.b, name: value})
+Henon = guide_example()
 
 
 class HenonByDifferences(Henon):

@@ -155,6 +155,27 @@ def test_declared_last_bit_sensitive_values_compared_by_their_mask(tmp_path):
                                                                                                "1")}))
 
 
+def _settled_trains(path: Path, period, near_edge) -> Path:
+    """An archive like train's: each value's samples and class, and its mask estimated by the run (so
+    among the sensitive names: another machine's mask may differ)."""
+    period = np.asarray(period)
+    return save_h5(path, {"x2": (np.outer(period, [1.0, 2.0]), "m"), "orbit_period": (period, "1"),
+                          "near_basin_edge": (np.asarray(near_edge), "1")},
+                   {"last_bit_sensitive": "x2 orbit_period near_basin_edge", "last_bit_mask": "near_basin_edge",
+                    "last_bit_reason": "where a train settles near a basin's edge moves with last bits"})
+
+
+def test_several_sensitive_datasets_compared_where_neither_archive_marks_them(tmp_path):
+    """train's values near a basin's edge: their samples (a row per value) and classes move together, and
+    each machine marks its own; a value either archive marks is not compared, the others are."""
+    old = _settled_trains(tmp_path / "old.h5", [1, 2, 0, 1], [False, True, True, False])
+    assert _settle.equivalent(old, _settled_trains(tmp_path / "moved.h5", [1, 1, 2, 1], [False, True, True, False]))
+    assert _settle.equivalent(old, _settled_trains(tmp_path / "other.h5", [1, 1, 0, 1], [False, False, True, False]))
+    assert _settle.equivalent(old, _settled_trains(tmp_path / "more.h5", [1, 2, 3, 8], [False, True, True, True]))
+    assert not _settle.equivalent(old, _settled_trains(tmp_path / "unmarked.h5", [2, 2, 0, 1],
+                                                       [False, True, True, False]))
+
+
 def test_a_figure_drawn_from_sensitive_values_follows_its_archive(tmp_path):
     """Only masked values moved: the archive and its figure keep their committed bytes. The same
     values with another figure (a change of style) replace the figure."""

@@ -25,7 +25,7 @@ Subclass :class:`ImpactMap` and give it
    describing the step (a change along a branch is reported as ``grazing``), None where the map
    is undefined (a failed run), with their names in ``structure_names``.
 
-The Hénon map, ``(x, y) -> (1 - a x^2 + y, b x)``, as tests/test_maps.py writes it::
+The Hénon map, ``(x, y) -> (1 - a x^2 + y, b x)``, which tests/test_maps.py runs as written::
 
     class Henon(ImpactMap):
         parameters = ("a", "b")
