@@ -22,7 +22,7 @@ import functools
 import numba
 import numpy as np
 
-from .integrate.record import workspace
+from .integrate.record import W_Y, Y_STATE, workspace
 
 try:  # a module global: the simulator swaps it for its own in the kernel's globals
     from numba import cuda
@@ -148,10 +148,12 @@ def workspaces(n: int, n_coef: int, capacity: int) -> tuple[tuple, tuple]:
     return tuple(rows[:12]), tuple(rows[12:])
 
 
-def run_batch_cuda(code: int, batch: tuple, options: tuple, outputs: tuple) -> None:
+def run_batch_cuda(code: int, batch: tuple, options: tuple, outputs: tuple, final_states=None) -> None:
     """Run every point of ``batch`` (the tuple ``integrate.driver.B_*``) on the GPU, one thread each, and fill
-    ``outputs`` (the tuple ``integrate.driver.O_*``) as :func:`.integrate.driver.run_block` does. Call
-    :func:`unavailable` first."""
+    ``outputs`` (the tuple ``integrate.driver.O_*``) as :func:`.integrate.driver.run_block` does; and
+    ``final_states`` (n x 5, optional) with each run's state ``(x1, x2, x1dot, x2dot, W)`` at its end (row
+    ``Y_STATE`` of its workspace, what :func:`.integrate.api.summary_run` returns). Call :func:`unavailable`
+    first."""
     from numba import cuda
 
     n = batch[0].shape[0]
@@ -165,3 +167,5 @@ def run_batch_cuda(code: int, batch: tuple, options: tuple, outputs: tuple) -> N
     cuda.synchronize()
     for host, device in zip(outputs, device_outputs, strict=True):
         device.copy_to_host(host)
+    if final_states is not None:
+        final_states[...] = device_w[W_Y].copy_to_host()[:, Y_STATE]

@@ -1,7 +1,8 @@
 """The CUDA backend (phaseimpact/cuda.py) without a GPU: the same per-point kernel run by numba's
-CUDA simulator (one Python thread per point, the engine uncompiled) against the threads backend;
-the refusals (no GPU, a user law); the device kernel compiled to PTX for an H100 by the real CUDA
-target where NVVM is installed; and the portable ulp that replaced ``np.nextafter``."""
+CUDA simulator (one Python thread per point, the engine uncompiled) against the threads backend, for
+simulate_many, atlas and orbit diagrams; the refusals (no GPU, a user law, critical-curve always);
+the device kernel compiled to PTX for an H100 by the real CUDA target where NVVM is installed; and
+the portable ulp that replaced ``np.nextafter``."""
 
 from __future__ import annotations
 
@@ -58,8 +59,29 @@ SIMULATED = textwrap.dedent("""
     a = atlas(seed_parameters(), "paper", {"kappa": KAPPAS[:3], "v": [0.5, 2.0]}, backend="cuda")
     out["atlas/outcome"] = a.outcome
     out["atlas/max_force"] = a.max_force
+    from test_cuda import ORBITS, orbit_diagram_of
+
+    for name in ORBITS:
+        for backend in ("cuda", "threads"):
+            d = orbit_diagram_of(name, backend)
+            out[f"orbits/{name}/{backend}/plate"] = d.plate
+            out[f"orbits/{name}/{backend}/peak_force"] = d.peak_force
+            out[f"orbits/{name}/{backend}/distinct"] = d.distinct
     np.savez(sys.argv[1], **out)
 """)
+
+#: Orbit diagrams over each parameter, a law of each kind: (law, case options, param, values, period).
+ORBITS = {"hunt-crossley-T": ("hunt-crossley", {"kappa": 3e9}, "T", [0.4e-3, 1e-3, 3e-3], None),
+          "paper-v": ("paper", {"kappa": 3e9}, "v", [0.5, 1.0, 2.0], 3e-3),
+          "thornton-kappa": ("thornton", {"limiting_pressure": 2e9}, "kappa", [0.0, 1e9], 2e-3)}
+
+
+def orbit_diagram_of(name, backend):
+    from phaseimpact.train import orbit_diagram
+
+    law, case, param, values, period = ORBITS[name]
+    return orbit_diagram(seed_parameters(**case), law, param, values, period=period, transients=2, samples=3,
+                         backend=backend)
 
 
 @pytest.fixture(scope="module")
@@ -115,6 +137,33 @@ def test_simulated_gpu_atlas_matches_threads(simulated):
     np.testing.assert_allclose(simulated["atlas/max_force"], threads.max_force, rtol=1e-9, atol=0)
 
 
+@pytest.mark.parametrize("name", list(ORBITS))
+def test_simulated_gpu_orbit_diagram_is_bit_identical_to_threads(simulated, name):
+    """orbit_diagram(backend="cuda"), one launch per impact over all values, against the threads backend
+    (each value's impacts in turn through simulate), both uncompiled in the simulator's process: the same
+    inputs and arithmetic, so states, peak forces and counts bit-identical."""
+    gpu, threads = _columns(simulated, f"orbits/{name}/cuda/"), _columns(simulated, f"orbits/{name}/threads/")
+    assert gpu.keys() == threads.keys() == {"plate", "peak_force", "distinct"}
+    for column in gpu:
+        np.testing.assert_array_equal(gpu[column], threads[column], err_msg=column)
+    values = ORBITS[name][3]
+    assert gpu["plate"].shape == (len(values), 3, 2) and np.all(np.isfinite(gpu["peak_force"]))
+    assert np.all(gpu["peak_force"] > 0)  # every sampled impact touched
+
+
+@pytest.mark.parametrize("name", list(ORBITS))
+def test_simulated_gpu_orbit_diagram_matches_the_compiled_threads_backend(simulated, name):
+    """The simulated GPU's orbit diagram against the compiled engine: distinct counts equal, states
+    and peak forces within 1e-9 relative (last bits of a libm call, carried over five impacts)."""
+    compiled = orbit_diagram_of(name, "threads")
+    gpu = _columns(simulated, f"orbits/{name}/cuda/")
+    np.testing.assert_array_equal(gpu["distinct"], compiled.distinct)
+    np.testing.assert_allclose(gpu["peak_force"], compiled.peak_force, rtol=1e-9, atol=0)
+    # the plate's x2 crosses zero: relative to the state's scales (Hertz indentation, v), as distinct counts
+    scale = np.array([seed_parameters(**ORBITS[name][1]).hertz_indentation, 1.0])
+    np.testing.assert_allclose(gpu["plate"] / scale, compiled.plate / scale, rtol=0, atol=1e-9)
+
+
 def _cuda_usable() -> bool:
     from phaseimpact import cuda
 
@@ -135,11 +184,50 @@ def test_without_a_gpu_the_cli_refuses_in_one_line(tmp_path):
 
 
 @pytest.mark.skipif(_cuda_usable(), reason="this machine has a usable GPU: nothing to refuse")
+def test_without_a_gpu_orbit_diagram_refuses_in_one_line(tmp_path):
+    """orbit-diagram --backend cuda without a GPU: exit 2, one line naming CUDA, no figure, no archive."""
+    figure, kept = tmp_path / "o.png", tmp_path / "o.nc"
+    out = subprocess.run([sys.executable, "-m", "phaseimpact.cli", "orbit-diagram", "--law", "hunt-crossley",
+                          "--kappa", "3e9", "--axis", "T=5e-4:4e-3:3", "--transients", "2", "--samples", "2",
+                          "--out", str(figure), "--archive", str(kept), "--backend", "cuda"], capture_output=True,
+                         text=True, timeout=300, cwd=ROOT, env=dict(os.environ, PYTHONPATH=str(ROOT)))
+    assert out.returncode == 2, out.stderr
+    lines = out.stderr.strip().splitlines()
+    assert len(lines) == 1 and "CUDA is not usable" in lines[0], out.stderr
+    assert not figure.exists() and not kept.exists()
+
+
+def test_critical_curve_refuses_cuda_in_one_line(tmp_path):
+    """critical-curve --backend cuda: refused, GPU or not (its continuation runs one point at a time),
+    exit 2 with one line saying why, no archive; the same refusal from Python."""
+    from phaseimpact.continuation import critical_curve
+
+    out_file = tmp_path / "c.nc"
+    out = subprocess.run([sys.executable, "-m", "phaseimpact.cli", "critical-curve", "--axis", "v=1:2:2",
+                          "--out", str(out_file), "--backend", "cuda"], capture_output=True, text=True,
+                         timeout=300, cwd=ROOT, env=dict(os.environ, PYTHONPATH=str(ROOT)))
+    assert out.returncode == 2, out.stderr
+    lines = out.stderr.strip().splitlines()
+    assert len(lines) == 1 and "backend = 'cuda' is out of range for critical-curve" in lines[0], out.stderr
+    assert "its points one at a time" in lines[0] and not out_file.exists()
+    with pytest.raises(ValueError, match="a CUDA launch would hold one point"):
+        critical_curve(seed_parameters(), "paper", "v", [1.0, 2.0], backend="cuda")
+    with pytest.raises(ValueError, match="backend = 'mpi' is out of range"):
+        critical_curve(seed_parameters(), "paper", "v", [1.0, 2.0], backend="mpi")
+
+
+@pytest.mark.skipif(_cuda_usable(), reason="this machine has a usable GPU: nothing to refuse")
 def test_without_a_gpu_python_refuses_before_any_work():
     with pytest.raises(ValueError, match="backend = 'cuda': CUDA is not usable"):
         simulate_many([seed_parameters()], "paper", backend="cuda")
     with pytest.raises(ValueError, match="CUDA is not usable"):
         atlas(seed_parameters(), "paper", {"kappa": [1e9, 1e10]}, backend="cuda")
+    from phaseimpact.train import orbit_diagram
+
+    with pytest.raises(ValueError, match="backend = 'cuda': CUDA is not usable"):
+        orbit_diagram(seed_parameters(kappa=3e9), "hunt-crossley", "T", [1e-3, 2e-3], backend="cuda")
+    with pytest.raises(ValueError, match="backend = 'dask' is out of range; allowed: one of threads, cuda"):
+        orbit_diagram(seed_parameters(kappa=3e9), "hunt-crossley", "T", [1e-3, 2e-3], backend="dask")
 
 
 def test_the_cli_offers_every_backend_of_the_library():
@@ -170,6 +258,10 @@ def test_a_user_law_is_refused_on_the_gpu():
             simulate_many([seed_parameters(kappa=1e5)], "cuda-test-kk", backend="cuda")
         with pytest.raises(ValueError, match="cannot run the user law 'cuda-test-kk'"):
             atlas(seed_parameters(kappa=1e5), "cuda-test-kk", {"kappa": [1e5, 1e6]}, backend="cuda")
+        from phaseimpact.train import orbit_diagram
+
+        with pytest.raises(ValueError, match="cannot run the user law 'cuda-test-kk'"):
+            orbit_diagram(seed_parameters(kappa=1e5), "cuda-test-kk", "T", [1e-3, 2e-3], backend="cuda")
 
 
 def test_ulp_above_is_nextafter_bit_for_bit():

@@ -51,6 +51,9 @@ def add_critical_curve(p) -> None:
     options.samples(p, None)
     options.kappa_tolerance(p, "width of kappa_c's (kappa_2's, the grazing value's) final bracket at each point")
     options.tolerance(p)
+    p.add_argument("--backend", choices=("threads", "cuda"), default="threads",
+                   help="threads of this process; cuda is refused: the continuation runs its points one at a time "
+                        "(a GPU atlas over kappa and the axis shows the boundary instead) (default: %(default)s)")
     options.out_options(p, resume=False)
     options.json_option(p)
 
@@ -118,8 +121,11 @@ def run_critical_curve(args) -> int:
 
     from .. import archive
     from ..continuation import critical_curve, transitions
+    from ..continuation.curve import NO_CUDA_CURVE
     from ..continuation.transition import RunFailed
 
+    if args.backend == "cuda":
+        raise ValueError(NO_CUDA_CURVE)
     setup = _setup(args)
     law = setup.law
     what = args.what

@@ -35,6 +35,10 @@ __all__ = ["CriticalCurve", "critical_curve", "CURVE_QUANTITIES"]
 
 #: What :func:`critical_curve` continues.
 CURVE_QUANTITIES = ("kappa_c", "kappa_2", "grazing")
+#: Why :func:`critical_curve` (and ``phaseimpact critical-curve``) refuses ``backend="cuda"``.
+NO_CUDA_CURVE = ("backend = 'cuda' is out of range for critical-curve: a CUDA launch would hold one point, as the "
+                 "continuation runs its points one at a time (each bracket comes from the roots before it, Brent's "
+                 "method is sequential); allowed: threads")
 
 
 @dataclass(frozen=True)
@@ -114,7 +118,7 @@ def _parameters(base, param, value) -> Parameters:
 def critical_curve(base: Parameters | Case, law: ContactLaw | str, param: str, values, *,
                    what: str = "kappa_c", kappa_rtol: float = 1e-10, rtol: float = 1e-10,
                    contact_index: int = 1, kappa_start: float | None = None, max_halvings: int = 6,
-                   progress: bool = False) -> CriticalCurve:
+                   progress: bool = False, backend: str = "threads") -> CriticalCurve:
     """Continue ``what`` over ``values`` of ``param`` (see the module docstring).
 
     Raises ``ValueError`` for bad arguments (before any work) and
@@ -156,6 +160,12 @@ def critical_curve(base: Parameters | Case, law: ContactLaw | str, param: str, v
         Step halvings allowed before a value counts as lost.
     progress : bool, default False
         Draw a progress bar on stderr.
+    backend : {"threads"}, default "threads"
+        ``cuda`` is refused (before any work, with or without a GPU): every run of the walk waits
+        for the one before it (a bracket is placed from the roots already found, Brent's method
+        picks each next ``kappa`` from the last), so a GPU launch would hold one point and leave
+        the GPU idle but for one thread. On a GPU, an :func:`~phaseimpact.continuation.atlas` over
+        ``kappa`` and the second parameter shows the boundary to its grid's spacing.
 
     Returns
     -------
@@ -168,7 +178,7 @@ def critical_curve(base: Parameters | Case, law: ContactLaw | str, param: str, v
     ValueError
         For ``what`` not in :data:`CURVE_QUANTITIES`, a law that does not fit ``what``,
         ``param = "kappa"``, bad ``values`` (or a case invalid at either end), ``kappa_rtol`` or
-        ``rtol`` out of range, or ``grazing`` without ``kappa_start``.
+        ``rtol`` out of range, ``grazing`` without ``kappa_start``, or ``backend`` other than ``threads``.
     TypeError
         For the spellings of 0.2.0 (``integrator_rtol=``; ``rtol=`` without ``kappa_rtol=``).
     RunFailed
@@ -194,6 +204,9 @@ def critical_curve(base: Parameters | Case, law: ContactLaw | str, param: str, v
     >>> [f"{k:.4g}" for k in c.kappa]
     ['1.36e+12', '1.499e+12']
     """
+    if backend != "threads":
+        raise ValueError(NO_CUDA_CURVE if backend == "cuda" else
+                         f"backend = {backend!r} is out of range for critical-curve; allowed: threads")
     law = as_law(law)
     values, rtol = _checked(base, law, param, values, what, kappa_rtol, rtol)
     correct = _corrector(law, what, contact_index, kappa_rtol, rtol)
