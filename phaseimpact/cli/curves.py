@@ -53,7 +53,7 @@ def add_critical_curve(p) -> None:
     options.tolerance(p)
     p.add_argument("--backend", choices=("threads", "cuda"), default="threads",
                    help="threads of this process; cuda is refused: the continuation runs its points one at a time "
-                        "(a GPU atlas over kappa and the axis shows the boundary instead) (default: %(default)s)")
+                        "(an atlas over kappa and the axis runs on a GPU instead) (default: %(default)s)")
     options.out_options(p, resume=False)
     options.json_option(p)
 

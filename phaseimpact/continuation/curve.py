@@ -165,7 +165,7 @@ def critical_curve(base: Parameters | Case, law: ContactLaw | str, param: str, v
         for the one before it (a bracket is placed from the roots already found, Brent's method
         picks each next ``kappa`` from the last), so a GPU launch would hold one point and leave
         the GPU idle but for one thread. On a GPU, an :func:`~phaseimpact.continuation.atlas` over
-        ``kappa`` and the second parameter shows the boundary to its grid's spacing.
+        ``kappa`` and the second parameter maps the outcomes either side of the curve instead.
 
     Returns
     -------

@@ -43,7 +43,7 @@ def orbit_diagram(params: Parameters, law, param: str, values, *, period: float 
     last one left): ``threads`` runs values side by side, each its impacts in turn; ``cuda`` runs
     impact ``n`` of every value as one GPU launch (one thread per value, the per-point kernel of
     :mod:`phaseimpact.cuda`), ``transients + samples`` launches in turn. A launch is as wide as the
-    number of values, so the GPU pays off only with many values. Both take each impact's inputs as
+    number of values: a few values leave most of the GPU idle. Both take each impact's inputs as
     :meth:`~phaseimpact.maps.impact.ModelImpactMap.step` does and the same arithmetic follows (the
     per-point path without an event log, whose numbers are :func:`~phaseimpact.simulate`'s): the
     diagrams are bit-identical where both run the same compiled (or uncompiled) code
