@@ -264,6 +264,16 @@ def test_a_user_law_is_refused_on_the_gpu():
             orbit_diagram(seed_parameters(kappa=1e5), "cuda-test-kk", "T", [1e-3, 2e-3], backend="cuda")
 
 
+def test_orbit_diagram_checks_its_tolerance_before_any_run():
+    """The GPU's runs do not pass through simulate, which checked rtol for the threads backend:
+    orbit_diagram checks it first, for both backends, GPU or not."""
+    from phaseimpact.train import orbit_diagram
+
+    for backend in ("threads", "cuda"):
+        with pytest.raises(ValueError, match=r"rtol = 5.0 is out of range; allowed: 1e-13 <= rtol <= 0.001"):
+            orbit_diagram(seed_parameters(kappa=3e9), "hunt-crossley", "T", [1e-3], rtol=5.0, backend=backend)
+
+
 def test_ulp_above_is_nextafter_bit_for_bit():
     """The portable gap to the next float (the device has no nextafter) equals numpy's for zero,
     subnormals, powers of two of both signs and random magnitudes."""

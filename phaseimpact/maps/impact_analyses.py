@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..integrate.api import check_rtol
 from ..model import as_law
 from ..parameters import Parameters
 from .basins import Basins, check_grid, check_settling, find
@@ -104,7 +105,7 @@ def orbit_diagram(params: Parameters, law, param: str, values, *, period: float 
     check_counts(transients, samples)
     if backend not in ORBIT_DIAGRAM_BACKENDS:
         raise ValueError(f"backend = {backend!r} is out of range; allowed: one of {', '.join(ORBIT_DIAGRAM_BACKENDS)}")
-    imap = ModelImpactMap(params, law, period, rtol)
+    imap = ModelImpactMap(params, law, period, check_rtol(rtol))  # the GPU's runs do not pass through simulate
     if backend == "cuda":
         from .. import cuda
 
