@@ -1,6 +1,6 @@
 """The CUDA backend (phaseimpact/cuda.py) without a GPU: the same per-point kernel run by numba's
 CUDA simulator (one Python thread per point, the engine uncompiled) against the threads backend, for
-simulate_many, atlas and orbit diagrams; the refusals (no GPU, a user law, critical-curve always);
+simulate_many, atlas, orbit diagrams and critical curves; the refusals (no GPU, a user law);
 the device kernel compiled to PTX for an H100 by the real CUDA target where NVVM is installed; and
 the portable ulp that replaced ``np.nextafter``."""
 
@@ -67,6 +67,14 @@ SIMULATED = textwrap.dedent("""
             out[f"orbits/{name}/{backend}/plate"] = d.plate
             out[f"orbits/{name}/{backend}/peak_force"] = d.peak_force
             out[f"orbits/{name}/{backend}/distinct"] = d.distinct
+    from phaseimpact.continuation import curve
+    from test_cuda import CURVES, SIMULATED_GPU_KAPPAS, critical_curve_of
+
+    curve.GPU_KAPPAS = SIMULATED_GPU_KAPPAS
+    for name in CURVES:
+        c = critical_curve_of(name, "cuda")
+        for column in ("values", "kappa", "requested", "predicted"):
+            out[f"curves/{name}/{column}"] = getattr(c, column)
     np.savez(sys.argv[1], **out)
 """)
 
@@ -82,6 +90,21 @@ def orbit_diagram_of(name, backend):
     law, case, param, values, period = ORBITS[name]
     return orbit_diagram(seed_parameters(**case), law, param, values, period=period, transients=2, samples=3,
                          backend=backend)
+
+#: Critical curves, each quantity the GPU corrector evaluates: (law, what, values of v, options); the
+#: grazing curve starts at the seed case's first grazing value (extremum 5, near 3.577e10 at v = 1).
+CURVES = {"kappa_c": ("paper", "kappa_c", [1.0, 2.0], {}),
+          "grazing": ("hunt-crossley", "grazing", [1.0, 1.05, 1.1], {"kappa_start": 3.577e10, "contact_index": 5})}
+#: Kappas of a launch of the GPU corrector under the simulator (few: each is a Python thread).
+SIMULATED_GPU_KAPPAS = 4
+
+
+def critical_curve_of(name, backend):
+    from phaseimpact.continuation import critical_curve
+
+    law, what, speeds, options = CURVES[name]
+    return critical_curve(seed_parameters(), law, "v", speeds, what=what, kappa_rtol=1e-10, backend=backend,
+                          **options)
 
 
 @pytest.fixture(scope="module")
@@ -164,6 +187,21 @@ def test_simulated_gpu_orbit_diagram_matches_the_compiled_threads_backend(simula
     np.testing.assert_allclose(gpu["plate"] / scale, compiled.plate / scale, rtol=0, atol=1e-9)
 
 
+@pytest.mark.parametrize("name", list(CURVES))
+def test_simulated_gpu_critical_curve_walks_as_the_threads_backend(simulated, name):
+    """critical_curve(backend="cuda"): the same walk with the GPU's corrector (the defining function at
+    SIMULATED_GPU_KAPPAS kappas per launch, sign change narrowed to Brent's final bracket) against the
+    compiled threads backend (Brent's method): the same values walked, steps and requested flags, every
+    kappa within 1e-9 relative (both within kappa_rtol = 1e-10 of the root)."""
+    threads = critical_curve_of(name, "threads")
+    gpu = _columns(simulated, f"curves/{name}/")
+    np.testing.assert_array_equal(gpu["values"], threads.values)
+    np.testing.assert_array_equal(gpu["requested"], threads.requested)
+    assert len(gpu["values"]) > len(CURVES[name][2]) and not threads.message  # the step was halved on the way
+    np.testing.assert_allclose(gpu["kappa"], threads.kappa, rtol=1e-9, atol=0)
+    np.testing.assert_allclose(gpu["predicted"], threads.predicted, rtol=1e-9, atol=0)
+
+
 def _cuda_usable() -> bool:
     from phaseimpact import cuda
 
@@ -197,23 +235,17 @@ def test_without_a_gpu_orbit_diagram_refuses_in_one_line(tmp_path):
     assert not figure.exists() and not kept.exists()
 
 
-def test_critical_curve_refuses_cuda_in_one_line(tmp_path):
-    """critical-curve --backend cuda: refused, GPU or not (its continuation runs one point at a time),
-    exit 2 with one line saying why, no archive; the same refusal from Python."""
-    from phaseimpact.continuation import critical_curve
-
+@pytest.mark.skipif(_cuda_usable(), reason="this machine has a usable GPU: nothing to refuse")
+def test_without_a_gpu_critical_curve_refuses_in_one_line(tmp_path):
+    """critical-curve --backend cuda without a GPU: exit 2, one line naming CUDA, no archive."""
     out_file = tmp_path / "c.nc"
     out = subprocess.run([sys.executable, "-m", "phaseimpact.cli", "critical-curve", "--axis", "v=1:2:2",
                           "--out", str(out_file), "--backend", "cuda"], capture_output=True, text=True,
                          timeout=300, cwd=ROOT, env=dict(os.environ, PYTHONPATH=str(ROOT)))
     assert out.returncode == 2, out.stderr
     lines = out.stderr.strip().splitlines()
-    assert len(lines) == 1 and "backend = 'cuda' is out of range for critical-curve" in lines[0], out.stderr
-    assert "its points one at a time" in lines[0] and not out_file.exists()
-    with pytest.raises(ValueError, match="a CUDA launch would hold one point"):
-        critical_curve(seed_parameters(), "paper", "v", [1.0, 2.0], backend="cuda")
-    with pytest.raises(ValueError, match="backend = 'mpi' is out of range"):
-        critical_curve(seed_parameters(), "paper", "v", [1.0, 2.0], backend="mpi")
+    assert len(lines) == 1 and "backend = 'cuda': CUDA is not usable" in lines[0], out.stderr
+    assert not out_file.exists()
 
 
 @pytest.mark.skipif(_cuda_usable(), reason="this machine has a usable GPU: nothing to refuse")
@@ -228,6 +260,12 @@ def test_without_a_gpu_python_refuses_before_any_work():
         orbit_diagram(seed_parameters(kappa=3e9), "hunt-crossley", "T", [1e-3, 2e-3], backend="cuda")
     with pytest.raises(ValueError, match="backend = 'dask' is out of range; allowed: one of threads, cuda"):
         orbit_diagram(seed_parameters(kappa=3e9), "hunt-crossley", "T", [1e-3, 2e-3], backend="dask")
+    from phaseimpact.continuation import critical_curve
+
+    with pytest.raises(ValueError, match="backend = 'cuda': CUDA is not usable"):
+        critical_curve(seed_parameters(), "paper", "v", [1.0, 2.0], backend="cuda")
+    with pytest.raises(ValueError, match="backend = 'mpi' is out of range; allowed: one of threads, cuda"):
+        critical_curve(seed_parameters(), "paper", "v", [1.0, 2.0], backend="mpi")
 
 
 def test_the_cli_offers_every_backend_of_the_library():
@@ -248,7 +286,7 @@ def test_backends_command_lists_each_backend():
 
 def test_a_user_law_is_refused_on_the_gpu():
     """A user law is a Python function: refused with backend cuda (before any run), whether or not
-    a GPU exists, in simulate_many and atlas alike."""
+    a GPU exists, in simulate_many, atlas, orbit diagrams and critical curves alike."""
     import phaseimpact
 
     with restored_registry():  # later tests enumerate the registry (test_precompile's fingerprint)
@@ -262,6 +300,11 @@ def test_a_user_law_is_refused_on_the_gpu():
 
         with pytest.raises(ValueError, match="cannot run the user law 'cuda-test-kk'"):
             orbit_diagram(seed_parameters(kappa=1e5), "cuda-test-kk", "T", [1e-3, 2e-3], backend="cuda")
+        from phaseimpact.continuation import critical_curve
+
+        with pytest.raises(ValueError, match="cannot run the user law 'cuda-test-kk'"):
+            critical_curve(seed_parameters(), "cuda-test-kk", "v", [1.0, 2.0], what="grazing", kappa_start=1e5,
+                           backend="cuda")
 
 
 def test_orbit_diagram_checks_its_tolerance_before_any_run():
