@@ -7,6 +7,7 @@ the portable ulp that replaced ``np.nextafter``."""
 from __future__ import annotations
 
 import hashlib
+import math
 import os
 import subprocess
 import sys
@@ -398,3 +399,58 @@ def test_the_gpu_benchmark_runs_under_the_simulator(tmp_path):
     text = results.read_text()
     assert "GPU vs CPU equal in codes and counts" in text
     assert text.count("| (a) paper atlas | 9 |") == 3 and "| (b) hunt-crossley" in text
+
+
+def _synthetic_margins(monkeypatch, margin):
+    """The GPU corrector's launches answered on the CPU with ``margin(kappa)`` as each run's first stick
+    margin; returns the list of each launch's kappas."""
+    from phaseimpact import cuda
+    from phaseimpact.integrate import driver as d
+
+    launches = []
+
+    def summary_runs(law, points, t_ends, *, rtol, **options):
+        kappas = np.array([p.kappa for p in points])
+        launches.append(kappas)
+        summary = np.zeros((len(points), d.N_SUMMARY))
+        summary[:, d.S_STATUS] = d.SUCCESS
+        summary[:, d.S_FIRST_STICK_MARGIN] = margin(kappas)
+        return summary, np.zeros((len(points), 5))
+
+    monkeypatch.setattr(cuda, "summary_runs", summary_runs)
+    return launches
+
+
+@pytest.mark.parametrize("kappa_rtol", [1e-10, 1e-14])
+def test_gpu_corrector_narrows_to_brents_final_bracket(monkeypatch, kappa_rtol):
+    """A margin with one known root: the root within kappa_rtol / 4 (Brent's xtol in log(kappa)), in
+    launches of GPU_KAPPAS kappas each, a 2 % bracket narrowed GPU_KAPPAS + 1-fold a launch (5 launches
+    at kappa_rtol = 1e-10, as GPU_KAPPAS's docstring says); each launch's kappas in the last's bracket."""
+    from phaseimpact.continuation import curve
+    from phaseimpact.model import as_law
+
+    root = 1.234567e12
+    launches = _synthetic_margins(monkeypatch, lambda k: np.log(root) - np.log(k))
+    correct = curve._gpu_corrector(as_law("paper"), "kappa_c", 1, kappa_rtol, 1e-10)
+    found = correct(seed_parameters(), root * 1.01, 0.02)
+    assert abs(math.log(found / root)) <= kappa_rtol / 4 + curve.BRENT_RTOL * math.log(root)
+    assert all(len(kappas) == curve.GPU_KAPPAS for kappas in launches)
+    if kappa_rtol == 1e-10:
+        assert len(launches) == 5
+    for before, after in zip(launches, launches[1:]):
+        assert before.min() <= after.min() and after.max() <= before.max()
+
+
+def test_gpu_corrector_refuses_a_bracket_as_brent_does_and_several_sign_changes(monkeypatch):
+    """None for ends of one sign or not finite (as the threads corrector), and for a bracket whose samples
+    change sign five times, its ends of opposite signs (Brent would take one of the roots: the GPU's
+    corrector takes none)."""
+    from phaseimpact.continuation import curve
+    from phaseimpact.model import as_law
+
+    law, p, guess = as_law("paper"), seed_parameters(), 1e12
+    for margin in (lambda k: np.log(k) * 0 + 1.0,  # no root
+                   lambda k: np.where(k > guess * 1.01, -np.inf, np.log(guess * 0.99) - np.log(k)),  # end -inf
+                   lambda k: np.sin(np.log(k / guess) * 2.5 * np.pi / 0.02)):  # roots at 0, +-0.008, +-0.016
+        _synthetic_margins(monkeypatch, margin)
+        assert curve._gpu_corrector(law, "kappa_c", 1, 1e-10, 1e-10)(p, guess, 0.02) is None
