@@ -437,7 +437,7 @@ def test_gpu_corrector_narrows_to_brents_final_bracket(monkeypatch, kappa_rtol):
     assert all(len(kappas) == curve.GPU_KAPPAS for kappas in launches)
     if kappa_rtol == 1e-10:
         assert len(launches) == 5
-    for before, after in zip(launches, launches[1:]):
+    for before, after in zip(launches[:-1], launches[1:], strict=True):
         assert before.min() <= after.min() and after.max() <= before.max()
 
 
