@@ -454,3 +454,26 @@ def test_gpu_corrector_refuses_a_bracket_as_brent_does_and_several_sign_changes(
                    lambda k: np.sin(np.log(k / guess) * 2.5 * np.pi / 0.02)):  # roots at 0, +-0.008, +-0.016
         _synthetic_margins(monkeypatch, margin)
         assert curve._gpu_corrector(law, "kappa_c", 1, 1e-10, 1e-10)(p, guess, 0.02) is None
+
+
+def test_gpu_corrector_does_not_read_a_failed_run(monkeypatch):
+    """A launch whose run failed is not read as a value: RunFailed naming its kappa and status (the run
+    again on the CPU, which succeeds here, has no message to add)."""
+    from phaseimpact.continuation import curve
+    from phaseimpact.continuation.transition import RunFailed
+    from phaseimpact.integrate import driver as d
+    from phaseimpact.model import as_law
+
+    _synthetic_margins(monkeypatch, lambda k: np.log(1e12) - np.log(k))
+    from phaseimpact import cuda
+
+    answered = cuda.summary_runs
+
+    def failing(*args, **options):
+        summary, final = answered(*args, **options)
+        summary[1, d.S_STATUS] = d.STATUSES.index("step-size-collapse")
+        return summary, final
+
+    monkeypatch.setattr(cuda, "summary_runs", failing)
+    with pytest.raises(RunFailed, match=r"kappa = 9\.\d+e\+11: step-size-collapse on the GPU"):
+        curve._gpu_corrector(as_law("paper"), "kappa_c", 1, 1e-10, 1e-10)(seed_parameters(), 1e12, 0.1)
