@@ -22,14 +22,14 @@ import functools
 import numba
 import numpy as np
 
-from .integrate.record import workspace
+from .integrate.record import W_Y, Y_STATE, workspace
 
 try:  # a module global: the simulator swaps it for its own in the kernel's globals
     from numba import cuda
 except ImportError as missing:  # a numba built without its CUDA target
     cuda, _MISSING = None, missing
 
-__all__ = ["unavailable", "check", "run_batch_cuda", "THREADS_PER_BLOCK"]
+__all__ = ["unavailable", "check", "run_batch_cuda", "summary_runs", "THREADS_PER_BLOCK"]
 
 #: Threads of a block. The per-point kernel is long and holds many registers: small blocks keep
 #: the multiprocessors' register files from limiting the blocks resident at once.
@@ -148,10 +148,12 @@ def workspaces(n: int, n_coef: int, capacity: int) -> tuple[tuple, tuple]:
     return tuple(rows[:12]), tuple(rows[12:])
 
 
-def run_batch_cuda(code: int, batch: tuple, options: tuple, outputs: tuple) -> None:
+def run_batch_cuda(code: int, batch: tuple, options: tuple, outputs: tuple, final_states=None) -> None:
     """Run every point of ``batch`` (the tuple ``integrate.driver.B_*``) on the GPU, one thread each, and fill
-    ``outputs`` (the tuple ``integrate.driver.O_*``) as :func:`.integrate.driver.run_block` does. Call
-    :func:`unavailable` first."""
+    ``outputs`` (the tuple ``integrate.driver.O_*``) as :func:`.integrate.driver.run_block` does; and
+    ``final_states`` (n x 5, optional) with each run's state ``(x1, x2, x1dot, x2dot, W)`` at its end (row
+    ``Y_STATE`` of its workspace, what :func:`.integrate.api.summary_run` returns). Call :func:`unavailable`
+    first."""
     from numba import cuda
 
     n = batch[0].shape[0]
@@ -165,3 +167,29 @@ def run_batch_cuda(code: int, batch: tuple, options: tuple, outputs: tuple) -> N
     cuda.synchronize()
     for host, device in zip(outputs, device_outputs, strict=True):
         device.copy_to_host(host)
+    if final_states is not None:
+        final_states[...] = device_w[W_Y].copy_to_host()[:, Y_STATE]
+
+
+def summary_runs(law, params_seq, t_ends, *, rtol: float, stop_when_settled: bool = True,
+                 stop_on=None) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`.integrate.api.summary_run` of every case of ``params_seq`` in one launch, one thread each:
+    the summaries (n x ``driver.N_SUMMARY``) and final states (n x 5) it would give, from the same inputs
+    (``t_ends``: each run's horizon, None for the case's own). The caller checks the arguments and calls
+    :func:`check` first."""
+    from .integrate import api
+    from .integrate import driver as d
+
+    packed = [api._packed(p, law, rtol) for p in params_seq]  # summary_run's inputs, cached
+    horizons = np.array([s.horizon if t_end is None else api.check_t_end(t_end, s.contact_time)
+                         for (_, _, _, s), t_end in zip(packed, t_ends, strict=True)])
+    batch = (np.stack([c for c, _, _, _ in packed]), np.stack([y0 for _, _, y0, _ in packed]), horizons,
+             np.stack([atol for _, atol, _, _ in packed]), np.array([s.max_step for _, _, _, s in packed]))
+    stop_kind, stop_count = api._stop_on(stop_on)
+    options = (rtol, stop_when_settled, stop_kind, stop_count, api.MAX_STEPS, api.MAX_EVENTS, api._stiff_after(True))
+    n = len(packed)
+    summary, final = np.empty((n, d.N_SUMMARY)), np.empty((n, 5))
+    no_sticks = np.empty((n, 1))  # the stick points are not read: one slot each
+    run_batch_cuda(law.code, batch, options, (summary, no_sticks, no_sticks.copy(), no_sticks.copy(),
+                                              np.empty(n, np.int64)), final)
+    return summary, final

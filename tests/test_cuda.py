@@ -1,11 +1,13 @@
 """The CUDA backend (phaseimpact/cuda.py) without a GPU: the same per-point kernel run by numba's
-CUDA simulator (one Python thread per point, the engine uncompiled) against the threads backend;
-the refusals (no GPU, a user law); the device kernel compiled to PTX for an H100 by the real CUDA
-target where NVVM is installed; and the portable ulp that replaced ``np.nextafter``."""
+CUDA simulator (one Python thread per point, the engine uncompiled) against the threads backend, for
+simulate_many, atlas, orbit diagrams and critical curves; the refusals (no GPU, a user law);
+the device kernel compiled to PTX for an H100 by the real CUDA target where NVVM is installed; and
+the portable ulp that replaced ``np.nextafter``."""
 
 from __future__ import annotations
 
 import hashlib
+import math
 import os
 import subprocess
 import sys
@@ -58,8 +60,52 @@ SIMULATED = textwrap.dedent("""
     a = atlas(seed_parameters(), "paper", {"kappa": KAPPAS[:3], "v": [0.5, 2.0]}, backend="cuda")
     out["atlas/outcome"] = a.outcome
     out["atlas/max_force"] = a.max_force
+    from test_cuda import ORBITS, orbit_diagram_of
+
+    for name in ORBITS:
+        for backend in ("cuda", "threads"):
+            d = orbit_diagram_of(name, backend)
+            out[f"orbits/{name}/{backend}/plate"] = d.plate
+            out[f"orbits/{name}/{backend}/peak_force"] = d.peak_force
+            out[f"orbits/{name}/{backend}/distinct"] = d.distinct
+    from phaseimpact.continuation import curve
+    from test_cuda import CURVES, SIMULATED_GPU_KAPPAS, critical_curve_of
+
+    curve.GPU_KAPPAS = SIMULATED_GPU_KAPPAS
+    for name in CURVES:
+        c = critical_curve_of(name, "cuda")
+        for column in ("values", "kappa", "requested", "predicted"):
+            out[f"curves/{name}/{column}"] = getattr(c, column)
     np.savez(sys.argv[1], **out)
 """)
+
+#: Orbit diagrams over each parameter, a law of each kind: (law, case options, param, values, period).
+ORBITS = {"hunt-crossley-T": ("hunt-crossley", {"kappa": 3e9}, "T", [0.4e-3, 1e-3, 3e-3], None),
+          "paper-v": ("paper", {"kappa": 3e9}, "v", [0.5, 1.0, 2.0], 3e-3),
+          "thornton-kappa": ("thornton", {"limiting_pressure": 2e9}, "kappa", [0.0, 1e9], 2e-3)}
+
+
+def orbit_diagram_of(name, backend):
+    from phaseimpact.train import orbit_diagram
+
+    law, case, param, values, period = ORBITS[name]
+    return orbit_diagram(seed_parameters(**case), law, param, values, period=period, transients=2, samples=3,
+                         backend=backend)
+
+#: Critical curves, each quantity the GPU corrector evaluates: (law, what, values of v, options); the
+#: grazing curve starts at the seed case's first grazing value (extremum 5, near 3.577e10 at v = 1).
+CURVES = {"kappa_c": ("paper", "kappa_c", [1.0, 2.0], {}),
+          "grazing": ("hunt-crossley", "grazing", [1.0, 1.05, 1.1], {"kappa_start": 3.577e10, "contact_index": 5})}
+#: Kappas of a launch of the GPU corrector under the simulator (few: each is a Python thread).
+SIMULATED_GPU_KAPPAS = 4
+
+
+def critical_curve_of(name, backend):
+    from phaseimpact.continuation import critical_curve
+
+    law, what, speeds, options = CURVES[name]
+    return critical_curve(seed_parameters(), law, "v", speeds, what=what, kappa_rtol=1e-10, backend=backend,
+                          **options)
 
 
 @pytest.fixture(scope="module")
@@ -115,6 +161,48 @@ def test_simulated_gpu_atlas_matches_threads(simulated):
     np.testing.assert_allclose(simulated["atlas/max_force"], threads.max_force, rtol=1e-9, atol=0)
 
 
+@pytest.mark.parametrize("name", list(ORBITS))
+def test_simulated_gpu_orbit_diagram_is_bit_identical_to_threads(simulated, name):
+    """orbit_diagram(backend="cuda"), one launch per impact over all values, against the threads backend
+    (each value's impacts in turn through simulate), both uncompiled in the simulator's process: the same
+    inputs and arithmetic, so states, peak forces and counts bit-identical."""
+    gpu, threads = _columns(simulated, f"orbits/{name}/cuda/"), _columns(simulated, f"orbits/{name}/threads/")
+    assert gpu.keys() == threads.keys() == {"plate", "peak_force", "distinct"}
+    for column in gpu:
+        np.testing.assert_array_equal(gpu[column], threads[column], err_msg=column)
+    values = ORBITS[name][3]
+    assert gpu["plate"].shape == (len(values), 3, 2) and np.all(np.isfinite(gpu["peak_force"]))
+    assert np.all(gpu["peak_force"] > 0)  # every sampled impact touched
+
+
+@pytest.mark.parametrize("name", list(ORBITS))
+def test_simulated_gpu_orbit_diagram_matches_the_compiled_threads_backend(simulated, name):
+    """The simulated GPU's orbit diagram against the compiled engine: distinct counts equal, states
+    and peak forces within 1e-9 relative (last bits of a libm call, carried over five impacts)."""
+    compiled = orbit_diagram_of(name, "threads")
+    gpu = _columns(simulated, f"orbits/{name}/cuda/")
+    np.testing.assert_array_equal(gpu["distinct"], compiled.distinct)
+    np.testing.assert_allclose(gpu["peak_force"], compiled.peak_force, rtol=1e-9, atol=0)
+    # the plate's x2 crosses zero: relative to the state's scales (Hertz indentation, v), as distinct counts
+    scale = np.array([seed_parameters(**ORBITS[name][1]).hertz_indentation, 1.0])
+    np.testing.assert_allclose(gpu["plate"] / scale, compiled.plate / scale, rtol=0, atol=1e-9)
+
+
+@pytest.mark.parametrize("name", list(CURVES))
+def test_simulated_gpu_critical_curve_walks_as_the_threads_backend(simulated, name):
+    """critical_curve(backend="cuda"): the same walk with the GPU's corrector (the defining function at
+    SIMULATED_GPU_KAPPAS kappas per launch, sign change narrowed to Brent's final bracket) against the
+    compiled threads backend (Brent's method): the same values walked, steps and requested flags, every
+    kappa within 1e-9 relative (both within kappa_rtol = 1e-10 of the root)."""
+    threads = critical_curve_of(name, "threads")
+    gpu = _columns(simulated, f"curves/{name}/")
+    np.testing.assert_array_equal(gpu["values"], threads.values)
+    np.testing.assert_array_equal(gpu["requested"], threads.requested)
+    assert len(gpu["values"]) > len(CURVES[name][2]) and not threads.message  # the step was halved on the way
+    np.testing.assert_allclose(gpu["kappa"], threads.kappa, rtol=1e-9, atol=0)
+    np.testing.assert_allclose(gpu["predicted"], threads.predicted, rtol=1e-9, atol=0)
+
+
 def _cuda_usable() -> bool:
     from phaseimpact import cuda
 
@@ -135,11 +223,50 @@ def test_without_a_gpu_the_cli_refuses_in_one_line(tmp_path):
 
 
 @pytest.mark.skipif(_cuda_usable(), reason="this machine has a usable GPU: nothing to refuse")
+def test_without_a_gpu_orbit_diagram_refuses_in_one_line(tmp_path):
+    """orbit-diagram --backend cuda without a GPU: exit 2, one line naming CUDA, no figure, no archive."""
+    figure, kept = tmp_path / "o.png", tmp_path / "o.nc"
+    out = subprocess.run([sys.executable, "-m", "phaseimpact.cli", "orbit-diagram", "--law", "hunt-crossley",
+                          "--kappa", "3e9", "--axis", "T=5e-4:4e-3:3", "--transients", "2", "--samples", "2",
+                          "--out", str(figure), "--archive", str(kept), "--backend", "cuda"], capture_output=True,
+                         text=True, timeout=300, cwd=ROOT, env=dict(os.environ, PYTHONPATH=str(ROOT)))
+    assert out.returncode == 2, out.stderr
+    lines = out.stderr.strip().splitlines()
+    assert len(lines) == 1 and "CUDA is not usable" in lines[0], out.stderr
+    assert not figure.exists() and not kept.exists()
+
+
+@pytest.mark.skipif(_cuda_usable(), reason="this machine has a usable GPU: nothing to refuse")
+def test_without_a_gpu_critical_curve_refuses_in_one_line(tmp_path):
+    """critical-curve --backend cuda without a GPU: exit 2, one line naming CUDA, no archive."""
+    out_file = tmp_path / "c.nc"
+    out = subprocess.run([sys.executable, "-m", "phaseimpact.cli", "critical-curve", "--axis", "v=1:2:2",
+                          "--out", str(out_file), "--backend", "cuda"], capture_output=True, text=True,
+                         timeout=300, cwd=ROOT, env=dict(os.environ, PYTHONPATH=str(ROOT)))
+    assert out.returncode == 2, out.stderr
+    lines = out.stderr.strip().splitlines()
+    assert len(lines) == 1 and "backend = 'cuda': CUDA is not usable" in lines[0], out.stderr
+    assert not out_file.exists()
+
+
+@pytest.mark.skipif(_cuda_usable(), reason="this machine has a usable GPU: nothing to refuse")
 def test_without_a_gpu_python_refuses_before_any_work():
     with pytest.raises(ValueError, match="backend = 'cuda': CUDA is not usable"):
         simulate_many([seed_parameters()], "paper", backend="cuda")
     with pytest.raises(ValueError, match="CUDA is not usable"):
         atlas(seed_parameters(), "paper", {"kappa": [1e9, 1e10]}, backend="cuda")
+    from phaseimpact.train import orbit_diagram
+
+    with pytest.raises(ValueError, match="backend = 'cuda': CUDA is not usable"):
+        orbit_diagram(seed_parameters(kappa=3e9), "hunt-crossley", "T", [1e-3, 2e-3], backend="cuda")
+    with pytest.raises(ValueError, match="backend = 'dask' is out of range; allowed: one of threads, cuda"):
+        orbit_diagram(seed_parameters(kappa=3e9), "hunt-crossley", "T", [1e-3, 2e-3], backend="dask")
+    from phaseimpact.continuation import critical_curve
+
+    with pytest.raises(ValueError, match="backend = 'cuda': CUDA is not usable"):
+        critical_curve(seed_parameters(), "paper", "v", [1.0, 2.0], backend="cuda")
+    with pytest.raises(ValueError, match="backend = 'mpi' is out of range; allowed: one of threads, cuda"):
+        critical_curve(seed_parameters(), "paper", "v", [1.0, 2.0], backend="mpi")
 
 
 def test_the_cli_offers_every_backend_of_the_library():
@@ -160,7 +287,7 @@ def test_backends_command_lists_each_backend():
 
 def test_a_user_law_is_refused_on_the_gpu():
     """A user law is a Python function: refused with backend cuda (before any run), whether or not
-    a GPU exists, in simulate_many and atlas alike."""
+    a GPU exists, in simulate_many, atlas, orbit diagrams and critical curves alike."""
     import phaseimpact
 
     with restored_registry():  # later tests enumerate the registry (test_precompile's fingerprint)
@@ -170,6 +297,25 @@ def test_a_user_law_is_refused_on_the_gpu():
             simulate_many([seed_parameters(kappa=1e5)], "cuda-test-kk", backend="cuda")
         with pytest.raises(ValueError, match="cannot run the user law 'cuda-test-kk'"):
             atlas(seed_parameters(kappa=1e5), "cuda-test-kk", {"kappa": [1e5, 1e6]}, backend="cuda")
+        from phaseimpact.train import orbit_diagram
+
+        with pytest.raises(ValueError, match="cannot run the user law 'cuda-test-kk'"):
+            orbit_diagram(seed_parameters(kappa=1e5), "cuda-test-kk", "T", [1e-3, 2e-3], backend="cuda")
+        from phaseimpact.continuation import critical_curve
+
+        with pytest.raises(ValueError, match="cannot run the user law 'cuda-test-kk'"):
+            critical_curve(seed_parameters(), "cuda-test-kk", "v", [1.0, 2.0], what="grazing", kappa_start=1e5,
+                           backend="cuda")
+
+
+def test_orbit_diagram_checks_its_tolerance_before_any_run():
+    """The GPU's runs do not pass through simulate, which checked rtol for the threads backend:
+    orbit_diagram checks it first, for both backends, GPU or not."""
+    from phaseimpact.train import orbit_diagram
+
+    for backend in ("threads", "cuda"):
+        with pytest.raises(ValueError, match=r"rtol = 5.0 is out of range; allowed: 1e-13 <= rtol <= 0.001"):
+            orbit_diagram(seed_parameters(kappa=3e9), "hunt-crossley", "T", [1e-3], rtol=5.0, backend=backend)
 
 
 def test_ulp_above_is_nextafter_bit_for_bit():
@@ -253,3 +399,81 @@ def test_the_gpu_benchmark_runs_under_the_simulator(tmp_path):
     text = results.read_text()
     assert "GPU vs CPU equal in codes and counts" in text
     assert text.count("| (a) paper atlas | 9 |") == 3 and "| (b) hunt-crossley" in text
+
+
+def _synthetic_margins(monkeypatch, margin):
+    """The GPU corrector's launches answered on the CPU with ``margin(kappa)`` as each run's first stick
+    margin; returns the list of each launch's kappas."""
+    from phaseimpact import cuda
+    from phaseimpact.integrate import driver as d
+
+    launches = []
+
+    def summary_runs(law, points, t_ends, *, rtol, **options):
+        kappas = np.array([p.kappa for p in points])
+        launches.append(kappas)
+        summary = np.zeros((len(points), d.N_SUMMARY))
+        summary[:, d.S_STATUS] = d.SUCCESS
+        summary[:, d.S_FIRST_STICK_MARGIN] = margin(kappas)
+        return summary, np.zeros((len(points), 5))
+
+    monkeypatch.setattr(cuda, "summary_runs", summary_runs)
+    return launches
+
+
+@pytest.mark.parametrize("kappa_rtol", [1e-10, 1e-14])
+def test_gpu_corrector_narrows_to_brents_final_bracket(monkeypatch, kappa_rtol):
+    """A margin with one known root: the root within kappa_rtol / 4 (Brent's xtol in log(kappa)), in
+    launches of GPU_KAPPAS kappas each, a 2 % bracket narrowed GPU_KAPPAS + 1-fold a launch (5 launches
+    at kappa_rtol = 1e-10, as GPU_KAPPAS's docstring says); each launch's kappas in the last's bracket."""
+    from phaseimpact.continuation import curve
+    from phaseimpact.model import as_law
+
+    root = 1.234567e12
+    launches = _synthetic_margins(monkeypatch, lambda k: np.log(root) - np.log(k))
+    correct = curve._gpu_corrector(as_law("paper"), "kappa_c", 1, kappa_rtol, 1e-10)
+    found = correct(seed_parameters(), root * 1.01, 0.02)
+    assert abs(math.log(found / root)) <= kappa_rtol / 4 + curve.BRENT_RTOL * math.log(root)
+    assert all(len(kappas) == curve.GPU_KAPPAS for kappas in launches)
+    if kappa_rtol == 1e-10:
+        assert len(launches) == 5
+    for before, after in zip(launches[:-1], launches[1:], strict=True):
+        assert before.min() <= after.min() and after.max() <= before.max()
+
+
+def test_gpu_corrector_refuses_a_bracket_as_brent_does_and_several_sign_changes(monkeypatch):
+    """None for ends of one sign or not finite (as the threads corrector), and for a bracket whose samples
+    change sign five times, its ends of opposite signs (Brent would take one of the roots: the GPU's
+    corrector takes none)."""
+    from phaseimpact.continuation import curve
+    from phaseimpact.model import as_law
+
+    law, p, guess = as_law("paper"), seed_parameters(), 1e12
+    for margin in (lambda k: np.log(k) * 0 + 1.0,  # no root
+                   lambda k: np.where(k > guess * 1.01, -np.inf, np.log(guess * 0.99) - np.log(k)),  # end -inf
+                   lambda k: np.sin(np.log(k / guess) * 2.5 * np.pi / 0.02)):  # roots at 0, +-0.008, +-0.016
+        _synthetic_margins(monkeypatch, margin)
+        assert curve._gpu_corrector(law, "kappa_c", 1, 1e-10, 1e-10)(p, guess, 0.02) is None
+
+
+def test_gpu_corrector_does_not_read_a_failed_run(monkeypatch):
+    """A launch whose run failed is not read as a value: RunFailed naming its kappa and status (the run
+    again on the CPU, which succeeds here, has no message to add)."""
+    from phaseimpact.continuation import curve
+    from phaseimpact.continuation.transition import RunFailed
+    from phaseimpact.integrate import driver as d
+    from phaseimpact.model import as_law
+
+    _synthetic_margins(monkeypatch, lambda k: np.log(1e12) - np.log(k))
+    from phaseimpact import cuda
+
+    answered = cuda.summary_runs
+
+    def failing(*args, **options):
+        summary, final = answered(*args, **options)
+        summary[1, d.S_STATUS] = d.STATUSES.index("step-size-collapse")
+        return summary, final
+
+    monkeypatch.setattr(cuda, "summary_runs", failing)
+    with pytest.raises(RunFailed, match=r"kappa = 9\.\d+e\+11: step-size-collapse on the GPU"):
+        curve._gpu_corrector(as_law("paper"), "kappa_c", 1, 1e-10, 1e-10)(seed_parameters(), 1e12, 0.1)

@@ -93,7 +93,8 @@ COMMANDS: list[Command] = [
             help="which --backend choices work on this machine, and why not",
             description="Lists each backend of sweep and atlas (--backend) with whether it can run here: threads, "
                         "joblib processes (loky), a Dask cluster (dask), and a GPU (cuda, with what is missing "
-                        "when there is none: the CUDA driver, NVVM or a device)."),
+                        "when there is none: the CUDA driver, NVVM or a device). orbit-diagram and "
+                        "critical-curve take threads or cuda."),
     Command("check-law", inputs.add_check_law, inputs.run_check_law,
             help="run the law conformance suite on a law or a law file",
             description="The checks every shipped law passes (force, repulsive on loading, partials against finite "

@@ -51,6 +51,11 @@ def add_critical_curve(p) -> None:
     options.samples(p, None)
     options.kappa_tolerance(p, "width of kappa_c's (kappa_2's, the grazing value's) final bracket at each point")
     options.tolerance(p)
+    p.add_argument("--backend", choices=("threads", "cuda"), default="threads",
+                   help="where each point's correction runs: this process (Brent's method), or a GPU (cuda: the "
+                        "defining function at many kappas of the bracket in each launch, one thread each; the first "
+                        "point and kappa_2's confirmation stay on the CPU; phaseimpact backends says whether it works "
+                        "here) (default: %(default)s)")
     options.out_options(p, resume=False)
     options.json_option(p)
 
@@ -125,6 +130,10 @@ def run_critical_curve(args) -> int:
     what = args.what
     _check_what(args, setup)
     param, values = _curve_values(args, setup)
+    if args.backend == "cuda":
+        from .. import cuda
+
+        cuda.check(law)  # a user law, or no GPU: one line and exit 2, nothing computed
     out = args.out
     archive.created_timestamp()
     samples = args.samples or DEFAULT_SAMPLES
@@ -147,7 +156,7 @@ def run_critical_curve(args) -> int:
         try:
             curve = critical_curve(setup.case, law, param, values, what=what, kappa_rtol=args.kappa_rtol,
                                    rtol=args.rtol, contact_index=index, kappa_start=start,
-                                   progress=_progress(args))
+                                   progress=_progress(args), backend=args.backend)
         except RunFailed as error:  # every input was checked: this is the curve's own failure
             print(f"phaseimpact: the curve failed to start: {error}; nothing written", file=sys.stderr)
             return EXIT_FAILURE

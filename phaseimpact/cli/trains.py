@@ -80,6 +80,9 @@ def add_orbit_diagram(p) -> None:
     p.add_argument("--samples", type=_integer("samples", 1, 100_000), default=50,
                    help="impacts kept at each value (default: %(default)s)")
     _threads_option(p, "values")
+    p.add_argument("--backend", choices=("threads", "cuda"), default="threads",
+                   help="threads of this process (--jobs), or a GPU (cuda: each impact of every value in one launch, "
+                        "one thread per value; phaseimpact backends says whether it works here) (default: %(default)s)")
     _figure_option(p, "the diagram")
     options.tolerance(p)
     options.json_option(p)
@@ -255,10 +258,15 @@ def run_orbit_diagram(args) -> int:
     work = _train_work(args, "orbit-diagram", {param: values}, period=args.period, transients=args.transients,
                        samples=args.samples)
     _check_archive_target(args, setup, work)
+    if args.backend == "cuda":
+        from .. import cuda
+
+        cuda.check(setup.law)  # a user law, or no GPU: one line and exit 2, nothing computed
     _note(f"orbit diagram of {setup.law.label()} over {param}: {len(values)} values x "
           f"{args.transients + args.samples} impacts")
     diagram = orbit_diagram(setup.params, setup.law, param, values, period=args.period,
-                            transients=args.transients, samples=args.samples, rtol=args.rtol, n_jobs=args.jobs)
+                            transients=args.transients, samples=args.samples, rtol=args.rtol, n_jobs=args.jobs,
+                            backend=args.backend)
     _save_train_archive(args, setup, diagram, work)
     if args.out is not None:
         with exclusive(args.out, "out"):

@@ -5,6 +5,12 @@ Natural-parameter continuation of the defining function with step control: each 
 predicted from the previous ones (secant in log-log), corrected by Brent's method on a
 bracket around the prediction, and where the prediction is poor the step is halved (the
 intermediate points are computed and kept, flagged as not asked for).
+
+The walk is sequential (each bracket comes from the roots before it); what a backend changes
+is the corrector. ``threads``: Brent's method, one run at a time. ``cuda``: the defining
+function at :data:`GPU_KAPPAS` kappas across the bracket in one GPU launch (one thread per
+kappa), the sub-bracket of its sign change, again, until the bracket is as narrow as Brent's
+final one.
 """
 
 from __future__ import annotations
@@ -17,9 +23,12 @@ from tqdm.auto import tqdm
 
 from ..case import Case
 from ..integrate.api import check_rtol
+from ..integrate.driver import S_STATUS, STATUSES, SUCCESS
 from ..model.laws import ContactLaw, as_law
 from ..parameters import Parameters
+from ._kappa_search import checked_summary
 from ._renamed import renamed_tolerances
+from .grazing import extremum_of, extremum_run
 from .transition import (
     KAPPA_2_RTOL,
     RunFailed,
@@ -29,12 +38,19 @@ from .transition import (
     delta_extremum,
     first_stick_margin,
     locate_kappa_2,
+    margin_of,
+    margin_run,
 )
 
 __all__ = ["CriticalCurve", "critical_curve", "CURVE_QUANTITIES"]
 
 #: What :func:`critical_curve` continues.
 CURVE_QUANTITIES = ("kappa_c", "kappa_2", "grazing")
+#: Where :func:`critical_curve`'s corrector runs.
+CURVE_BACKENDS = ("threads", "cuda")
+#: Kappas of one GPU launch of the ``cuda`` corrector (one thread each): each launch narrows the
+#: bracket ``GPU_KAPPAS + 1``-fold, so a 2 % bracket reaches ``kappa_rtol = 1e-10`` in 5 launches.
+GPU_KAPPAS = 128
 
 
 @dataclass(frozen=True)
@@ -114,7 +130,7 @@ def _parameters(base, param, value) -> Parameters:
 def critical_curve(base: Parameters | Case, law: ContactLaw | str, param: str, values, *,
                    what: str = "kappa_c", kappa_rtol: float = 1e-10, rtol: float = 1e-10,
                    contact_index: int = 1, kappa_start: float | None = None, max_halvings: int = 6,
-                   progress: bool = False) -> CriticalCurve:
+                   progress: bool = False, backend: str = "threads") -> CriticalCurve:
     """Continue ``what`` over ``values`` of ``param`` (see the module docstring).
 
     Raises ``ValueError`` for bad arguments (before any work) and
@@ -127,6 +143,16 @@ def critical_curve(base: Parameters | Case, law: ContactLaw | str, param: str, v
     20 %, of the prediction; where both fail the step is halved (at most ``max_halvings`` times
     per value). ``kappa_2`` rides on the continued ``kappa_c`` (:func:`locate_kappa_2` at each
     point); an unconfirmed ``kappa_2`` is NaN, named in the message.
+
+    ``backend="cuda"`` keeps this walk and replaces Brent's method in the corrector: the defining
+    function (the first stick's margin, or ``delta`` at the extremum) at :data:`GPU_KAPPAS`
+    kappas evenly spaced in ``log(kappa)`` across the bracket, in one GPU launch; the bracket
+    is refused as Brent's is (ends not finite or of one sign) and also when the samples change
+    sign more than once (Brent would take one of the roots); else the interval of the sign change
+    is sampled again, until it is as narrow as Brent's final bracket (``kappa_rtol / 4`` in
+    ``log(kappa)``): both backends meet ``kappa_rtol`` (``tests/test_cuda.py``). The first
+    point's search (:func:`critical_damping`; ``grazing``: the corrector, on the GPU) and
+    ``kappa_2``'s confirmation stay on the CPU.
 
     Parameters
     ----------
@@ -156,6 +182,9 @@ def critical_curve(base: Parameters | Case, law: ContactLaw | str, param: str, v
         Step halvings allowed before a value counts as lost.
     progress : bool, default False
         Draw a progress bar on stderr.
+    backend : {"threads", "cuda"}, default "threads"
+        Where the corrector runs (above): this thread, or a GPU; ``cuda`` is refused before any
+        work for a user law or without a usable GPU.
 
     Returns
     -------
@@ -168,7 +197,8 @@ def critical_curve(base: Parameters | Case, law: ContactLaw | str, param: str, v
     ValueError
         For ``what`` not in :data:`CURVE_QUANTITIES`, a law that does not fit ``what``,
         ``param = "kappa"``, bad ``values`` (or a case invalid at either end), ``kappa_rtol`` or
-        ``rtol`` out of range, or ``grazing`` without ``kappa_start``.
+        ``rtol`` out of range, ``grazing`` without ``kappa_start``, or ``backend`` out of range
+        (``cuda``: without a usable GPU, or for a user law).
     TypeError
         For the spellings of 0.2.0 (``integrator_rtol=``; ``rtol=`` without ``kappa_rtol=``).
     RunFailed
@@ -196,7 +226,15 @@ def critical_curve(base: Parameters | Case, law: ContactLaw | str, param: str, v
     """
     law = as_law(law)
     values, rtol = _checked(base, law, param, values, what, kappa_rtol, rtol)
-    correct = _corrector(law, what, contact_index, kappa_rtol, rtol)
+    if backend not in CURVE_BACKENDS:
+        raise ValueError(f"backend = {backend!r} is out of range; allowed: one of {', '.join(CURVE_BACKENDS)}")
+    if backend == "cuda":
+        from .. import cuda
+
+        cuda.check(law)
+        correct = _gpu_corrector(law, what, contact_index, kappa_rtol, rtol)
+    else:
+        correct = _corrector(law, what, contact_index, kappa_rtol, rtol)
     first = _first_point(base, law, param, values, what, kappa_start, correct, kappa_rtol, rtol)
     walk_x, walk_k, walk_req, walk_pred, message = _walk(base, param, values, first, correct, max_halvings,
                                                          f"{what}({param})", progress)
@@ -248,7 +286,56 @@ def _corrector(law, what, contact_index, kappa_rtol, rtol):
         f_lo, f_hi = f(lo), f(hi)
         if not (math.isfinite(f_lo) and math.isfinite(f_hi)) or (f_lo > 0) == (f_hi > 0):
             return None
-        return math.exp(brentq(f, lo, hi, xtol=kappa_rtol / 4, rtol=4 * np.finfo(float).eps))
+        return math.exp(brentq(f, lo, hi, xtol=kappa_rtol / 4, rtol=BRENT_RTOL))
+    return correct
+
+
+#: Brent's ``rtol`` in the ``threads`` corrector (its ``xtol`` is ``kappa_rtol / 4``): it stops at a
+#: bracket narrower than ``xtol + rtol |log(kappa)|``, the ``cuda`` corrector's stop too.
+BRENT_RTOL = 4 * np.finfo(float).eps
+
+
+def _gpu_corrector(law, what, contact_index, kappa_rtol, rtol):
+    """:func:`_corrector` on a GPU: the defining function at :data:`GPU_KAPPAS` points of the bracket
+    in one launch, the interval of its one sign change sampled again until narrower than Brent's final
+    bracket; None where Brent's corrector refuses the bracket, or where the samples change sign more
+    than once."""
+    from .. import cuda
+
+    if what == "grazing":  # delta_extremum's and first_stick_margin's runs and readings
+        def run(q):
+            return extremum_run(q, contact_index)
+        read = extremum_of
+    else:
+        run, read = margin_run, lambda summary, _final: margin_of(summary)
+
+    def defining(p: Parameters, log_kappas: np.ndarray) -> np.ndarray:
+        points = [p.replace(kappa=math.exp(x)) for x in log_kappas]
+        t_ends, options = [run(q)[0] for q in points], run(p)[1]
+        summaries, finals = cuda.summary_runs(law, points, t_ends, rtol=rtol, **options)
+        for point, t_end, summary in zip(points, t_ends, summaries, strict=True):
+            if summary[S_STATUS] != SUCCESS:  # a search must not read a failed run: the CPU's message
+                checked_summary(point, law, t_end, rtol=rtol, **options)
+                raise RunFailed(f"kappa = {point.kappa:.6g}: {STATUSES[int(summary[S_STATUS])]} on the GPU")
+        return np.array([read(summary, final) for summary, final in zip(summaries, finals, strict=True)])
+
+    def correct(p: Parameters, guess: float, width: float) -> float | None:
+        x = np.linspace(math.log(guess) - width, math.log(guess) + width, GPU_KAPPAS)
+        f = defining(p, x)
+        if not (math.isfinite(f[0]) and math.isfinite(f[-1])) or (f[0] > 0) == (f[-1] > 0):
+            return None
+        while True:
+            changes = np.flatnonzero((f[:-1] > 0) != (f[1:] > 0))
+            if changes.size != 1:
+                return None
+            i = changes[0]
+            lo, hi = x[i], x[i + 1]
+            # the width falls GPU_KAPPAS + 1-fold a launch; at the stop, it spans several ulps of log(kappa)
+            if hi - lo < kappa_rtol / 4 + BRENT_RTOL * max(abs(lo), abs(hi)):
+                return math.exp(0.5 * (lo + hi))
+            inner = np.linspace(lo, hi, GPU_KAPPAS + 2)[1:-1]
+            x = np.concatenate(([lo], inner, [hi]))
+            f = np.concatenate(([f[i]], defining(p, inner), [f[i + 1]]))
     return correct
 
 

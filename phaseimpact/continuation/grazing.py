@@ -150,13 +150,20 @@ def delta_extremum(params: Parameters, law: ContactLaw | str, j: int, *, rtol: f
     >>> print(f"{delta_extremum(p, 'hunt-crossley', 1):.4g} {delta_extremum(p, 'hunt-crossley', 2):.4g}")
     3.629e-05 -0.0001097
     """
+    t_end, options = extremum_run(params, j)
+    return extremum_of(*checked_summary(params, law, t_end, rtol=rtol, **options))
+
+
+def extremum_run(params: Parameters, j: int) -> tuple[float, dict]:
+    """The horizon and options of :func:`delta_extremum`'s run."""
     # no stop when out of reach: the extrema go on (below zero), so each stays defined across
     # the kappa where the projectile stops getting out of reach
-    summary, y = checked_summary(params, law, _extrema_horizon(params), rtol=rtol, stop_on=("reversal", j),
-                                 stop_when_settled=False)
-    if summary[S_REASON] != ASKED_STOP:
-        return -math.inf
-    return float(y[0] - y[1])
+    return _extrema_horizon(params), {"stop_on": ("reversal", j), "stop_when_settled": False}
+
+
+def extremum_of(summary, y) -> float:
+    """:func:`delta_extremum` read from its run's summary and final state."""
+    return float(y[0] - y[1]) if summary[S_REASON] == ASKED_STOP else -math.inf
 
 
 def _check_ok(trajectory):

@@ -148,7 +148,18 @@ def first_stick_margin(params: Parameters, law: ContactLaw | str = "paper", *, r
     >>> print(f"{first_stick_margin(p.replace(kappa=1e12)):.4f} {first_stick_margin(p.replace(kappa=2e12)):.4f}")
     0.2046 -0.1795
     """
-    margin = checked_summary(params, law, None, rtol=rtol, stop_on="stick")[0][S_FIRST_STICK_MARGIN]
+    t_end, options = margin_run(params)
+    return margin_of(checked_summary(params, law, t_end, rtol=rtol, **options)[0])
+
+
+def margin_run(params: Parameters) -> tuple[None, dict]:
+    """The horizon (the case's own) and options of :func:`first_stick_margin`'s run."""
+    return None, {"stop_on": "stick"}
+
+
+def margin_of(summary) -> float:
+    """:func:`first_stick_margin` read from its run's summary."""
+    margin = summary[S_FIRST_STICK_MARGIN]
     return -math.inf if math.isnan(margin) else float(margin)
 
 

@@ -4,6 +4,9 @@ case, the law and the period, checks them before any work, and runs the generic 
 
 from __future__ import annotations
 
+import numpy as np
+
+from ..integrate.api import check_rtol
 from ..model import as_law
 from ..parameters import Parameters
 from .basins import Basins, check_grid, check_settling, find
@@ -19,7 +22,7 @@ from .continuation import (
     walk,
 )
 from .impact import TRAIN_PARAMETERS, ModelImpactMap, check_period
-from .orbit_diagram import OrbitDiagram, check_counts, check_values, diagram
+from .orbit_diagram import OrbitDiagram, assembled, check_counts, check_values, diagram
 
 __all__ = ["orbit_diagram", "continue_map_orbit", "continue_map_bifurcation", "basins"]
 
@@ -28,9 +31,24 @@ def _peak_force(run) -> float:
     return run.max_force
 
 
+#: Where :func:`orbit_diagram` runs: threads of this process, or a GPU (:mod:`phaseimpact.cuda`).
+ORBIT_DIAGRAM_BACKENDS = ("threads", "cuda")
+
+
 def orbit_diagram(params: Parameters, law, param: str, values, *, period: float | None = None,
-                  transients: int = 200, samples: int = 50, rtol: float = 1e-10, n_jobs: int = 1) -> OrbitDiagram:
+                  transients: int = 200, samples: int = 50, rtol: float = 1e-10, n_jobs: int = 1,
+                  backend: str = "threads") -> OrbitDiagram:
     """Iterate the impact map at each of ``values`` of ``param`` and keep the last ``samples`` states.
+
+    The values are independent, the impacts of one value are not (each starts from the state the
+    last one left): ``threads`` runs values side by side, each its impacts in turn; ``cuda`` runs
+    impact ``n`` of every value as one GPU launch (one thread per value, the per-point kernel of
+    :mod:`phaseimpact.cuda`), ``transients + samples`` launches in turn. A launch is as wide as the
+    number of values: a few values leave most of the GPU idle. Both take each impact's inputs as
+    :meth:`~phaseimpact.maps.impact.ModelImpactMap.step` does and the same arithmetic follows (the
+    per-point path without an event log, whose numbers are :func:`~phaseimpact.simulate`'s): the
+    diagrams are bit-identical where both run the same compiled (or uncompiled) code
+    (``tests/test_cuda.py``).
 
     Parameters
     ----------
@@ -48,7 +66,10 @@ def orbit_diagram(params: Parameters, law, param: str, values, *, period: float 
     rtol : float, default 1e-10
         The integrator's relative tolerance.
     n_jobs : int, default 1
-        Values computed side by side (threads; the result does not depend on it).
+        Values computed side by side (threads; the result does not depend on it; not read by ``cuda``).
+    backend : {"threads", "cuda"}, default "threads"
+        ``cuda``: each impact of every value at once on a GPU (above); refused before any work for
+        a user law or without a usable GPU.
 
     Returns
     -------
@@ -57,7 +78,7 @@ def orbit_diagram(params: Parameters, law, param: str, values, *, period: float 
     Raises
     ------
     ValueError
-        A parameter name, values, period, or number of transients or samples out of range.
+        A parameter name, values, period, number of transients or samples, or backend out of range.
 
     Examples
     --------
@@ -82,8 +103,58 @@ def orbit_diagram(params: Parameters, law, param: str, values, *, period: float 
         for value in (values.min(), values.max()):
             check_period(float(value), params, "T")
     check_counts(transients, samples)
-    return diagram(ModelImpactMap(params, law, period, rtol), param, values, transients, samples, _peak_force,
-                   n_jobs)
+    if backend not in ORBIT_DIAGRAM_BACKENDS:
+        raise ValueError(f"backend = {backend!r} is out of range; allowed: one of {', '.join(ORBIT_DIAGRAM_BACKENDS)}")
+    imap = ModelImpactMap(params, law, period, check_rtol(rtol))  # the GPU's runs do not pass through simulate
+    if backend == "cuda":
+        from .. import cuda
+
+        cuda.check(law)
+        return _diagram_on_gpu(imap, param, values, transients, samples)
+    return diagram(imap, param, values, transients, samples, _peak_force, n_jobs)
+
+
+def _diagram_on_gpu(imap: ModelImpactMap, param: str, values, transients: int, samples: int) -> OrbitDiagram:
+    """:func:`orbit_diagram`'s ``cuda`` backend on checked arguments: impact ``n`` of every value in
+    one launch. Each value's run gets what :meth:`ModelImpactMap.step` gives :func:`~phaseimpact.simulate`
+    (the case's packed coefficients and tolerances, the period as horizon, the arrival as initial state,
+    no stop when settled); its summary gives the peak force, its final state the next arrival."""
+    from .. import cuda
+    from ..integrate import api
+    from ..integrate import driver as d
+
+    maps = [imap.at(param, float(value)) for value in values]
+    n = len(maps)
+    coefficients, tolerances, starts = (np.stack([api._packed(m.params, m.law, m.rtol)[k] for m in maps])
+                                        for k in range(3))  # simulate's inputs; W from the seed state, as in _initial
+    horizons, max_steps, speeds = np.empty(n), np.empty(n), np.empty(n)
+    for i, m in enumerate(maps):
+        m.check()
+        s = api._packed(m.params, m.law, m.rtol)[3]
+        horizons[i], max_steps[i], speeds[i] = api.check_t_end(m.period, s.contact_time), s.max_step, m.params.v
+    stop_kind, stop_count = api._stop_on(None)
+    options = (imap.rtol, False, stop_kind, stop_count, api.MAX_STEPS, api.MAX_EVENTS, api._stiff_after(True))
+    summary = np.empty((n, d.N_SUMMARY))
+    no_sticks = np.empty((n, 1))  # the stick points are not read: one slot each
+    outputs = (summary, no_sticks, no_sticks.copy(), no_sticks.copy(), np.empty(n, np.int64))
+    final = np.empty((n, 5))
+    plate = np.empty((n, samples, 2))
+    peak_force = np.empty((n, samples))
+    z = np.stack([m.origin for m in maps]).astype(float)
+    for step in range(transients + samples):
+        unusable = np.flatnonzero(~np.all(np.isfinite(z), axis=1))
+        if unusable.size:  # simulate refuses such an arrival: the same ValueError as the threads backend's
+            first = maps[unusable[0]]
+            api._initial(first.params, first._arrival(z[unusable[0]]))
+        starts[:, 0] = starts[:, 1] = z[:, 0]  # ModelImpactMap._arrival: (x2, x2, v, x2dot)
+        starts[:, 2], starts[:, 3] = speeds, z[:, 1]
+        cuda.run_batch_cuda(imap.law.code, (coefficients, starts, horizons, tolerances, max_steps), options, outputs,
+                            final)
+        if step >= transients:
+            plate[:, step - transients] = z
+            peak_force[:, step - transients] = summary[:, d.S_MAX_FORCE]
+        z = final[:, [1, 3]]
+    return assembled(imap, param, values, plate, peak_force)
 
 
 def continue_map_orbit(params: Parameters, law, param: str, start: float, stop: float, *,

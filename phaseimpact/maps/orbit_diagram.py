@@ -143,8 +143,12 @@ def diagram(imap, param, values, transients, samples, observe, n_jobs) -> OrbitD
 
     columns = map_in_threads(lambda value: _column(imap.at(param, float(value)), transients, samples, observe),
                              values, n_jobs)
-    plate = np.stack([c[0] for c in columns])
-    observed = np.stack([c[1] for c in columns])
+    return assembled(imap, param, values, np.stack([c[0] for c in columns]), np.stack([c[1] for c in columns]))
+
+
+def assembled(imap, param, values, plate, observed) -> OrbitDiagram:
+    """The diagram of the sampled states ``plate`` (values x samples x dim) and what was observed of each
+    step, with its counts of distinct points (to 1e-6 of ``imap``'s scales)."""
     scale = np.asarray(imap.scale, dtype=float)
     distinct = np.array([len(np.unique(np.round(col / scale / 1e-6), axis=0)) for col in plate])
     return OrbitDiagram(param, values, plate, observed, distinct)
