@@ -17,13 +17,21 @@ without events (what a user would write; its max force is only the largest over 
 Errors: max force, restitution (Hunt-Crossley) or the slip time and stick depth (paper),
 relative to the oracle at rtol 1e-13.
 
-    python benchmarks/trajectory.py [--quick]
+``--against TREE`` times this checkout against another one (e.g. ``git worktree add /tmp/old
+<commit>``) on the first case: fresh processes, one per tree and round, taking turns, so that the
+load of a shared machine hits both alike; it prints the median per-call times, their ratio and
+whether the results are bit for bit the same, and saves ``results/trajectory_against.md``.
+
+    python benchmarks/trajectory.py [--quick] [--against TREE [--rounds N]]
 """
 
 from __future__ import annotations
 
 import argparse
+import json
+import os
 import statistics
+import subprocess
 import sys
 import time
 from pathlib import Path
@@ -159,11 +167,70 @@ def rel(a, b) -> float:
     return abs(a - b) / abs(b) if b else abs(a - b)
 
 
+def worker(repeats: int) -> int:
+    """One process's numbers for ``--against`` (the first case, in the checkout on ``PYTHONPATH``):
+    median times of one ``simulate`` and of one compiled ``driver.run``, and the results' bits."""
+    import phaseimpact
+
+    label, kappa, law, t_end, stop_on, _ = CASES[0]
+    params = seed_parameters(v=1.0, kappa=kappa)
+    args_ = driver_args(params, law, t_end, RTOL, stop_on)
+
+    def call():
+        return simulate(params, law, t_end, rtol=RTOL, stop_on=stop_on)
+
+    times = interleaved({"simulate": repeat(call), "loop": lambda n: _loop(n, *args_)}, repeats)
+    tr = call()
+    bits = [float(x).hex() for x in np.concatenate([tr.summary, tr.final_state])]
+    print(json.dumps({"tree": str(Path(phaseimpact.__file__).parent.parent), "case": label, **times, "bits": bits}))
+    return 0
+
+
+def against(tree: Path, rounds: int, repeats: int) -> int:
+    """This checkout against ``tree``: a worker process per tree and round, taking turns."""
+    here = Path(__file__).resolve().parent.parent
+    start_load = load()
+    runs = {"before": [], "after": []}
+    for _ in range(rounds):
+        for name, root in (("before", tree), ("after", here)):
+            env = dict(os.environ, PYTHONPATH=str(root))
+            out = subprocess.run([sys.executable, __file__, "--worker", str(repeats)], env=env, cwd=root,
+                                 capture_output=True, text=True, check=True)
+            result = json.loads(out.stdout.strip().splitlines()[-1])
+            assert Path(result["tree"]).resolve() == root.resolve(), (result["tree"], root)
+            runs[name].append(result)
+    end_load = load()
+    med = {name: {k: statistics.median(r[k] for r in rs) for k in ("simulate", "loop")} for name, rs in runs.items()}
+    ratios = {k: statistics.median(b[k] / a[k] for b, a in zip(runs["before"], runs["after"], strict=True))
+              for k in ("simulate", "loop")}
+    same = all(r["bits"] == runs["before"][0]["bits"] for r in runs["before"] + runs["after"])
+    rows = [(name, us(med[name]["simulate"]), us(med[name]["loop"]), us(med[name]["simulate"] - med[name]["loop"]))
+            for name in ("before", "after")]
+    rows.append(("before / after (median of the rounds' ratios)", f"{ratios['simulate']:.2f}",
+                 f"{ratios['loop']:.2f}", ""))
+    text = (f"{runs['before'][0]['case']}: `{tree}` (before) against this checkout (after), {rounds} rounds of a "
+            f"fresh process per tree, taking turns; each number a median of {repeats} repeats.\n\n"
+            + table(("tree", "simulate [µs]", "compiled loop [µs]", "Python layer [µs]"), rows)
+            + f"\n\nResults (summary and final state) bit for bit the same: {'yes' if same else 'NO'}.")
+    emit(text)
+    emit(f"\n{start_load} at the start, {end_load} at the end")
+    save_section("trajectory_against", f"## One trajectory, before and after\n\n{machine()}\n\n{start_load} at the "
+                 f"start, {end_load} at the end.\n\n{text}\n\n`python benchmarks/trajectory.py --against TREE`")
+    return 0 if same else 1
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__)
     ap.add_argument("--quick", action="store_true", help="5 repeats instead of 15")
+    ap.add_argument("--against", type=Path, help="another checkout of the project to time this one against")
+    ap.add_argument("--rounds", type=int, default=5, help="--against: processes per tree (default 5)")
+    ap.add_argument("--worker", type=int, help=argparse.SUPPRESS)
     args = ap.parse_args(argv)
     repeats = 5 if args.quick else 15
+    if args.worker:
+        return worker(args.worker)
+    if args.against:
+        return against(args.against, args.rounds, repeats)
     start_load = load()
     emit("# One trajectory (seed case, kappa = 3e9, v = 1 m/s, rtol 1e-10, summary, stop when settled)\n")
     emit(machine())
@@ -195,18 +262,20 @@ def main(argv=None) -> int:
         names = ("max force", "restitution") if law == "hunt-crossley" else ("max force", "stick depth")
         if tr.events_of("slip"):
             names += ("slip time",)
-        rows.append((label, f"{tr.t_stop:.4g}", tr.nsteps, tr.nfev, us(t_sim), us(t_loop), us(t_sim - t_loop),
-                     us(t_run), us(limit), f"{t_sim / limit:.2f}", f"{t_loop / limit:.2f}",
-                     f"{t_oracle * 1e3:.3g} ms ({t_oracle / t_sim:.0f}x)",
-                     plain_cell))
+        errors = []
         for name in names:
             e10, e13, eo = rel(q_10[name], q_ref[name]), rel(q_13[name], q_ref[name]), rel(q_or10[name], q_ref[name])
+            errors.append(f"{name} {e10:.1e}")
             ep = rel(f_plain, q_ref[name]) if name == "max force" else np.nan
             err_rows.append((label, name, f"{q_ref[name]:.12g}", e10, e13, eo, ep))
             if law == "hunt-crossley" and t_end == 2e-3:  # issue 9's accuracy target (the same run at 1e-2)
                 targets.append(target(f"{label}: {name} vs oracle at rtol 1e-13", "<= 1e-9 relative",
                                       f"{e10:.1e} (rtol 1e-10), {e13:.1e} (rtol 1e-13)", bool(max(e10, e13) <= 1e-9),
                                       "python benchmarks/trajectory.py"))
+        rows.append((label, f"{tr.t_stop:.4g}", tr.nsteps, tr.nfev, us(t_sim), us(t_loop), us(t_sim - t_loop),
+                     us(t_run), ", ".join(errors), us(limit), f"{t_sim / limit:.2f}", f"{t_loop / limit:.2f}",
+                     f"{t_oracle * 1e3:.3g} ms ({t_oracle / t_sim:.0f}x)",
+                     plain_cell))
         targets.append(target(f"one trajectory: {label}", f"<= {us(limit)} µs",
                               f"simulate {us(t_sim)} µs, compiled loop {us(t_loop)} µs",
                               bool(t_sim <= limit), "python benchmarks/trajectory.py"))
@@ -215,7 +284,8 @@ def main(argv=None) -> int:
              f"(nfev {nfev_plain}); t_stop {tr.t_stop:.4g} s, {tr.nsteps} steps, nfev {tr.nfev}")
     end_load = load()
     header = ("case", "t_stop [s]", "steps", "nfev", "simulate [µs]", "compiled loop [µs]", "Python layer [µs]",
-              "driver.run from Python [µs]", "target [µs]", "simulate / target", "compiled / target",
+              "driver.run from Python [µs]", "error vs oracle at rtol 1e-13 (ours, rtol 1e-10)", "target [µs]",
+              "simulate / target", "compiled / target",
               "scipy oracle, same events (x simulate)", "plain solve_ivp DOP853, no events (x simulate)")
     err_header = ("case", "quantity", "oracle at rtol 1e-13", "ours rtol 1e-10", "ours rtol 1e-13",
                   "oracle rtol 1e-10", "plain solve_ivp rtol 1e-10")
