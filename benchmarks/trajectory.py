@@ -18,8 +18,8 @@ Errors: max force, restitution (Hunt-Crossley) or the slip time and stick depth 
 relative to the oracle at rtol 1e-13.
 
 ``--against TREE`` times this checkout against another one (e.g. ``git worktree add /tmp/old
-<commit>``) on the first case: fresh processes, one per tree and round, taking turns, so that the
-load of a shared machine hits both alike; it prints the median per-call times, their ratio and
+<commit>``) on the same cases: fresh processes, one per tree and round, taking turns, so that the
+load of a shared machine hits both alike; it prints the median per-call times, their ratios and
 whether the results are bit for bit the same, and saves ``results/trajectory_against.md``.
 
     python benchmarks/trajectory.py [--quick] [--against TREE [--rounds N]]
@@ -168,21 +168,23 @@ def rel(a, b) -> float:
 
 
 def worker(repeats: int) -> int:
-    """One process's numbers for ``--against`` (the first case, in the checkout on ``PYTHONPATH``):
+    """One process's numbers for ``--against``, in the checkout on ``PYTHONPATH``: for each case,
     median times of one ``simulate`` and of one compiled ``driver.run``, and the results' bits."""
     import phaseimpact
 
-    label, kappa, law, t_end, stop_on, _ = CASES[0]
-    params = seed_parameters(v=1.0, kappa=kappa)
-    args_ = driver_args(params, law, t_end, RTOL, stop_on)
+    cases = []
+    for label, kappa, law, t_end, stop_on, _ in CASES:
+        params = seed_parameters(v=1.0, kappa=kappa)
+        args_ = driver_args(params, law, t_end, RTOL, stop_on)
 
-    def call():
-        return simulate(params, law, t_end, rtol=RTOL, stop_on=stop_on)
+        def call(params=params, law=law, t_end=t_end, stop_on=stop_on):
+            return simulate(params, law, t_end, rtol=RTOL, stop_on=stop_on)
 
-    times = interleaved({"simulate": repeat(call), "loop": lambda n: _loop(n, *args_)}, repeats)
-    tr = call()
-    bits = [float(x).hex() for x in np.concatenate([tr.summary, tr.final_state])]
-    print(json.dumps({"tree": str(Path(phaseimpact.__file__).parent.parent), "case": label, **times, "bits": bits}))
+        times = interleaved({"simulate": repeat(call), "loop": lambda n, a=args_: _loop(n, *a)}, repeats)
+        tr = call()
+        cases.append({"case": label, **times,
+                      "bits": [float(x).hex() for x in np.concatenate([tr.summary, tr.final_state])]})
+    print(json.dumps({"tree": str(Path(phaseimpact.__file__).parent.parent), "cases": cases}))
     return 0
 
 
@@ -198,25 +200,39 @@ def against(tree: Path, rounds: int, repeats: int) -> int:
                                  capture_output=True, text=True, check=True)
             result = json.loads(out.stdout.strip().splitlines()[-1])
             assert Path(result["tree"]).resolve() == root.resolve(), (result["tree"], root)
-            runs[name].append(result)
+            runs[name].append(result["cases"])
     end_load = load()
-    med = {name: {k: statistics.median(r[k] for r in rs) for k in ("simulate", "loop")} for name, rs in runs.items()}
-    ratios = {k: statistics.median(b[k] / a[k] for b, a in zip(runs["before"], runs["after"], strict=True))
-              for k in ("simulate", "loop")}
-    same = all(r["bits"] == runs["before"][0]["bits"] for r in runs["before"] + runs["after"])
-    rows = [(name, us(med[name]["simulate"]), us(med[name]["loop"]), us(med[name]["simulate"] - med[name]["loop"]))
-            for name in ("before", "after")]
-    rows.append(("before / after (median of the rounds' ratios)", f"{ratios['simulate']:.2f}",
-                 f"{ratios['loop']:.2f}", ""))
-    text = (f"{runs['before'][0]['case']}: `{tree}` (before) against this checkout (after), {rounds} rounds of a "
-            f"fresh process per tree, taking turns; each number a median of {repeats} repeats.\n\n"
-            + table(("tree", "simulate [µs]", "compiled loop [µs]", "Python layer [µs]"), rows)
-            + f"\n\nResults (summary and final state) bit for bit the same: {'yes' if same else 'NO'}.")
+    rows, ratios, same_all = [], [], True
+    for i, case in enumerate(CASES):
+        before = [r[i] for r in runs["before"]]
+        after = [r[i] for r in runs["after"]]
+        med = {name: {k: statistics.median(r[k] for r in rs) for k in ("simulate", "loop")}
+               for name, rs in (("before", before), ("after", after))}
+        ratio = {k: statistics.median(b[k] / a[k] for b, a in zip(before, after, strict=True))
+                 for k in ("simulate", "loop")}
+        same = all(r["bits"] == before[0]["bits"] for r in before + after)
+        same_all &= same
+        ratios.append(ratio)
+        rows.append((case[0], us(med["before"]["simulate"]), us(med["after"]["simulate"]), f"{ratio['simulate']:.2f}",
+                     us(med["before"]["loop"]), us(med["after"]["loop"]), f"{ratio['loop']:.2f}",
+                     "yes" if same else "NO"))
+    text = (f"`{tree}` (before) against this checkout (after): {rounds} rounds of a fresh process per tree, taking "
+            f"turns; each time a median over the rounds of medians of {repeats} repeats, each ratio the median "
+            "of the rounds' ratios (the same load on both sides of a round).\n\n"
+            + table(("case", "simulate before [µs]", "after [µs]", "before / after", "compiled loop before [µs]",
+                     "after [µs]", "before / after", "results bit for bit the same"), rows))
     emit(text)
     emit(f"\n{start_load} at the start, {end_load} at the end")
     save_section("trajectory_against", f"## One trajectory, before and after\n\n{machine()}\n\n{start_load} at the "
                  f"start, {end_load} at the end.\n\n{text}\n\n`python benchmarks/trajectory.py --against TREE`")
-    return 0 if same else 1
+    # issue 36 asks 29.6 -> 25 µs, measured on a quieter machine: on a loaded one, the same ratio
+    needed = 29.6 / 25
+    save_targets("trajectory_against", [target(
+        f"one trajectory ({CASES[0][0]}) against the code before, same machine and run (issue 36: 29.6 -> 25 µs)",
+        f">= {needed:.2f}x faster", f"{ratios[0]['simulate']:.2f}x (simulate), {ratios[0]['loop']:.2f}x (compiled "
+        f"loop), results {'bit for bit the same' if same_all else 'DIFFERENT'}",
+        bool(ratios[0]["simulate"] >= needed and same_all), "python benchmarks/trajectory.py --against TREE")])
+    return 0 if same_all else 1
 
 
 def main(argv=None) -> int:
