@@ -18,8 +18,8 @@ Errors: max force, restitution (Hunt-Crossley) or the slip time and stick depth 
 relative to the oracle at rtol 1e-13.
 
 ``--against TREE`` times this checkout against another one (e.g. ``git worktree add /tmp/old
-<commit>``) on the same cases: fresh processes, one per tree and round, taking turns, so that the
-load of a shared machine hits both alike; it prints the median per-call times, their ratios and
+<commit>``) on the same cases: a worker process per tree, both alive, taking turns batch by batch, so
+that the load of a shared machine hits both alike; it prints the median per-call times, their ratios and
 whether the results are bit for bit the same, and saves ``results/trajectory_against.md``.
 
     python benchmarks/trajectory.py [--quick] [--against TREE [--rounds N]]
@@ -167,40 +167,67 @@ def rel(a, b) -> float:
     return abs(a - b) / abs(b) if b else abs(a - b)
 
 
-def worker(repeats: int) -> int:
-    """One process's numbers for ``--against``, in the checkout on ``PYTHONPATH``: for each case,
-    median times of one ``simulate`` and of one compiled ``driver.run``, and the results' bits."""
+def worker() -> int:
+    """A worker process of ``--against``, in the checkout on ``PYTHONPATH``: it prints its tree and
+    the results' bits, then for each line ``go`` on stdin the CPU time of one call of ``simulate`` and
+    of the compiled ``driver.run`` in each case (each the mean of a batch of calls lasting about 20 ms)."""
     import phaseimpact
 
-    cases = []
-    for label, kappa, law, t_end, stop_on, _ in CASES:
+    timers, bits = [], []
+    for _label, kappa, law, t_end, stop_on, _ in CASES:
         params = seed_parameters(v=1.0, kappa=kappa)
         args_ = driver_args(params, law, t_end, RTOL, stop_on)
 
         def call(params=params, law=law, t_end=t_end, stop_on=stop_on):
             return simulate(params, law, t_end, rtol=RTOL, stop_on=stop_on)
 
-        times = interleaved({"simulate": repeat(call), "loop": lambda n, a=args_: _loop(n, *a)}, repeats)
         tr = call()
-        cases.append({"case": label, **times,
-                      "bits": [float(x).hex() for x in np.concatenate([tr.summary, tr.final_state])]})
-    print(json.dumps({"tree": str(Path(phaseimpact.__file__).parent.parent), "cases": cases}))
+        bits.append([float(x).hex() for x in np.concatenate([tr.summary, tr.final_state])])
+        for fn in (repeat(call), lambda n, a=args_: _loop(n, *a)):
+            fn(10)
+            start = time.perf_counter()
+            fn(10)
+            timers.append((fn, max(10, int(0.02 / max((time.perf_counter() - start) / 10, 1e-7)))))
+    print(json.dumps({"tree": str(Path(phaseimpact.__file__).parent.parent), "bits": bits}), flush=True)
+    for line in sys.stdin:
+        if line.strip() != "go":
+            break
+        times = []
+        for fn, n in timers:
+            # the thread's CPU time: on a loaded machine the wall time also counts the turns of other
+            # processes, which the alternation evens out only on average
+            start = time.thread_time()
+            fn(n)
+            times.append((time.thread_time() - start) / n)
+        print(json.dumps(times), flush=True)
     return 0
 
 
 def against(tree: Path, rounds: int, repeats: int) -> int:
-    """This checkout against ``tree``: a worker process per tree and round, taking turns."""
+    """This checkout against ``tree``: one worker process per tree, both alive, taking turns batch
+    by batch (the order swapped every round), so that the load of a shared machine hits both alike."""
     here = Path(__file__).resolve().parent.parent
     start_load = load()
-    runs = {"before": [], "after": []}
-    for _ in range(rounds):
-        for name, root in (("before", tree), ("after", here)):
-            env = dict(os.environ, PYTHONPATH=str(root))
-            out = subprocess.run([sys.executable, __file__, "--worker", str(repeats)], env=env, cwd=root,
-                                 capture_output=True, text=True, check=True)
-            result = json.loads(out.stdout.strip().splitlines()[-1])
-            assert Path(result["tree"]).resolve() == root.resolve(), (result["tree"], root)
-            runs[name].append(result["cases"])
+    workers = {}
+    for name, root in (("before", tree), ("after", here)):
+        env = dict(os.environ, PYTHONPATH=str(root))
+        proc = subprocess.Popen([sys.executable, __file__, "--worker"], env=env, cwd=root, text=True,
+                                stdin=subprocess.PIPE, stdout=subprocess.PIPE)
+        head = json.loads(proc.stdout.readline())
+        assert Path(head["tree"]).resolve() == root.resolve(), (head["tree"], root)
+        workers[name] = (proc, head["bits"])
+    samples = {"before": [], "after": []}
+    for r in range(rounds * repeats):
+        for name in (("before", "after") if r % 2 == 0 else ("after", "before")):
+            proc = workers[name][0]
+            proc.stdin.write("go\n")
+            proc.stdin.flush()
+            samples[name].append(json.loads(proc.stdout.readline()))
+    for proc, _ in workers.values():
+        proc.stdin.close()
+        proc.wait()
+    runs = {name: [[{"simulate": t[2 * i], "loop": t[2 * i + 1], "bits": workers[name][1][i]}
+                    for i in range(len(CASES))] for t in samples[name]] for name in samples}
     end_load = load()
     rows, ratios, same_all = [], [], True
     for i, case in enumerate(CASES):
@@ -216,9 +243,11 @@ def against(tree: Path, rounds: int, repeats: int) -> int:
         rows.append((case[0], us(med["before"]["simulate"]), us(med["after"]["simulate"]), f"{ratio['simulate']:.2f}",
                      us(med["before"]["loop"]), us(med["after"]["loop"]), f"{ratio['loop']:.2f}",
                      "yes" if same else "NO"))
-    text = (f"`{tree}` (before) against this checkout (after): {rounds} rounds of a fresh process per tree, taking "
-            f"turns; each time a median over the rounds of medians of {repeats} repeats, each ratio the median "
-            "of the rounds' ratios (the same load on both sides of a round).\n\n"
+    text = (f"`{tree}` (before) against this checkout (after): a worker process per tree, {rounds * repeats} "
+            "turns each, alternating batch by batch (each batch the mean of about 20 ms of calls, the thread's CPU "
+            "time: on a loaded machine the wall time counts other processes' turns too); each time the "
+            "median of the batches, each ratio the median of the ratios of neighbouring batches (the same load on "
+            "both sides).\n\n"
             + table(("case", "simulate before [µs]", "after [µs]", "before / after", "compiled loop before [µs]",
                      "after [µs]", "before / after", "results bit for bit the same"), rows))
     emit(text)
@@ -239,12 +268,12 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__)
     ap.add_argument("--quick", action="store_true", help="5 repeats instead of 15")
     ap.add_argument("--against", type=Path, help="another checkout of the project to time this one against")
-    ap.add_argument("--rounds", type=int, default=5, help="--against: processes per tree (default 5)")
-    ap.add_argument("--worker", type=int, help=argparse.SUPPRESS)
+    ap.add_argument("--rounds", type=int, default=4, help="--against: turns per tree, times the repeats (default 4)")
+    ap.add_argument("--worker", action="store_true", help=argparse.SUPPRESS)
     args = ap.parse_args(argv)
     repeats = 5 if args.quick else 15
     if args.worker:
-        return worker(args.worker)
+        return worker()
     if args.against:
         return against(args.against, args.rounds, repeats)
     start_load = load()

@@ -233,27 +233,3 @@ def test_law_entry_fields_are_keyword_only():
     with pytest.raises(TypeError):
         LawEntry("positional", HUNT_CROSSLEY, "kappa", False, True, True)
     assert _entry("by-keyword", HUNT_CROSSLEY).form == HUNT_CROSSLEY
-
-
-@pytest.mark.parametrize("law", VARIANTS, ids=IDS)
-def test_a_regularised_contact_s_force_is_the_law_s_force_bit_for_bit(law):
-    """A regularised contact (delta = side w^2) takes the Hertz power from |w| instead of
-    sqrt(delta) (model.forms._hertz_power_at: sqrt(fl(w*w)) == |w| in binary floating point): its
-    force must be the law's own force at that delta, odd in w, to the last bit, from the smallest
-    w whose square is subnormal to the largest, on both sides of a bilateral law."""
-    from phaseimpact.model.rhs import relative_slip, rhs_values
-
-    c = pack(case_for(law), law)
-    rng = np.random.default_rng(7)
-    magnitudes = np.concatenate([[0.0, 1e-160, 1e-155, 1.5e-154, 1e-3, 1.0, 1e150],
-                                 10.0 ** rng.uniform(-150, 150, 400), 10.0 ** rng.uniform(-4, -1, 400)])
-    sides = (1, -1) if not law.entry.unilateral else (1,)
-    for side in sides:
-        for w in np.concatenate([magnitudes, -magnitudes]):
-            for v1, v2, mode in ((0.7, 0.1, 1), (-0.3, 0.2, -1), (0.2, 0.2, 1)):
-                got = rhs_values(law.code, c, float(w), 0.0, v1, v2, mode, side)[6]
-                deltadot = v1 if relative_slip(law.code, mode, side) else v1 - v2
-                want = force_of(law.code, c, side * float(w) * float(w), deltadot, mode)
-                want = -want if w < 0 else want
-                same = np.float64(got).tobytes() == np.float64(want).tobytes()
-                assert same or (math.isnan(got) and math.isnan(want)), (law.label(), side, w, v1, v2, got, want)

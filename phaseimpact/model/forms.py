@@ -81,18 +81,6 @@ def hertz_power(ad, alpha):
 
 
 @kernel(inline="always")
-def _hertz_power_at(ad, alpha, root):
-    """:func:`hertz_power` with ``root = sqrt(ad)`` given where the caller has it for free (``ad > 0``;
-    negative: not given). A regularised contact (:func:`phaseimpact.model.rhs.rhs_values`) has
-    ``ad = fl(w*w)`` and gives ``|w|``: in binary floating point ``sqrt(fl(w*w)) == |w|`` exactly
-    (round to nearest, no underflow), so the force is bit for bit the same without the square
-    root, which was on every stage's critical path."""
-    if alpha == 1.5:
-        return ad * (root if root >= 0 and ad > 0 else math.sqrt(ad))
-    return ad**alpha
-
-
-@kernel(inline="always")
 def _root(ad, alpha):
     """``ad**(alpha - 1)`` for ``ad >= 0``; ``sqrt(ad)`` for Hertz's 3/2."""
     if alpha == 1.5:
@@ -163,32 +151,25 @@ def _native_partials(code, delta, deltadot, mode, K, damping, alpha):
             _native(address, int(D_RATE), delta, deltadot, mode, K, damping, alpha))
 
 
-@kernel(python=True, inline="always")
+# The branches of the laws added after the first ones call out-of-line kernels (the inlining rule
+# of the module's guide): the steppers' stages inline contact_force and force_partials whole.
+@kernel(python=True)
 def contact_force(code, delta, deltadot, mode, K, damping, alpha):
     """Contact force ``P`` (N, positive pushing the bodies apart) while slipping or free.
 
     ``mode`` is ignored except by ``paper`` (sign factor); the stuck force of ``paper`` is not a
     function of ``(delta, deltadot)`` and comes from :func:`phaseimpact.model.rhs.stick_force`.
     """
-    return _contact_force(code, delta, -1.0, deltadot, mode, K, damping, alpha)
-
-
-# The branches of the laws added after the first ones call out-of-line kernels (the inlining rule
-# of the module's guide): the steppers' stages inline _contact_force and force_partials whole.
-@kernel
-def _contact_force(code, delta, root, deltadot, mode, K, damping, alpha):
-    """:func:`contact_force`, with ``root = sqrt(|delta|)`` where the caller has it (else negative;
-    :func:`_hertz_power_at`)."""
     unilateral = (code & UNILATERAL) != 0
     if unilateral and delta <= 0:
         return 0.0
     form = (code >> FORM_SHIFT) & FORM_MASK
     if form == ELASTIC:
         if unilateral:
-            return K * _hertz_power_at(delta, alpha, root)
-        return K * _hertz_power_at(abs(delta), alpha, root) * _sign(delta)
+            return K * hertz_power(delta, alpha)
+        return K * hertz_power(abs(delta), alpha) * _sign(delta)
     if form == HUNT_CROSSLEY:
-        force = (K + damping * deltadot) * _hertz_power_at(delta, alpha, root)
+        force = (K + damping * deltadot) * hertz_power(delta, alpha)
         return max(force, 0.0) if (code & CLAMP) != 0 else force
     if form == KUWABARA_KONO:
         return _kuwabara_kono_force(code, delta, deltadot, K, damping, alpha)
@@ -196,7 +177,7 @@ def _contact_force(code, delta, root, deltadot, mode, K, damping, alpha):
         return _native(code >> ADDRESS_SHIFT, int(FORCE), delta, deltadot, mode, K, damping, alpha)
     if form == PAPER:  # eq. 8
         sign = _sign(deltadot) if mode == PLAIN else float(mode)
-        return (K + damping * deltadot) * _hertz_power_at(abs(delta), alpha, root) * sign
+        return (K + damping * deltadot) * hertz_power(abs(delta), alpha) * sign
     return math.nan  # a form without a branch here (register refuses it): never another law's force
 
 
@@ -347,18 +328,11 @@ def force_of(code, c, delta, deltadot, mode):
     """The contact force of a run with packed coefficients ``c`` (what the engine calls): the
     law's :func:`contact_force`, or a law with memory read from ``c`` (its form's memory branch;
     NaN for a form without one)."""
-    return force_at(code, c, delta, -1.0, deltadot, mode)
-
-
-@kernel(inline="always")
-def force_at(code, c, delta, root, deltadot, mode):
-    """:func:`force_of` with ``root = sqrt(|delta|)`` where the caller has it (else negative): a
-    regularised contact's ``|w|`` (:func:`_hertz_power_at`)."""
     if has_memory(code):
         if (code >> FORM_SHIFT) & FORM_MASK == THORNTON:
             return _thornton(c, delta)[0] if delta > 0 else 0.0
         return math.nan
-    return _contact_force(code, delta, root, deltadot, mode, c[K_], c[DAMP_], c[ALPHA_])
+    return contact_force(code, delta, deltadot, mode, c[K_], c[DAMP_], c[ALPHA_])
 
 
 @kernel(python=True, inline="always")

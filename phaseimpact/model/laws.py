@@ -48,21 +48,19 @@ package:
    :data:`HUNT_CROSSLEY`). :func:`register` refuses a form missing from :data:`FORMS`, and the
    kernels give NaN for a form without a branch: a law is never computed with another law's
    force.
-2. Write the form's branch (in :mod:`phaseimpact.model.forms`) in ``_contact_force`` (the body
-   of :func:`contact_force`; a Hertz power through ``_hertz_power_at``, which a regularised
-   contact feeds its exact ``sqrt(|delta|)``),
+2. Write the form's branch (in :mod:`phaseimpact.model.forms`) in :func:`contact_force`,
    :func:`force_partials` (exact partial derivatives, zero where ``P`` is 0) and, if its elastic
    term has a potential, :func:`contact_potential` (a Filippov law has none; a Filippov form
    also gives its force at rest in :func:`stick_bound`: the stick holds while the required force
    stays within it). A branch reads the flags from ``code``: :data:`UNILATERAL` (the kernels
    already return 0 for ``delta <= 0``), :data:`CLAMP` (``P >= 0``), and the sign factor of a
    :data:`FILIPPOV` law from ``mode``. A law with memory (:data:`MEMORY`, set from
-   :attr:`LawEntry.memory`) writes its branch in ``force_at`` (the body of :func:`force_of`), :func:`partials_of` and
+   :attr:`LawEntry.memory`) writes its branch in :func:`force_of`, :func:`partials_of` and
    :func:`remember` instead, reading its state from the packed coefficients (its dent, if any,
    at ``DENT_``).
    **Inlining rule:** the branch calls an out-of-line kernel of the form's own
    (``_kuwabara_kono_force``, ``_thornton``), never writes the physics inline: the bodies of
-   ``_contact_force`` and :func:`force_partials` must stay small enough for LLVM to inline
+   :func:`contact_force` and :func:`force_partials` must stay small enough for LLVM to inline
    them into the steppers' stages (a Hunt-Crossley step evaluates the force 12 times). Only the
    first laws' one-line forms are inline.
 3. :func:`register` a :class:`LawEntry` (every field by keyword): name, form, damping source
