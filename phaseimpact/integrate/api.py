@@ -57,6 +57,8 @@ def check_params(params, name: str = "params") -> Parameters:
 def check_t_end(t_end, contact_time: float, name: str = "t_end") -> float:
     """A horizon (s): a finite number no shorter than :data:`MIN_HORIZON_CONTACT_TIMES` contact times."""
     shortest = MIN_HORIZON_CONTACT_TIMES * contact_time
+    if type(t_end) is float and shortest <= t_end < math.inf:  # the common case, without formatting the range
+        return t_end
     return check_real(name, t_end, f"a finite number >= {shortest:.3g} s ({MIN_HORIZON_CONTACT_TIMES:g} of the "
                                       f"contact time {contact_time:.3g} s: nothing shorter can be resolved)",
                       lambda x: x >= shortest)
@@ -365,7 +367,8 @@ def simulate(params: Parameters, law: ContactLaw | str = "paper", t_end: float |
     settle = ((t_end is None or save_kind == d.SAVE_SUMMARY) if stop_when_settled is None
               else check_bool("stop_when_settled", stop_when_settled))
     stop_kind, stop_count = _stop_on(stop_on)
-    if not (isinstance(max_steps, numbers.Integral) and not isinstance(max_steps, bool) and max_steps >= 1):
+    if not (type(max_steps) is int and max_steps >= 1) and not (  # the common case, without the ABC checks
+            isinstance(max_steps, numbers.Integral) and not isinstance(max_steps, bool) and max_steps >= 1):
         raise ValueError(f"max_steps = {max_steps!r} is out of range; allowed: an integer >= 1")
     y0 = seed_state.copy() if initial is None else _initial(params, initial)
     rk4_step = 0.0
@@ -391,18 +394,20 @@ def simulate(params: Parameters, law: ContactLaw | str = "paper", t_end: float |
             out = d.run(law.code, c, y0, default_atol if atol is None else _atol(params, rtol, atol), horizon,
                         s.max_step, (rtol, settle, stop_kind, stop_count, int(max_steps), MAX_EVENTS, stiff_after),
                         save_kind, times)
-        woken = _woken(out[0][d.S_STATUS], native)
+        codes = out[0].tolist()  # the summary's numbers: cheaper than reading entries of the array one by one
+        woken = _woken(codes[d.S_STATUS], native)
         if not (woken or _signals.deferred):
             break
         _signals.check(woken)  # raises for Ctrl-C or SIGTERM; after an old wake-up, runs again
     summary, event_log, samples, y_final = out
     law_fault = ""
-    if native is not None and native.faulted and summary[d.S_STATUS] != d.SUCCESS:
-        summary[d.S_STATUS] = d.NON_FINITE  # the law's NaN failed the run, whatever the steps made of it
+    if native is not None and native.faulted and codes[d.S_STATUS] != d.SUCCESS:
+        # the law's NaN failed the run, whatever the steps made of it
+        summary[d.S_STATUS] = codes[d.S_STATUS] = d.NON_FINITE
         law_fault = native.fault(law.name)
-    status = d.STATUSES[int(summary[d.S_STATUS])]
-    reason = d.STOP_REASONS[int(summary[d.S_REASON])]
-    outcome = d.OUTCOMES[int(summary[d.S_OUTCOME])]
+    status = d.STATUSES[int(codes[d.S_STATUS])]
+    reason = d.STOP_REASONS[int(codes[d.S_REASON])]
+    outcome = d.OUTCOMES[int(codes[d.S_OUTCOME])]
     return Trajectory(
         samples=samples, event_log=event_log, params=params, law=law, initial_state=y0, final_state=y_final,
         t_end=horizon, status=status, stop_reason=reason, outcome=outcome, summary=summary,
@@ -540,7 +545,8 @@ def _run_one(batch: Batch, i: int, rtol, settle, stop_kind, stop_count, stiff_af
         out = d.run(batch.law.code, batch.C[i], batch.Y0[i], batch.atol[i], batch.t_end[i], batch.max_step[i],
                     (rtol, settle, stop_kind, stop_count, MAX_STEPS, MAX_EVENTS, stiff_after), d.SAVE_SUMMARY,
                     _NO_TIMES)
-        woken = _woken(out[0][d.S_STATUS], native)
+        codes = out[0].tolist()  # the summary's numbers: cheaper than reading entries of the array one by one
+        woken = _woken(codes[d.S_STATUS], native)
         if not (woken or _signals.deferred):
             return out
         _signals.check(woken)
