@@ -37,10 +37,18 @@ The cache
 ---------
 Compiled machine code is kept on disk (numba's ``cache=True`` files) in one directory per
 version of the engine's sources, ``phaseimpact-<version>-<digest>`` (:func:`cache_info`), where
-the digest is the SHA-256 of every file whose code is compiled (:data:`ENGINE_SOURCES`). numba
-itself checks only the cached function's own file, while a cached function holds the machine
-code of every function it calls: after an edit of ``model/rhs.py`` the driver ran the old
-right-hand side. A new digest is a new, empty directory, so any edit recompiles everything.
+the digest is the SHA-256 of every file that can change the compiled code
+(:func:`engine_sources`). numba itself checks only the cached function's own file, while a
+cached function holds the machine code of every function it calls: after an edit of
+``model/rhs.py`` the driver ran the old right-hand side. And numba freezes the module globals a
+compiled function reads (the constants, the workspace's row indices of ``integrate/record.py``)
+into its code. So the sources are every module that compiles (imports ``kernel`` or
+``allocating``, or one of numba's CPU compilers: ``njit``, ``intrinsic``, ``cfunc``...), this
+module and ``_signals.py``, and every module of the package these import, at module level or
+inside a function, transitively; read from the import statements, not by importing anything. A
+new digest is a new, empty directory, so an edit of any of them recompiles everything; an edit of
+the Python around the engine (``integrate/api.py``, ``integrate/result.py``, ``model/regime.py``,
+the command line...) keeps the cache.
 The directory is handed to numba through its public setting, ``numba.config.CACHE_DIR``
 (what ``NUMBA_CACHE_DIR`` sets), for the engine's functions only: it is set while each is
 declared to numba and restored at once, so other numba code in the process caches as it would.
@@ -61,9 +69,11 @@ without the hooks.
 
 from __future__ import annotations
 
+import bisect
 import functools
 import hashlib
 import os
+import re
 import shutil
 import sys
 import tempfile
@@ -71,13 +81,15 @@ import warnings
 from dataclasses import dataclass
 from pathlib import Path
 
-__all__ = ["kernel", "allocating", "cache_info", "CacheInfo", "ENGINE_SOURCES", "linked_only",
+__all__ = ["kernel", "allocating", "cache_info", "CacheInfo", "engine_sources", "linked_only",
            "LINKED_ONLY_VARIABLE", "announce"]
 
 #: The package's root directory.
 PACKAGE = Path(__file__).resolve().parent
-#: The files whose code numba compiles, relative to :data:`PACKAGE` (folders: every ``.py`` in them).
-ENGINE_SOURCES = ("model", "integrate", "_jit.py", "_signals.py")
+#: The package's name (absolute imports of it are its own).
+PACKAGE_NAME = PACKAGE.name
+#: Engine sources whatever imports them: the compiler's hooks and the signals' intrinsics.
+ALWAYS_ENGINE = ("_jit.py", "_signals.py")
 #: Directories of older engine sources kept in a cache root besides the one in use.
 KEEP = 4
 #: Marks a cache directory this module made (only those are ever removed).
@@ -109,16 +121,150 @@ def _version() -> str:
     return __version__
 
 
+# A module "compiles" when it imports one of these: its functions are machine code in the cache.
+# numba's ``overload`` and ``register_jitable`` are left out: the package uses them only for the
+# CUDA target (cuda.py), whose code is not cached here (``tests/test_cache.py`` checks that).
+_OUR_COMPILERS = frozenset({"kernel", "allocating"})
+_NUMBA_COMPILERS = frozenset({"njit", "jit", "cfunc", "intrinsic", "generated_jit", "vectorize", "guvectorize"})
+# The imports are read from the text, not with ``ast``: parsing the candidate files took 0.34 s on
+# this (loaded, 2-core) machine, this whole digest takes 10 ms (the former one, of every file in
+# model/ and integrate/: 1.7 ms), once per process. ``tests/test_cache.py`` checks that it finds
+# what ``ast`` finds, in every file of the package. A statement is ``from X import names`` (a
+# parenthesised list may span lines, with comments) or ``import names``, from the start of the
+# line where the word ``import`` is found outside docstrings.
+_IMPORT_WORD = re.compile(rb"import[ \t(]")
+_IMPORT = re.compile(rb"[ \t]*(?:from[ \t]+(\.*[\w.]*)[ \t]+import[ \t]*(\((?:[^)#]|#[^\n]*\n)*\)|[^\n]*)"
+                     rb"|import[ \t]+([^\n]*))")
+# ``numba.njit(f)``, ``_jit.kernel(f)``: a compiler used through its module (two patterns: each
+# starts with a literal, which the search skips to)
+_COMPILER_ATTRIBUTES = tuple(re.compile(rb"%s\.(?:%s)\b" % (module, b"|".join(n.encode() for n in sorted(names))))
+                             for module, names in ((b"numba", _NUMBA_COMPILERS), (b"_jit", _OUR_COMPILERS)))
+_COMMENT = re.compile(rb"#[^\n]*")
+#: A file that compiles names one of these (``_jit`` or ``numba``).
+_COMPILER_WORDS = (b"jit", b"numba")
+
+
+def _names(listed: bytes) -> list[str]:
+    """The names of an import's list (``a as b, c``, parenthesised or not), without comments."""
+    text = _COMMENT.sub(b"", listed).strip(b"()\\ \t\n")
+    return [item.split()[0].decode() for item in text.split(b",") if item.split()]
+
+
+def _long_strings(source: bytes) -> list[int]:
+    """Where the triple-quoted strings of ``source`` begin and end, in order (an example in a
+    docstring is no import)."""
+    quotes = []
+    for quote in (b'"""', b"'''"):
+        at = source.find(quote)
+        while at >= 0:
+            quotes.append((at, quote))
+            at = source.find(quote, at + 3)
+    bounds, opened = [], None
+    for at, quote in sorted(quotes):
+        if opened is None or quote == opened:
+            bounds.append(at)
+            opened = quote if opened is None else None
+    return bounds
+
+
+def _code_matches(pattern: re.Pattern, source: bytes, bounds: list[int]):
+    """The matches of ``pattern`` in ``source`` outside its triple-quoted strings (``bounds``)."""
+    return [match for match in pattern.finditer(source) if bisect.bisect(bounds, match.start()) % 2 == 0]
+
+
+def _imports(source: bytes, where: str, files: dict[str, bytes]) -> tuple[set[str], bool]:
+    """The package's files that ``source`` (the file ``where``, relative to the package) imports,
+    anywhere in it (inside functions too), and whether it compiles with numba. ``from X import y``
+    counts as the file of the module ``X.y`` where that is one, else as ``X``'s."""
+    def file_of(parts: list[str]) -> str | None:
+        for candidate in ("/".join(parts) + ".py", "/".join([*parts, "__init__.py"])):
+            if candidate in files:
+                return candidate
+        return None
+
+    package = where.split("/")[:-1]
+    bounds = _long_strings(source)
+    imported = set()
+    compiles = any(_code_matches(pattern, source, bounds) for pattern in _COMPILER_ATTRIBUTES)
+    for word in _code_matches(_IMPORT_WORD, source, bounds):
+        statement = _IMPORT.match(source, source.rfind(b"\n", 0, word.start()) + 1)
+        if statement is None or statement.end() <= word.start():
+            continue  # "import" in a line that is no import statement
+        origin, listed, plain = statement.groups()
+        if plain is not None:  # import phaseimpact.x.y
+            for name in _names(plain):
+                parts = name.split(".")
+                if parts[0] == PACKAGE_NAME and (found := file_of(parts[1:])):
+                    imported.add(found)
+            continue
+        origin = origin.decode()
+        names = _names(listed)
+        level = len(origin) - len(origin.lstrip("."))
+        dotted = [part for part in origin[level:].split(".") if part]
+        if level == 0:
+            if dotted and dotted[0] == "numba" and _NUMBA_COMPILERS.intersection(names):
+                compiles = True
+            if not dotted or dotted[0] != PACKAGE_NAME:
+                continue
+            parts = dotted[1:]
+        elif level - 1 > len(package):
+            continue  # above the package
+        else:
+            parts = package[:len(package) - level + 1] + dotted
+        module = file_of(parts)
+        if module == "_jit.py" and _OUR_COMPILERS.intersection(names):
+            compiles = True
+        for name in names:
+            found = file_of([*parts, name]) or module
+            if found is not None:
+                imported.add(found)
+    return imported, compiles
+
+
+def _engine_files(package: Path) -> dict[str, bytes]:
+    """The engine's source files under ``package`` (relative paths, ``/``-separated) and their
+    bytes: every module that compiles, and every module of the package those import, transitively."""
+    files = {}
+    for folder, subfolders, names in os.walk(package):
+        subfolders[:] = [name for name in subfolders if name != "__pycache__"]
+        prefix = os.path.relpath(folder, package).replace(os.sep, "/")
+        for name in names:
+            if name.endswith(".py"):
+                with open(os.path.join(folder, name), "rb") as file:
+                    files[name if prefix == "." else f"{prefix}/{name}"] = file.read()
+    graph = {}
+    for where, source in files.items():
+        if any(word in source for word in _COMPILER_WORDS):  # only these can compile
+            imported, compiles = _imports(source, where, files)
+            if compiles:
+                graph[where] = imported
+    todo = [*graph, *ALWAYS_ENGINE]
+    engine = {}
+    while todo:
+        where = todo.pop()
+        if where in engine:
+            continue
+        engine[where] = files[where]
+        if where not in graph:
+            graph[where] = _imports(files[where], where, files)[0]
+        todo.extend(graph[where])
+    return engine
+
+
+def engine_sources(package: Path = PACKAGE) -> tuple[str, ...]:
+    """The files whose code can change the compiled engine, relative to ``package`` (sorted): the
+    modules that compile (see the module's docstring) and every module of the package they import,
+    at module level or inside a function, transitively."""
+    return tuple(sorted(_engine_files(package)))
+
+
 def engine_digest(package: Path = PACKAGE) -> str:
-    """SHA-256 (hex, 16 digits) of the engine's sources under ``package``: names and contents."""
+    """SHA-256 (hex, 16 digits) of the engine's sources under ``package`` (:func:`engine_sources`):
+    names and contents."""
     digest = hashlib.sha256()
-    files = []
-    for entry in ENGINE_SOURCES:
-        path = package / entry
-        files.extend(sorted(path.rglob("*.py")) if path.is_dir() else [path])
-    for path in files:
-        digest.update(path.relative_to(package).as_posix().encode() + b"\0")
-        digest.update(path.read_bytes() + b"\0")
+    for name, source in sorted(_engine_files(package).items()):
+        digest.update(name.encode() + b"\0")
+        digest.update(source + b"\0")
     return digest.hexdigest()[:16]
 
 

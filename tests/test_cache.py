@@ -46,16 +46,93 @@ def _run(code: str, pythonpath: Path, **env) -> subprocess.CompletedProcess:
                           text=True, timeout=900)
 
 
-def test_the_digest_covers_every_engine_file_and_only_those(tmp_path):
+def _edit(path: Path, text: str = "\n# an edit\n") -> None:
+    path.write_text(path.read_text() + text)
+
+
+def test_an_edit_of_python_that_is_not_compiled_keeps_the_cache(tmp_path):
+    """The run's Python around the engine (the API, results, laminates, regimes, the command line)
+    is compiled into nothing: an edit of it keeps the digest, and so the compiled cache."""
     package = _copy_package(tmp_path)
     before = _jit.engine_digest(package)
     assert before == _jit.engine_digest(ROOT / "phaseimpact")
-    command_line = package / "cli" / "__init__.py"
-    command_line.write_text(command_line.read_text() + "\n# not compiled\n")
-    assert _jit.engine_digest(package) == before
-    rhs = package / "model" / "rhs.py"
-    rhs.write_text(rhs.read_text() + "\n# an edit\n")
+    for name in ("integrate/api.py", "integrate/result.py", "integrate/__init__.py", "model/regime.py",
+                 "model/laminate.py", "model/__init__.py", "cli/__init__.py", "cuda.py", "__init__.py"):
+        _edit(package / name)
+        assert _jit.engine_digest(package) == before, name
+
+
+@pytest.mark.parametrize("name", [
+    "model/rhs.py",  # compiles
+    "integrate/record.py",  # the workspace's row indices, read by the driver's kernels
+    "model/laws.py",  # no compiled function: imported by integrate/events.py (law flags)
+    "model/restitution.py",  # imported only inside a function of model/laws.py
+    "parameters.py",  # imported by model/rhs.py
+    "_signals.py",
+])
+def test_an_edit_of_what_the_engine_compiles_or_imports_changes_the_digest(tmp_path, name):
+    package = _copy_package(tmp_path)
+    before = _jit.engine_digest(package)
+    _edit(package / name)
     assert _jit.engine_digest(package) != before
+
+
+def test_new_modules_join_the_digest_when_they_compile_or_a_kernel_module_imports_them(tmp_path):
+    package = _copy_package(tmp_path)
+    (package / "model" / "tables.py").write_text("LIMIT = 3.0\n")
+    (package / "maps" / "fast.py").write_text("from .._jit import kernel\n\n\n@kernel\ndef twice(x):\n"
+                                               "    return 2 * x\n")
+    (package / "maps" / "aside.py").write_text('"""Not compiled.\n\nfrom phaseimpact import simulate\n"""\n')
+    sources = _jit.engine_sources(package)
+    assert "maps/fast.py" in sources and "model/tables.py" not in sources and "maps/aside.py" not in sources
+    # imported inside a function of a module that compiles
+    _edit(package / "model" / "rhs.py", "\n\ndef _limit():\n    from .tables import LIMIT\n    return LIMIT\n")
+    assert "model/tables.py" in _jit.engine_sources(package)
+
+
+# A compiled function in the source text: a decorator of this package's or numba's, or a call of one.
+_COMPILED = re.compile(r"^\s*@(?:_jit\.|numba\.)?(?:kernel|allocating|njit|jit|intrinsic|cfunc)\b"
+                       r"|\b(?:kernel|allocating|numba\.njit|numba\.cfunc)\(", re.MULTILINE)
+
+
+def test_every_module_with_a_compiled_function_is_in_the_digest():
+    """An independent reading: the text of every file of the package, searched for a decorator."""
+    package = ROOT / "phaseimpact"
+    found = {path.relative_to(package).as_posix() for path in package.rglob("*.py")
+             if path.name != "_dop853_codegen.py" and _COMPILED.search(path.read_text())}
+    # the code generator writes "@kernel" into the stages' source, and compiles nothing itself
+    assert {"model/rhs.py", "model/forms.py", "integrate/driver.py", "integrate/record.py",
+            "model/userlaw.py", "model/native.py"} <= found
+    assert found <= set(_jit.engine_sources())
+    assert "integrate/_dop853_codegen.py" not in _jit.engine_sources()
+
+
+def test_numba_overloads_are_only_for_the_gpu():
+    """The digest leaves numba's ``overload`` out of what compiles: the package's are all for the
+    CUDA target, which is not cached. A CPU overload would change the engine's code from where it
+    is registered and must join the digest first."""
+    package = ROOT / "phaseimpact"
+    overloads = {path.relative_to(package).as_posix(): re.findall(r"@overload\((.*)\)", path.read_text())
+                 for path in package.rglob("*.py") if "@overload(" in path.read_text()}
+    assert list(overloads) == ["cuda.py"]
+    assert all('target="cuda"' in call for call in overloads["cuda.py"])
+
+
+def test_the_import_reader_finds_what_ast_finds_in_every_file():
+    """engine_sources reads imports from the text (fast); tests/test_imports.py reads them with ast."""
+    from test_imports import _imports
+
+    package = ROOT / "phaseimpact"
+    files = {path.relative_to(package).as_posix(): path.read_bytes() for path in package.rglob("*.py")}
+
+    def file_of(module: str) -> str:
+        parts = module.split(".")[1:]
+        plain = "/".join(parts) + ".py"
+        return plain if plain in files else "/".join([*parts, "__init__.py"])
+
+    for name, source in files.items():
+        expected = {file_of(module) for module, _, _ in _imports(package, package / name)}
+        assert _jit._imports(source, name, files)[0] == expected, name
 
 
 @pytest.mark.slow
