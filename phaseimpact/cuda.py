@@ -3,9 +3,10 @@
 target from the same source (numba compiles the engine's ``@njit`` functions a CUDA kernel calls
 as device functions; no second copy of any kernel).
 
-A launch allocates every thread's workspace at once: each member of :func:`.integrate.record.workspace`
-with a leading axis of one row per point, as the CPU's workspace starts, and a thread runs in its
-rows. The inputs go to the device once, the outputs come back once; the workspaces stay there.
+A launch allocates every thread's workspace at once: one row per point of a float64 array, each
+row the buffer a CPU thread's block runs in (:func:`.integrate.record.workspace_size` numbers), and
+a thread runs in the views :func:`.integrate.record.carve` makes of its row. The inputs go to the
+device once, the outputs come back once; the workspaces stay there.
 This module is host code and the CUDA kernel: it lies outside ``integrate/`` so that it is not
 part of the CPU engine's cache digest (``_jit.ENGINE_SOURCES``).
 
@@ -22,7 +23,7 @@ import functools
 import numba
 import numpy as np
 
-from .integrate.record import W_Y, Y_STATE, workspace
+from .integrate.record import Y_AT, Y_STATE, workspace_size
 
 try:  # a module global: the simulator swaps it for its own in the kernel's globals
     from numba import cuda
@@ -71,15 +72,6 @@ def check(law) -> None:
         raise ValueError(f"backend = 'cuda': {why}")
 
 
-def _flat(members):
-    """The workspace's arrays in order, its nested tuple (Radau's) flattened."""
-    for member in members:
-        if isinstance(member, tuple):
-            yield from _flat(member)
-        else:
-            yield member
-
-
 @functools.cache
 def _device_min_max() -> None:
     """``max`` and ``min`` of 2 to 4 numbers on the CUDA target. numba's own (an overload taking
@@ -124,28 +116,25 @@ def _device_min_max() -> None:
 @functools.cache
 def _kernel():
     """The CUDA kernel (compiled on first launch): thread ``i`` runs point ``i`` in row ``i`` of
-    each workspace array (``w``: the 12 arrays of the run, ``r``: Radau's 10)."""
+    ``work`` (:func:`workspaces`)."""
     from .integrate.driver import run_point_into
+    from .integrate.record import carve
 
     _device_min_max()
 
     @cuda.jit
-    def points(code, batch, options, outputs, w, r):
+    def points(code, batch, options, outputs, work):
         i = cuda.grid(1)
         if i < batch[0].shape[0]:
-            ws = (w[0][i], w[1][i], w[2][i], w[3][i], w[4][i], w[5][i], w[6][i], w[7][i], w[8][i], w[9][i], w[10][i],
-                  w[11][i], (r[0][i], r[1][i], r[2][i], r[3][i], r[4][i], r[5][i], r[6][i], r[7][i], r[8][i], r[9][i]))
+            ws = carve(work[i], batch[0].shape[1], outputs[1].shape[1])
             run_point_into(code, ws, batch, options, i, outputs)
 
     return points
 
 
-def workspaces(n: int, n_coef: int, capacity: int) -> tuple[tuple, tuple]:
-    """One workspace row per point (host arrays): the run's 12 arrays and Radau's 10, each as
-    :func:`.integrate.record.workspace` makes it, repeated ``n`` times."""
-    template = workspace(n_coef, capacity)
-    rows = [np.broadcast_to(a, (n, *a.shape)).copy() for a in _flat(template)]
-    return tuple(rows[:12]), tuple(rows[12:])
+def workspaces(n: int, n_coef: int, capacity: int) -> np.ndarray:
+    """One workspace row per point (a host array, zeros), as a CPU thread's block gets one."""
+    return np.zeros((n, workspace_size(n_coef, capacity)))
 
 
 def run_batch_cuda(code: int, batch: tuple, options: tuple, outputs: tuple, final_states=None) -> None:
@@ -157,18 +146,17 @@ def run_batch_cuda(code: int, batch: tuple, options: tuple, outputs: tuple, fina
     from numba import cuda
 
     n = batch[0].shape[0]
-    w, r = workspaces(n, batch[0].shape[1], outputs[1].shape[1])
+    work = cuda.to_device(workspaces(n, batch[0].shape[1], outputs[1].shape[1]))
     device_batch = tuple(cuda.to_device(np.ascontiguousarray(a)) for a in batch)
     device_outputs = tuple(cuda.to_device(a) for a in outputs)
-    device_w = tuple(cuda.to_device(a) for a in w)
-    device_r = tuple(cuda.to_device(a) for a in r)
     blocks = (n + THREADS_PER_BLOCK - 1) // THREADS_PER_BLOCK
-    _kernel()[blocks, THREADS_PER_BLOCK](np.int64(code), device_batch, options, device_outputs, device_w, device_r)
+    _kernel()[blocks, THREADS_PER_BLOCK](np.int64(code), device_batch, options, device_outputs, work)
     cuda.synchronize()
     for host, device in zip(outputs, device_outputs, strict=True):
         device.copy_to_host(host)
     if final_states is not None:
-        final_states[...] = device_w[W_Y].copy_to_host()[:, Y_STATE]
+        at = Y_AT + 5 * Y_STATE
+        final_states[...] = work.copy_to_host()[:, at:at + 5]
 
 
 def summary_runs(law, params_seq, t_ends, *, rtol: float, stop_when_settled: bool = True,

@@ -1,6 +1,7 @@
 """The per-point path allocates nothing: many runs go through the driver's per-point kernels in a
-workspace made once per chunk (``driver.run_block``), counted with numba's runtime allocation
-statistics; a run whose stick points overflow the chunk's rows is run again on the full path."""
+workspace the host makes once per thread and chunk (``api.run_batch``, handed to ``driver.run_block``),
+counted with numba's runtime allocation statistics; a run whose stick points overflow the chunk's
+rows is run again on the full path."""
 
 from __future__ import annotations
 
@@ -19,7 +20,7 @@ COUNT = r"""
 import json
 import numpy as np
 from numba.core.runtime import rtsys
-from phaseimpact import seed_parameters, simulate_many
+from phaseimpact import seed_parameters, simulate, simulate_many
 from phaseimpact.integrate import api
 
 def allocations(n, threads):
@@ -29,27 +30,30 @@ def allocations(n, threads):
     return rtsys.get_allocation_stats().alloc - before, int(columns.stick_count.max())
 
 simulate_many([seed_parameters(v=1.0)], "paper", n_threads=2)  # the engine loaded (or compiled) first
-print(json.dumps({"chunk": api.PACK_CHUNK, "one": allocations(1, 1), "many": allocations(10_000, 1),
-                  "many_two_threads": allocations(10_000, 2)}))
+before = rtsys.get_allocation_stats().alloc
+simulate(seed_parameters(v=1.0), "paper")
+trajectory = rtsys.get_allocation_stats().alloc - before
+print(json.dumps({"chunk": api.PACK_CHUNK, "trajectory": trajectory, "one": allocations(1, 1),
+                  "many": allocations(10_000, 1), "many_two_threads": allocations(10_000, 2)}))
 """
 
 
-def test_a_sweep_allocates_per_chunk_not_per_point():
-    """10 000 runs in 5 chunks of api.PACK_CHUNK (one thread; two threads: one workspace per
-    thread and chunk) make exactly as many numba allocations as 5 (10) one-run calls: the
-    workspace and the arrays handed in, nothing per run (the previous driver made ~21 per run)."""
+def test_a_sweep_makes_no_numba_allocation():
+    """10 000 runs in 5 chunks of api.PACK_CHUNK, in one thread or two, make no numba allocation at
+    all: each thread's workspace is one numpy buffer the host makes per chunk, and run_block (a
+    kernel: no reference counting) takes it and the batch without numba's runtime (the driver of
+    issue 36 made 32 per thread and chunk: the workspace's 22 arrays and the 10 it was handed; the
+    one before it ~21 per run). One trajectory does allocate (its workspace and logs): the counter
+    counts."""
     env = dict(os.environ, NUMBA_NRT_STATS="1")
     out = subprocess.run([sys.executable, "-c", COUNT], env=env, capture_output=True, text=True, timeout=900)
     assert out.returncode == 0, out.stderr[-3000:]
     counts = json.loads(out.stdout.strip().splitlines()[-1])
-    chunks = -(-10_000 // counts["chunk"])
-    one, _ = counts["one"]
+    assert -(-10_000 // counts["chunk"]) > 1  # the sweep spans several chunks
     many, most_sticks = counts["many"]
-    two, _ = counts["many_two_threads"]
     assert most_sticks <= 32  # no run overflowed its stick rows (that run would go the full path)
-    assert 0 < one < 100  # one chunk's workspace and arguments
-    assert many == chunks * one
-    assert two == 2 * chunks * one
+    assert counts["trajectory"] > 0
+    assert counts["one"][0] == many == counts["many_two_threads"][0] == 0
 
 
 def test_a_run_that_overflows_its_stick_rows_gives_the_full_path_result():
@@ -125,3 +129,28 @@ def test_summary_run_gives_simulate_numbers():
         np.testing.assert_array_equal(final, alone.final_state)
     assert alone.stop_reason == "asked" and summary[api.d.S_REASON] == api.d.ASKED_STOP
     assert api.summary_run(cases[0][0], "paper")[0][api.d.S_N_STICK] == 4
+
+
+def test_the_workspace_members_tile_one_buffer():
+    """record.carve's views (every member, Radau's too) lie in one buffer of workspace_size numbers
+    without overlapping, Radau's complex members 16-byte aligned as an array of their own is; the
+    buffer comes zeroed (radau5.clear's state, empty counters)."""
+    from phaseimpact.integrate import record
+
+    def members(ws):
+        for member in ws:
+            yield from (members(member) if isinstance(member, tuple) else [member])
+
+    for n_coef, capacity in ((12, 0), (12, 3), (25, 32)):
+        views = sorted(members(record.workspace(n_coef, capacity)), key=lambda a: a.__array_interface__["data"][0])
+        starts = [a.__array_interface__["data"][0] for a in views]
+        ends = [start + a.nbytes for start, a in zip(starts, views, strict=True)]
+        assert all(end <= start for end, start in zip(ends, starts[1:], strict=False))  # no overlap
+        assert ends[-1] - starts[0] <= 8 * record.workspace_size(n_coef, capacity)
+        assert record.workspace_size(n_coef, capacity) % 2 == 0
+        assert all(start % 16 == 0 for start, a in zip(starts, views, strict=True) if a.dtype == np.complex128)
+        assert all(not a.any() for a in views)
+        assert len(views) == 22 and {a.dtype for a in views} == {np.dtype(t) for t in (float, np.int64, bool, complex)}
+        ws = record.workspace(n_coef, capacity)  # the y rows where a host reads a run's state (record.Y_AT)
+        base = min(starts)
+        assert ws[record.W_Y].__array_interface__["data"][0] - base == 8 * record.Y_AT

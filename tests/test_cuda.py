@@ -356,12 +356,12 @@ PTX = textwrap.dedent("""
     # current device for its compute capability there, and there is none: the H100's (9.0) instead.
     numba.cuda.dispatcher.get_current_device = lambda: types.SimpleNamespace(compute_capability=(9, 0))
     batch = api.pack_batch([seed_parameters()], "paper", None, 1e-10)
-    w, r = gpu.workspaces(1, batch.C.shape[1], 32)
+    work = gpu.workspaces(1, batch.C.shape[1], 32)
     outputs = (np.empty((1, d.N_SUMMARY)), np.empty((1, 32)), np.empty((1, 32)), np.empty((1, 32)),
                np.empty(1, np.int64))
     options = (1e-10, True, np.int64(-1), np.int64(0), api.MAX_STEPS, api.MAX_EVENTS, api._stiff_after(True))
     args = (np.int64(batch.law.code), (batch.C, batch.Y0, batch.t_end, batch.atol, batch.max_step), options,
-            outputs, w, r)
+            outputs, work)
     ptx, _ = cuda.compile_ptx(gpu._kernel().py_func, tuple(numba.typeof(a) for a in args), cc=(9, 0))
     print(len(ptx), ".entry" in ptx, ".target sm_90" in ptx, "phaseimpact_poll" in ptx)
 """)

@@ -342,7 +342,7 @@ def test_engine_kernels_are_compiled_without_reference_counting():
                 assert "_nrt" in obj.targetoptions, f"{module.__name__}.{name} is not declared through _jit"
                 if obj.targetoptions["_nrt"]:
                     counted.add(name)
-    assert counted == {"run", "run_block", "run_rk4", "grow", "new_logs", "workspace"}
+    assert counted == {"run", "run_rk4", "grow", "new_logs", "workspace"}
 
 
 def _python_calls_of_compiled_functions():

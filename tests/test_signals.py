@@ -24,6 +24,7 @@ import pytest
 from phaseimpact import _signals, archive, seed_parameters, simulate, simulate_many
 from phaseimpact.integrate import api
 from phaseimpact.integrate import driver as d
+from phaseimpact.integrate.record import workspace_size
 from phaseimpact.integrate.rk4 import run_rk4
 from phaseimpact.model import as_law, pack
 
@@ -102,7 +103,7 @@ def _interrupted_block(pipe, start: int, step: int) -> np.ndarray:
     os.write(pipe, b"\x02")
     d.run_block(batch.law.code, (batch.C, batch.Y0, batch.t_end, batch.atol, batch.max_step),
                 (1e-10, True, -1, 0, api.MAX_STEPS, api.MAX_EVENTS, api._stiff_after(True)), start, n, step,
-                (summary, *st, count))
+                (summary, *st, count), np.zeros(workspace_size(batch.C.shape[1], 32)))
     return summary[:, d.S_STATUS]
 
 

@@ -20,7 +20,7 @@ from ..parameters import Parameters, is_number
 from . import driver as d
 from . import logs, radau5
 from .events import EVENT_KINDS
-from .record import W_SUMMARY, W_Y, Y_STATE, workspace
+from .record import W_SUMMARY, W_Y, Y_STATE, workspace, workspace_size
 from .result import Columns, Trajectory
 from .rk4 import run_rk4
 
@@ -500,6 +500,8 @@ def run_batch(batch: Batch, *, rtol: float, settle: bool = True, stop_on=None, n
             (rtol, settle, stop_kind, stop_count, MAX_STEPS, MAX_EVENTS, stiff_after))
     outputs = (summary, st[0], st[1], st[2], count)
     threads = max(1, min(int(n_threads), n))
+    # each thread's workspace, made here once for the chunk (the compiled runs allocate nothing)
+    work = np.zeros((threads, workspace_size(batch.C.shape[1], capacity)))
     if not _signals.installed:
         _signals.install()
     native = batch.law.entry.native
@@ -511,10 +513,10 @@ def run_batch(batch: Batch, *, rtol: float, settle: bool = True, stop_on=None, n
 
             cuda.run_batch_cuda(*args, outputs)
         elif threads == 1:
-            d.run_block(*args, 0, n, 1, outputs)
+            d.run_block(*args, 0, n, 1, outputs, work[0])
         else:  # thread k runs k, k + threads, ...: equal loads (run_block); the driver releases the GIL
             with ThreadPoolExecutor(threads) as pool:
-                list(pool.map(lambda start: d.run_block(*args, start, n, threads, outputs), range(threads)))
+                list(pool.map(lambda k: d.run_block(*args, k, n, threads, outputs, work[k]), range(threads)))
         woken = bool(np.any(summary[:, d.S_STATUS] == d.INTERRUPTED)) or _woken(d.SUCCESS, native)
         if not (woken or _signals.deferred):
             break

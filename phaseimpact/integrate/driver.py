@@ -139,6 +139,7 @@ from .record import (
     Y_START,
     Y_STATE,
     Y_TRIAL,
+    carve,
     workspace,
 )
 from .rootfind import s_at_time
@@ -600,8 +601,8 @@ def run_point_into(code, ws, batch, options, i, outputs):
         st_t[i, j], st_delta[i, j], st_dwell[i, j] = sticks[ST_T, j], sticks[ST_DELTA, j], sticks[ST_DWELL, j]
 
 
-@allocating(python=True, nogil=True)
-def run_block(code, batch, options, start, stop, step, outputs):
+@kernel(python=True, nogil=True)
+def run_block(code, batch, options, start, stop, step, outputs, work):
     """Runs ``start, start + step, ...`` (below ``stop``) of a batch, without the GIL (callers run
     blocks in threads; each run's numbers depend on nothing else). Fills ``outputs`` (the tuple
     ``O_*``): the summaries (n, N_SUMMARY), the first ``capacity`` stick points of each run and its
@@ -613,10 +614,12 @@ def run_block(code, batch, options, start, stop, step, outputs):
     an expensive stretch. On Ctrl-C or SIGTERM the rest of the block is left with the status
     ``interrupted``.
 
-    The block's one workspace is made here, once; each run goes through :func:`run_point` in it,
-    without an event log, and allocates nothing."""
+    ``work`` is the block's workspace, a buffer of :func:`.record.workspace_size` numbers the caller
+    made (one per thread); each run goes through :func:`run_point` in it, without an event log.
+    Allocates nothing, and being a kernel (no reference counting) takes its arguments from Python
+    without numba's runtime either: a chunk of runs makes no numba allocation at all."""
     summary = outputs[O_SUMMARY]
-    ws = workspace(batch[B_C].shape[1], outputs[O_STICK_T].shape[1])
+    ws = carve(work, batch[B_C].shape[1], outputs[O_STICK_T].shape[1])
     done = 0
     for i in range(start, stop, step):
         done += 1

@@ -16,8 +16,9 @@ The Jacobian is a forward difference over the four components that feed back (th
 the time ``t`` are quadratures); the collocation polynomial gives the dense output, written into
 the driver's interpolant array so that events are located on it like on DOP853's.
 
-All state travels in one tuple ``stiff`` made by :func:`workspace`, read by the positions ``WS`` ...
-``F_START`` (constants: numba indexes the tuple's differently typed members statically).
+All state travels in one tuple ``stiff`` of views of one buffer (:func:`carve`), read by the
+positions ``WS`` ... ``F_START`` (constants: numba indexes the tuple's differently typed members
+statically).
 
 The small kernels (LU, solves, the Newton iteration) are ordinary compiled functions that LLVM
 inlines or calls as it sees fit, not inlined by numba (``inline="always"``): numba types an inlined
@@ -81,30 +82,54 @@ WS_ROWS = 24
 # Controller state ctl.
 (ON, COUNT, SWITCH_AFTER, RTOL, H_OLD, ERR_OLD, JAC_CURRENT, LU_H, Q_BASE, Q_S, Q_H, HAVE_Q, FAILED) = range(13)
 N_CTL = 13
-# Members of the ``stiff`` tuple (:func:`workspace`).
+# Members of the ``stiff`` tuple (:func:`carve`).
 (WS, LU_REAL, LU_COMPLEX, ZC, PIV, CTL, TMP, FTMP, START, F_START) = range(10)
 # Rows of the pivots ``stiff[PIV]``: those of the real and of the complex factors.
 PIV_REAL, PIV_COMPLEX = 0, 1
 
 
+#: The ``stiff`` tuple's numbers in one float64 buffer (:func:`carve`): the complex members first, at
+#: even offsets (16-byte aligned where the buffer is, as a complex array of their own would be).
+WORKSPACE_SIZE = 3 * N_FEEDBACK * N_FEEDBACK + 2 * N_STATE + 2 * N_FEEDBACK + WS_ROWS * N_STATE + N_CTL + 4 * N_STATE
+
+
+@kernel(inline="always")  # typed in each caller: its views are the caller's own (counted where it counts)
+def carve(buf):
+    """The ``stiff`` tuple as views of ``buf`` (:data:`WORKSPACE_SIZE` float64 numbers): members at
+    ``WS`` (the float rows ``J_`` ... ``ATOL_``), ``LU_REAL``, ``LU_COMPLEX`` (the factors), ``ZC`` (a
+    complex vector), ``PIV`` (pivots), ``CTL`` (the controller, indices ``ON`` ... ``FAILED``), then
+    four scratch states: ``TMP``, ``FTMP`` for the right-hand side and ``START``, ``F_START`` for
+    :func:`fixed_step` (the kernels allocate nothing). Zeros in ``buf`` are :func:`clear`'s state."""
+    nf2 = N_FEEDBACK * N_FEEDBACK
+    lu_complex = buf[:2 * nf2].view(np.complex128).reshape((N_FEEDBACK, N_FEEDBACK))
+    o = 2 * nf2
+    zc = buf[o:o + 2 * N_STATE].view(np.complex128)
+    o += 2 * N_STATE
+    piv = buf[o:o + 2 * N_FEEDBACK].view(np.int64).reshape((2, N_FEEDBACK))
+    o += 2 * N_FEEDBACK
+    lu_real = buf[o:o + nf2].reshape((N_FEEDBACK, N_FEEDBACK))
+    o += nf2
+    ws = buf[o:o + WS_ROWS * N_STATE].reshape((WS_ROWS, N_STATE))
+    o += WS_ROWS * N_STATE
+    ctl = buf[o:o + N_CTL]
+    o += N_CTL
+    return (ws, lu_real, lu_complex, zc, piv, ctl, buf[o:o + N_STATE], buf[o + N_STATE:o + 2 * N_STATE],
+            buf[o + 2 * N_STATE:o + 3 * N_STATE], buf[o + 3 * N_STATE:o + 4 * N_STATE])
+
+
 @allocating(python=True)
 def workspace(switch_after):
-    """A fresh ``stiff`` tuple for one run, members at ``WS`` (the float rows ``J_`` ... ``ATOL_``),
-    ``LU_REAL``, ``LU_COMPLEX`` (the factors), ``ZC`` (a complex vector), ``PIV`` (pivots), ``CTL``
-    (the controller, indices ``ON`` ... ``FAILED``), then four scratch states: ``TMP``, ``FTMP`` for
-    the right-hand side and ``START``, ``F_START`` for :func:`fixed_step` (the kernels allocate
-    nothing)."""
-    ctl = np.zeros(N_CTL)
-    ctl[SWITCH_AFTER] = switch_after  # 0: never (DOP853 throughout)
-    return (np.zeros((WS_ROWS, N_STATE)), np.zeros((N_FEEDBACK, N_FEEDBACK)),
-            np.zeros((N_FEEDBACK, N_FEEDBACK), np.complex128), np.zeros(N_STATE, np.complex128),
-            np.zeros((2, N_FEEDBACK), np.int64), ctl, np.zeros(N_STATE), np.zeros(N_STATE),
-            np.zeros(N_STATE), np.zeros(N_STATE))
+    """A fresh ``stiff`` tuple for one run (:func:`carve` of a buffer of its own), for the tests;
+    the driver's runs carve theirs from their workspace (:func:`.record.carve`)."""
+    stiff = carve(np.zeros(WORKSPACE_SIZE))
+    stiff[CTL][SWITCH_AFTER] = switch_after  # 0: never (DOP853 throughout)
+    return stiff
 
 
 @kernel
 def clear(stiff, switch_after):
-    """The workspace as :func:`workspace` makes it, for the next run in it (nothing allocated)."""
+    """The workspace as :func:`workspace` makes it (zeros, and the switch), for the next run in it
+    (nothing allocated)."""
     ws, lu_real, lu_complex, zc, piv = stiff[WS], stiff[LU_REAL], stiff[LU_COMPLEX], stiff[ZC], stiff[PIV]
     for i in range(ws.shape[0]):
         for j in range(ws.shape[1]):

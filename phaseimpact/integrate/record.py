@@ -1,18 +1,21 @@
 """The state of one run: a workspace of fixed-size arrays with named rows, and the run's record
 (its scalars) in two of them.
 
-A run's whole state lives in a workspace (:func:`workspace`): made once per thread and chunk of
-runs (:func:`.driver.run_block`) or once per trajectory (:func:`.driver.run`), never inside the
-per-point kernels, which allocate nothing: the form a GPU thread needs too (numba-cuda compiles
-tuples of arrays and constant indices; it has no ``structref``). A scratch vector is a row of one
-array (an allocation costs about 30 ns, a row nothing).
+A run's whole state lives in a workspace: a tuple of views (:func:`carve`) of one float64 buffer
+of :func:`workspace_size` numbers, its integer, flag and complex members viewed as such. The buffer
+is made once per thread and chunk of runs by the host (:func:`.api.run_batch`, which hands it to
+:func:`.driver.run_block`), once per point of a GPU launch (:mod:`phaseimpact.cuda`), or once per
+trajectory (:func:`workspace`, for :func:`.driver.run`), never inside the per-point kernels, which
+allocate nothing: the form a GPU thread needs too (numba-cuda compiles tuples of arrays and
+constant indices; it has no ``structref``). A scratch vector is a row of one array (an allocation
+costs about 30 ns, a row nothing).
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from .._jit import allocating
+from .._jit import allocating, kernel
 from . import radau5
 from .dop853 import N_DENSE, N_STAGES, N_STATE
 from .events import EVENT_KINDS, N_EVENTS
@@ -60,12 +63,59 @@ N_ATOL = 7  # absolute tolerances of (x1, x2, v1, v2, W, t, w)
 ST_T, ST_DELTA, ST_DWELL = range(3)
 
 
+# Where the members lie in the buffer (float64 numbers), Radau's first (its complex members at even
+# offsets: radau5.carve) and the members whose length depends on the law and the capacity last; the
+# flags (bool) take one number per 8.
+N_FIRED_NUMBERS = (N_EVENTS + 7) // 8
+N_FIXED = (radau5.WORKSPACE_SIZE + N_REAL + N_INT + N_ATOL + N_Y_ROWS * 5 + N_G_ROWS * N_EVENTS + N_FIRED_NUMBERS
+           + N_U_ROWS * N_STATE + N_STATS + N_KINDS + N_SUMMARY)
+
+#: Where the rows of ``W_Y`` start in the buffer (a host reads a run's state from there: the GPU's launches).
+Y_AT = radau5.WORKSPACE_SIZE + N_REAL + N_INT + N_ATOL
+
+
+@kernel(python=True, inline="always")
+def workspace_size(n_coef, capacity):
+    """The float64 numbers of a workspace for ``n_coef`` coefficients and ``capacity`` stick points
+    (even: consecutive workspaces in one array keep Radau's complex members aligned)."""
+    size = N_FIXED + n_coef + 3 * capacity
+    return size + size % 2
+
+
+@kernel(inline="always")  # typed in each caller: its views are the caller's own (counted where it counts)
+def carve(buf, n_coef, capacity):
+    """The workspace (members ``W_*``) as views of ``buf`` (:func:`workspace_size` numbers, zeros
+    or a previous run's: every run sets what it reads); allocates nothing."""
+    o = radau5.WORKSPACE_SIZE
+    stiff = radau5.carve(buf[:o])
+    real = buf[o:o + N_REAL]
+    o += N_REAL
+    ints = buf[o:o + N_INT].view(np.int64)
+    o += N_INT
+    atol = buf[o:o + N_ATOL]
+    o += N_ATOL
+    y = buf[o:o + N_Y_ROWS * 5].reshape((N_Y_ROWS, 5))
+    o += N_Y_ROWS * 5
+    g = buf[o:o + N_G_ROWS * N_EVENTS].reshape((N_G_ROWS, N_EVENTS))
+    o += N_G_ROWS * N_EVENTS
+    fired = buf[o:o + N_FIRED_NUMBERS].view(np.bool_)[:N_EVENTS]
+    o += N_FIRED_NUMBERS
+    u = buf[o:o + N_U_ROWS * N_STATE].reshape((N_U_ROWS, N_STATE))
+    o += N_U_ROWS * N_STATE
+    stats = buf[o:o + N_STATS]
+    o += N_STATS
+    counts = buf[o:o + N_KINDS].view(np.int64)
+    o += N_KINDS
+    summary = buf[o:o + N_SUMMARY]
+    o += N_SUMMARY
+    c = buf[o:o + n_coef]
+    o += n_coef
+    sticks = buf[o:o + 3 * capacity].reshape((3, capacity))
+    return real, ints, c, atol, y, g, fired, u, stats, counts, summary, sticks, stiff
+
+
 @allocating(python=True)
 def workspace(n_coef, capacity):
-    """The arrays of one run (members ``W_*``), reused run after run; ``capacity`` stick points."""
-    return (np.empty(N_REAL), np.zeros(N_INT, np.int64), np.empty(n_coef), np.empty(N_ATOL),
-            np.empty((N_Y_ROWS, 5)), np.empty((N_G_ROWS, N_EVENTS)), np.zeros(N_EVENTS, np.bool_),
-            np.empty((N_U_ROWS, N_STATE)), np.empty(N_STATS), np.zeros(N_KINDS, np.int64), np.empty(N_SUMMARY),
-            np.empty((3, capacity)), radau5.workspace(0.0))
-
-
+    """A workspace of its own (members ``W_*``; one allocation), reused run after run; ``capacity``
+    stick points."""
+    return carve(np.zeros(workspace_size(n_coef, capacity)), n_coef, capacity)
