@@ -7,8 +7,8 @@ A launch allocates every thread's workspace at once: one row per point of a floa
 row the buffer a CPU thread's block runs in (:func:`.integrate.record.workspace_size` numbers), and
 a thread runs in the views :func:`.integrate.record.carve` makes of its row. The inputs go to the
 device once, the outputs come back once; the workspaces stay there.
-This module is host code and the CUDA kernel: it lies outside ``integrate/`` so that it is not
-part of the CPU engine's cache digest (``_jit.ENGINE_SOURCES``).
+This module is host code and the CUDA kernel (not cached on disk): no CPU kernel module imports it,
+so it is not part of the CPU engine's cache digest (:func:`._jit.engine_sources`).
 
 Without a usable GPU, :func:`unavailable` says what is missing (one line) and the callers refuse
 before any work. numba's CUDA simulator (``NUMBA_ENABLE_CUDASIM=1``) runs the kernel in Python
@@ -30,7 +30,7 @@ try:  # a module global: the simulator swaps it for its own in the kernel's glob
 except ImportError as missing:  # a numba built without its CUDA target
     cuda, _MISSING = None, missing
 
-__all__ = ["unavailable", "check", "run_batch_cuda", "summary_runs", "THREADS_PER_BLOCK"]
+__all__ = ["unavailable", "check", "run_batch_cuda", "THREADS_PER_BLOCK"]
 
 #: Threads of a block. The per-point kernel is long and holds many registers: small blocks keep
 #: the multiprocessors' register files from limiting the blocks resident at once.
@@ -157,27 +157,3 @@ def run_batch_cuda(code: int, batch: tuple, options: tuple, outputs: tuple, fina
     if final_states is not None:
         at = Y_AT + 5 * Y_STATE
         final_states[...] = work.copy_to_host()[:, at:at + 5]
-
-
-def summary_runs(law, params_seq, t_ends, *, rtol: float, stop_when_settled: bool = True,
-                 stop_on=None) -> tuple[np.ndarray, np.ndarray]:
-    """:func:`.integrate.api.summary_run` of every case of ``params_seq`` in one launch, one thread each:
-    the summaries (n x ``driver.N_SUMMARY``) and final states (n x 5) it would give, from the same inputs
-    (``t_ends``: each run's horizon, None for the case's own). The caller checks the arguments and calls
-    :func:`check` first."""
-    from .integrate import api
-    from .integrate import driver as d
-
-    packed = [api._packed(p, law, rtol) for p in params_seq]  # summary_run's inputs, cached
-    horizons = np.array([s.horizon if t_end is None else api.check_t_end(t_end, s.contact_time)
-                         for (_, _, _, s), t_end in zip(packed, t_ends, strict=True)])
-    batch = (np.stack([c for c, _, _, _ in packed]), np.stack([y0 for _, _, y0, _ in packed]), horizons,
-             np.stack([atol for _, atol, _, _ in packed]), np.array([s.max_step for _, _, _, s in packed]))
-    stop_kind, stop_count = api._stop_on(stop_on)
-    options = (rtol, stop_when_settled, stop_kind, stop_count, api.MAX_STEPS, api.MAX_EVENTS, api._stiff_after(True))
-    n = len(packed)
-    summary, final = np.empty((n, d.N_SUMMARY)), np.empty((n, 5))
-    no_sticks = np.empty((n, 1))  # the stick points are not read: one slot each
-    run_batch_cuda(law.code, batch, options, (summary, no_sticks, no_sticks.copy(), no_sticks.copy(),
-                                              np.empty(n, np.int64)), final)
-    return summary, final

@@ -152,5 +152,5 @@ def test_the_workspace_members_tile_one_buffer():
         assert all(not a.any() for a in views)
         assert len(views) == 22 and {a.dtype for a in views} == {np.dtype(t) for t in (float, np.int64, bool, complex)}
         ws = record.workspace(n_coef, capacity)  # the y rows where a host reads a run's state (record.Y_AT)
-        base = min(starts)
+        base = min(a.__array_interface__["data"][0] for a in members(ws))
         assert ws[record.W_Y].__array_interface__["data"][0] - base == 8 * record.Y_AT

@@ -404,7 +404,7 @@ def test_the_gpu_benchmark_runs_under_the_simulator(tmp_path):
 def _synthetic_margins(monkeypatch, margin):
     """The GPU corrector's launches answered on the CPU with ``margin(kappa)`` as each run's first stick
     margin; returns the list of each launch's kappas."""
-    from phaseimpact import cuda
+    from phaseimpact.continuation import curve
     from phaseimpact.integrate import driver as d
 
     launches = []
@@ -417,7 +417,7 @@ def _synthetic_margins(monkeypatch, margin):
         summary[:, d.S_FIRST_STICK_MARGIN] = margin(kappas)
         return summary, np.zeros((len(points), 5))
 
-    monkeypatch.setattr(cuda, "summary_runs", summary_runs)
+    monkeypatch.setattr(curve, "summary_runs", summary_runs)
     return launches
 
 
@@ -465,15 +465,13 @@ def test_gpu_corrector_does_not_read_a_failed_run(monkeypatch):
     from phaseimpact.model import as_law
 
     _synthetic_margins(monkeypatch, lambda k: np.log(1e12) - np.log(k))
-    from phaseimpact import cuda
-
-    answered = cuda.summary_runs
+    answered = curve.summary_runs
 
     def failing(*args, **options):
         summary, final = answered(*args, **options)
         summary[1, d.S_STATUS] = d.STATUSES.index("step-size-collapse")
         return summary, final
 
-    monkeypatch.setattr(cuda, "summary_runs", failing)
+    monkeypatch.setattr(curve, "summary_runs", failing)
     with pytest.raises(RunFailed, match=r"kappa = 9\.\d+e\+11: step-size-collapse on the GPU"):
         curve._gpu_corrector(as_law("paper"), "kappa_c", 1, 1e-10, 1e-10)(seed_parameters(), 1e12, 0.1)

@@ -22,7 +22,7 @@ import numpy as np
 from tqdm.auto import tqdm
 
 from ..case import Case
-from ..integrate.api import check_rtol
+from ..integrate.api import check_rtol, summary_runs
 from ..integrate.driver import S_STATUS, STATUSES, SUCCESS
 from ..model.laws import ContactLaw, as_law
 from ..parameters import Parameters
@@ -300,8 +300,6 @@ def _gpu_corrector(law, what, contact_index, kappa_rtol, rtol):
     in one launch, the interval of its one sign change sampled again until narrower than Brent's final
     bracket; None where Brent's corrector refuses the bracket, or where the samples change sign more
     than once."""
-    from .. import cuda
-
     if what == "grazing":  # delta_extremum's and first_stick_margin's runs and readings
         def run(q):
             return extremum_run(q, contact_index)
@@ -312,7 +310,7 @@ def _gpu_corrector(law, what, contact_index, kappa_rtol, rtol):
     def defining(p: Parameters, log_kappas: np.ndarray) -> np.ndarray:
         points = [p.replace(kappa=math.exp(x)) for x in log_kappas]
         t_ends, options = [run(q)[0] for q in points], run(p)[1]
-        summaries, finals = cuda.summary_runs(law, points, t_ends, rtol=rtol, **options)
+        summaries, finals = summary_runs(law, points, t_ends, rtol=rtol, **options)
         for point, t_end, summary in zip(points, t_ends, summaries, strict=True):
             if summary[S_STATUS] != SUCCESS:  # a search must not read a failed run: the CPU's message
                 checked_summary(point, law, t_end, rtol=rtol, **options)

@@ -598,6 +598,38 @@ def summary_run(params: Parameters, law: ContactLaw | str = "paper", t_end: floa
     return summary, ws[W_Y][Y_STATE].copy()
 
 
+def summary_runs(law: ContactLaw, params_seq, t_ends, *, rtol: float, stop_when_settled: bool = True,
+                 stop_on=None, arrivals=None) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`summary_run` of every case of ``params_seq`` in one GPU launch, one thread each (the
+    ``cuda`` backends of the critical curve and the orbit diagram): the summaries (n x
+    ``driver.N_SUMMARY``) and final states (n x 5) it would give, from the same inputs. ``t_ends``:
+    each run's horizon (None: the case's own); ``arrivals`` (n x 4, optional): each run's initial
+    ``(x1, x2, x1dot, x2dot)`` (``W`` from the seed state, as ``initial`` does). The caller checks
+    ``law`` and ``rtol`` and calls :func:`phaseimpact.cuda.check` first."""
+    from .. import cuda
+
+    packed = [_packed(p, law, rtol) for p in params_seq]  # summary_run's inputs, cached
+    starts = np.stack([y0 for _, _, y0, _ in packed])
+    if arrivals is not None:
+        unusable = np.flatnonzero(~np.all(np.isfinite(arrivals), axis=1))
+        if unusable.size:  # the ValueError summary_run would give
+            _initial(params_seq[unusable[0]], arrivals[unusable[0]])
+        starts[:, :4] = arrivals
+    horizons = np.array([s.horizon if t_end is None else check_t_end(t_end, s.contact_time)
+                         for (_, _, _, s), t_end in zip(packed, t_ends, strict=True)])
+    batch = (np.stack([c for c, _, _, _ in packed]), starts, horizons,
+             np.stack([atol for _, atol, _, _ in packed]), np.array([s.max_step for _, _, _, s in packed]))
+    stop_kind, stop_count = _stop_on(stop_on)
+    options = (rtol, check_bool("stop_when_settled", stop_when_settled), stop_kind, stop_count, MAX_STEPS,
+               MAX_EVENTS, _stiff_after(True))
+    n = len(packed)
+    summary, final = np.empty((n, d.N_SUMMARY)), np.empty((n, 5))
+    no_sticks = np.empty((n, 1))  # the stick points are not read: one slot each
+    cuda.run_batch_cuda(law.code, batch, options, (summary, no_sticks, no_sticks.copy(), no_sticks.copy(),
+                                                   np.empty(n, np.int64)), final)
+    return summary, final
+
+
 def _mark_law_faults(batch: Batch, summary, native, rtol, settle, stop_kind, stop_count, stiff_after) -> None:
     """Give the status ``non-finite`` to the failed runs whose user law raised or gave NaN or inf.
 

@@ -119,37 +119,21 @@ def _diagram_on_gpu(imap: ModelImpactMap, param: str, values, transients: int, s
     one launch. Each value's run gets what :meth:`ModelImpactMap.step` gives :func:`~phaseimpact.simulate`
     (the case's packed coefficients and tolerances, the period as horizon, the arrival as initial state,
     no stop when settled); its summary gives the peak force, its final state the next arrival."""
-    from .. import cuda
     from ..integrate import api
     from ..integrate import driver as d
 
     maps = [imap.at(param, float(value)) for value in values]
-    n = len(maps)
-    coefficients, tolerances, starts = (np.stack([api._packed(m.params, m.law, m.rtol)[k] for m in maps])
-                                        for k in range(3))  # simulate's inputs; W from the seed state, as in _initial
-    horizons, max_steps, speeds = np.empty(n), np.empty(n), np.empty(n)
-    for i, m in enumerate(maps):
+    for m in maps:
         m.check()
-        s = api._packed(m.params, m.law, m.rtol)[3]
-        horizons[i], max_steps[i], speeds[i] = api.check_t_end(m.period, s.contact_time), s.max_step, m.params.v
-    stop_kind, stop_count = api._stop_on(None)
-    options = (imap.rtol, False, stop_kind, stop_count, api.MAX_STEPS, api.MAX_EVENTS, api._stiff_after(True))
-    summary = np.empty((n, d.N_SUMMARY))
-    no_sticks = np.empty((n, 1))  # the stick points are not read: one slot each
-    outputs = (summary, no_sticks, no_sticks.copy(), no_sticks.copy(), np.empty(n, np.int64))
-    final = np.empty((n, 5))
+    cases, horizons = [m.params for m in maps], [m.period for m in maps]
+    n = len(maps)
     plate = np.empty((n, samples, 2))
     peak_force = np.empty((n, samples))
     z = np.stack([m.origin for m in maps]).astype(float)
     for step in range(transients + samples):
-        unusable = np.flatnonzero(~np.all(np.isfinite(z), axis=1))
-        if unusable.size:  # simulate refuses such an arrival: the same ValueError as the threads backend's
-            first = maps[unusable[0]]
-            api._initial(first.params, first._arrival(z[unusable[0]]))
-        starts[:, 0] = starts[:, 1] = z[:, 0]  # ModelImpactMap._arrival: (x2, x2, v, x2dot)
-        starts[:, 2], starts[:, 3] = speeds, z[:, 1]
-        cuda.run_batch_cuda(imap.law.code, (coefficients, starts, horizons, tolerances, max_steps), options, outputs,
-                            final)
+        arrivals = np.column_stack([z[:, 0], z[:, 0], [p.v for p in cases], z[:, 1]])  # ModelImpactMap._arrival
+        summary, final = api.summary_runs(imap.law, cases, horizons, rtol=imap.rtol, stop_when_settled=False,
+                                          arrivals=arrivals)
         if step >= transients:
             plate[:, step - transients] = z
             peak_force[:, step - transients] = summary[:, d.S_MAX_FORCE]
