@@ -44,7 +44,7 @@ reproduce: $(STAMP)
 NUMBA_OLDEST := "numba==0.59.0" "numpy<1.27"
 NUMBA_NEWEST := "numba<0.69"
 NUMBA_RANGE_TESTS ?= tests/test_integrate.py tests/test_laws.py tests/test_cache.py tests/test_precompile.py \
-	tests/test_imports.py
+	tests/test_imports.py tests/test_allocations.py
 
 .venv-numba-%/.installed: pyproject.toml
 	$(PYTHON) -m venv .venv-numba-$*
