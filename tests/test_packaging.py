@@ -40,12 +40,6 @@ MAX_SDIST_BYTES = 15_000_000
 pytestmark = pytest.mark.slow
 
 
-def _build(kind: str, out: Path) -> Path:
-    code = f"from setuptools import build_meta as b; print(b.build_{kind}({str(out)!r}))"
-    done = subprocess.run([sys.executable, "-c", code], cwd=ROOT, capture_output=True, text=True, check=True)
-    return out / done.stdout.strip().splitlines()[-1]
-
-
 def _source_files() -> set[str]:
     """The tracked files under :data:`NEEDED` (the working tree's files where git is missing)."""
     try:
@@ -56,15 +50,14 @@ def _source_files() -> set[str]:
                 if p.is_file() and "__pycache__" not in p.parts and "results" not in p.parts}
 
 
-def test_sdist_has_every_test_input_and_its_tests_run(tmp_path):
-    sdist = _build("sdist", tmp_path)
-    with tarfile.open(sdist) as tar:
+def test_sdist_has_every_test_input_and_its_tests_run(built_sdist, tmp_path):
+    with tarfile.open(built_sdist) as tar:
         top = tar.getnames()[0].split("/")[0]
         names = {n.removeprefix(top + "/") for n in tar.getnames()}
         tar.extractall(tmp_path / "unpacked", filter="data")
     missing = sorted(_source_files() - names)
     assert not missing, f"files the tests need are not in the sdist: {missing[:10]}"
-    assert sdist.stat().st_size < MAX_SDIST_BYTES and not any(n.startswith("figures/preview") for n in names)
+    assert built_sdist.stat().st_size < MAX_SDIST_BYTES and not any(n.startswith("figures/preview") for n in names)
     assert {"phaseimpact/_oracle.py", "Makefile", "mkdocs.yml", "phaseimpact/docs/physics.md"} <= names
     # Collecting every test imports each test module from the unpacked sdist.
     tree = tmp_path / "unpacked" / top
@@ -112,9 +105,8 @@ def test_the_sdist_selection_keeps_every_file():
                                        *INSTEAD_OF_THE_FIRST.values()]
 
 
-def test_wheel_carries_the_physics_notes_archives_cite(tmp_path):
-    wheel = _build("wheel", tmp_path)
-    with zipfile.ZipFile(wheel) as whl:
+def test_wheel_carries_the_physics_notes_archives_cite(built_wheel):
+    with zipfile.ZipFile(built_wheel) as whl:
         notes = whl.read("phaseimpact/docs/physics.md").decode()
         assert "py.typed" in " ".join(whl.namelist())
     assert notes == (ROOT / "docs" / "physics.md").read_text()
@@ -130,16 +122,12 @@ wrong: str = trajectory.max_force
 """
 
 
-def test_mypy_sees_the_types_of_the_installed_package(tmp_path):
+def test_mypy_sees_the_types_of_the_installed_package(installed_wheel, tmp_path):
     """py.typed ships, and the lazily imported top-level names have their types for a type checker."""
-    wheel = _build("wheel", tmp_path)
-    target = tmp_path / "site"
-    subprocess.run([sys.executable, "-m", "pip", "install", "--quiet", "--no-deps", "--target", str(target),
-                    str(wheel)], check=True, capture_output=True)
     (tmp_path / "user.py").write_text(USER_SCRIPT)
     # mypy reads the package from the target (on the interpreter's path), as an installed package: its
     # types are used only because of py.typed
-    env = {"PATH": "/usr/bin:/bin", "PYTHONPATH": str(target)}
+    env = {"PATH": "/usr/bin:/bin", "PYTHONPATH": str(installed_wheel)}
     done = subprocess.run([sys.executable, "-m", "mypy", "--no-incremental", "user.py"], cwd=tmp_path, env=env,
                           capture_output=True, text=True)
     assert 'Revealed type is "phaseimpact.integrate.result.Trajectory"' in done.stdout, done.stdout

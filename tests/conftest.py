@@ -1,0 +1,38 @@
+"""Set-up shared by several test files, made once per test session (each costs seconds to minutes)."""
+
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def build_distribution(kind: str, out: Path) -> Path:
+    """``kind`` ("wheel" or "sdist") built from this checkout by setuptools' PEP 517 backend into ``out``."""
+    code = f"from setuptools import build_meta as b; print(b.build_{kind}({str(out)!r}))"
+    done = subprocess.run([sys.executable, "-c", code], cwd=ROOT, capture_output=True, text=True, check=True)
+    return out / done.stdout.strip().splitlines()[-1]
+
+
+@pytest.fixture(scope="session")
+def built_wheel(tmp_path_factory) -> Path:
+    """The wheel of this checkout (test_packaging reads it, test_check_law and mypy use it installed)."""
+    return build_distribution("wheel", tmp_path_factory.mktemp("wheel"))
+
+
+@pytest.fixture(scope="session")
+def built_sdist(tmp_path_factory) -> Path:
+    """The sdist of this checkout (test_packaging unpacks it and runs tests from it)."""
+    return build_distribution("sdist", tmp_path_factory.mktemp("sdist"))
+
+
+@pytest.fixture(scope="session")
+def installed_wheel(built_wheel, tmp_path_factory) -> Path:
+    """:func:`built_wheel` installed by pip, offline and without dependencies, into its own folder
+    (a ``--target``: put it on ``PYTHONPATH``; its console scripts are in ``bin/``)."""
+    target = tmp_path_factory.mktemp("installed")
+    subprocess.run([sys.executable, "-m", "pip", "install", "--quiet", "--no-deps", "--no-index", "--target",
+                    str(target), str(built_wheel)], check=True, capture_output=True)
+    return target
