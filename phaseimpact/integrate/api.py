@@ -480,15 +480,13 @@ def _checked_sequence(params_seq) -> list:
     return params_seq
 
 
-#: The fields of :class:`Parameters` that :func:`_pack` reads as columns.
 _NUMBER_FIELDS = operator.attrgetter("M1", "M2", "K", "Kb", "Km", "alpha", "kappa", "v")
 
 
 def _pack(params_seq: list, law: ContactLaw, t_end, rtol: float, initial) -> Batch:
-    """The rows of :func:`pack`, :func:`scales` and the initial states of every case, computed on
-    columns: per case only the fields are read (and what the law computes per case), so packing
-    costs a fraction of the runs. Each column is the same IEEE operations in the same order as the
-    per-case code (``hertz_indentation``'s powers stay per case), hence the same bits."""
+    """The rows of :func:`pack`, :func:`scales` and the initial states, on columns: per case only the
+    fields are read (and what the law computes per case). The same IEEE operations in the same order
+    as the per-case code (``hertz_indentation``'s powers stay per case), hence the same bits."""
     y0 = initial_state(0.0) if initial is None else np.concatenate([_checked_initial(initial), [0.0]])
     n = len(params_seq)
     M1, M2, K, Kb, Km, alpha, kappa, v = np.array([_NUMBER_FIELDS(p) for p in params_seq]).reshape(n, 8).T
@@ -519,11 +517,8 @@ def _pack(params_seq: list, law: ContactLaw, t_end, rtol: float, initial) -> Bat
 
 def _damping_column(law: ContactLaw, params_seq: list, K: np.ndarray, v: np.ndarray, kappa: np.ndarray):
     """:meth:`ContactLaw.kappa` of every case (the same operations on columns)."""
-    source = law.damping_source
-    if source is None:
-        return 0.0
-    if source == "kappa":
-        return kappa
+    if law.damping_source in (None, "kappa"):
+        return 0.0 if law.damping_source is None else kappa
     if law.entry.chi is not None:
         return law.entry.chi(law.restitution) * K / v
     return [law.kappa(p) for p in params_seq]  # the exact inverse: a root per case
