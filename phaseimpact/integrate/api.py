@@ -476,7 +476,8 @@ def _checked_sequence(params_seq) -> list:
     if not params_seq:
         raise ValueError("params_seq = [] is out of range; allowed: a non-empty sequence of Parameters")
     for i, p in enumerate(params_seq):
-        check_params(p, f"params_seq[{i}]")
+        if type(p) is not Parameters:  # the common case without formatting the name
+            check_params(p, f"params_seq[{i}]")
     return params_seq
 
 
@@ -488,11 +489,10 @@ def _pack(params_seq: list, law: ContactLaw, t_end, rtol: float, initial) -> Bat
     fields are read (and what the law computes per case). The same IEEE operations in the same order
     as the per-case code (``hertz_indentation``'s powers stay per case), hence the same bits."""
     y0 = initial_state(0.0) if initial is None else np.concatenate([_checked_initial(initial), [0.0]])
-    n = len(params_seq)
-    M1, M2, K, Kb, Km, alpha, kappa, v = np.array([_NUMBER_FIELDS(p) for p in params_seq]).reshape(n, 8).T
+    M1, M2, K, Kb, Km, alpha, kappa, v = np.array([_NUMBER_FIELDS(p) for p in params_seq]).reshape(-1, 8).T
     targets = [p.target for p in params_seq]
     springs = np.array([t == "plate" for t in targets])
-    C = np.zeros((n, N_COEF))
+    C = np.zeros((len(v), N_COEF))
     C[:, M1_], C[:, M2_], C[:, K_], C[:, ALPHA_] = M1, M2, K, alpha
     C[:, KB_], C[:, KM_] = np.where(springs, Kb, 0.0), np.where(springs, Km, 0.0)
     C[:, DAMP_] = _damping_column(law, params_seq, K, v, kappa)
@@ -507,7 +507,7 @@ def _pack(params_seq: list, law: ContactLaw, t_end, rtol: float, initial) -> Bat
     with np.errstate(divide="ignore"):  # Kb = 0: no period (Parameters.target_period)
         period = np.where(springs & (Kb != 0), 2 * math.pi * np.sqrt(M2 / Kb), math.inf)
     finite = np.isfinite(period)
-    Y0 = np.tile(y0, (n, 1))
+    Y0 = np.tile(y0, (len(v), 1))
     if initial is None:
         Y0[:, 2] = v
     horizon = HORIZON_CAP_PERIODS * np.where(finite, period, contact_time)
