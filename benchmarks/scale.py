@@ -29,6 +29,8 @@ from _common import emit, load, machine, save_section, save_targets, table, targ
 
 from phaseimpact import seed_parameters, simulate_many  # noqa: E402
 from phaseimpact.continuation import Axis, atlas, sweep  # noqa: E402
+from phaseimpact.integrate.api import PACK_CHUNK, pack_batch  # noqa: E402
+from phaseimpact.model import as_law  # noqa: E402
 
 RTOL = 1e-10
 
@@ -96,6 +98,9 @@ def main(argv=None) -> int:
                 targets.append(target(f"{what}: parallel efficiency at 2 threads", ">= 90 %",
                                       f"{100 * efficiency:.0f} %", bool(efficiency >= 0.9),
                                       "python benchmarks/scale.py"))
+    pack_us = _packing_us(plist, repeats)
+    run_us = 1e6 * statistics.median(times[("simulate_many", "threads", 1)]) / n_points
+    emit(f"simulate_many's packing: {pack_us:.2g} us a case, a run {run_us:.3g} us a case on one worker")
     end_load = load()
     header = ("workload", "workers", "n", "time [s]", "speed-up", "efficiency", "serial fraction (Karp-Flatt)",
               "result vs 1 worker")
@@ -103,13 +108,25 @@ def main(argv=None) -> int:
             f"`python benchmarks/scale.py{' --quick' if args.quick else ''}`\n\n"
             f"{n_points} points each (the atlas {side} x {side}), median of {repeats}; paper for the sweep and the "
             "atlas, hunt-crossley for simulate_many. The GPU backend of the scale issue is not built: no GPU "
-            "rows.\n\n" + table(header, rows))
+            f"rows. simulate_many's packing (serial Python, one thread beside the workers): {pack_us:.2g} us a case "
+            f"(process CPU time, median of {3 * repeats}), its runs {run_us:.3g} us a case on one worker.\n\n"
+            + table(header, rows))
     emit()
     emit(text)
     suffix = "_quick" if args.quick else ""
     save_section(f"scale{suffix}", text)
     save_targets(f"scale{suffix}", targets)
     return 0
+
+
+def _packing_us(plist: list, repeats: int) -> float:
+    """Process CPU time of packing one of simulate_many's chunks, us a case (median)."""
+    chunk, law, cpu = plist[:PACK_CHUNK], as_law("hunt-crossley"), []
+    for _ in range(3 * repeats):
+        start = time.process_time()
+        pack_batch(chunk, law, None, RTOL)
+        cpu.append(time.process_time() - start)
+    return 1e6 * statistics.median(cpu) / len(chunk)
 
 
 def _same(a, b) -> bool:

@@ -7,6 +7,7 @@ from __future__ import annotations
 import functools
 import math
 import numbers
+import operator
 import threading
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
@@ -14,6 +15,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .. import _signals
+from ..model.forms import ALPHA_, DAMP_, GUARD_, IMPEDANCE_, K_, KB_, KM_, LAW_, M1_, M2_, RIGID_, SPRINGS_
 from ..model.laws import ContactLaw, as_law
 from ..model.rhs import N_COEF, initial_state, pack
 from ..parameters import Parameters, is_number
@@ -123,10 +125,16 @@ class Scales:
     max_step: float
 
 
-def hertz_contact_time(alpha: float, indentation, v):
-    """Duration of the undamped impact, ``2 tau delta_max / v`` (s; scalars or arrays)."""
-    tau = math.sqrt(math.pi) * math.gamma(1 + 1 / (alpha + 1)) / math.gamma(0.5 + 1 / (alpha + 1))  # 1.4716: Hertz
+def hertz_contact_time(alpha, indentation, v):
+    """Duration of the undamped impact, ``2 tau delta_max / v`` (s; scalars or arrays, ``alpha`` too)."""
+    tau = _hertz_tau(alpha) if np.ndim(alpha) == 0 else np.array([_hertz_tau(a) for a in np.asarray(alpha).tolist()])
     return 2 * tau * indentation / v
+
+
+@functools.lru_cache(maxsize=64)
+def _hertz_tau(alpha: float) -> float:
+    # cached: a batch has few distinct exponents
+    return math.sqrt(math.pi) * math.gamma(1 + 1 / (alpha + 1)) / math.gamma(0.5 + 1 / (alpha + 1))  # 1.4716: Hertz
 
 
 def scales(params: Parameters) -> Scales:
@@ -203,15 +211,20 @@ def _packed(params: Parameters, law: ContactLaw, rtol: float) -> tuple:
 def _initial(params: Parameters, initial) -> np.ndarray:
     y = initial_state(params.v)
     if initial is not None:
-        try:
-            state = np.asarray(initial, dtype=float)
-        except (TypeError, ValueError):
-            state = np.full(0, np.nan)
-        if isinstance(initial, str) or state.shape != (4,) or not np.all(np.isfinite(state)):
-            raise ValueError(f"initial = {initial!r} is out of range; allowed: 4 finite numbers "
-                             "(x1, x2, x1dot, x2dot)")
-        y[:4] = state
+        y[:4] = _checked_initial(initial)
     return y
+
+
+def _checked_initial(initial) -> np.ndarray:
+    """``initial`` as 4 finite floats; ``ValueError`` naming it otherwise."""
+    try:
+        state = np.asarray(initial, dtype=float)
+    except (TypeError, ValueError):
+        state = np.full(0, np.nan)
+    if isinstance(initial, str) or state.shape != (4,) or not np.all(np.isfinite(state)):
+        raise ValueError(f"initial = {initial!r} is out of range; allowed: 4 finite numbers "
+                         "(x1, x2, x1dot, x2dot)")
+    return state
 
 
 def _stop_on(stop_on) -> tuple[int, int]:
@@ -463,26 +476,64 @@ def _checked_sequence(params_seq) -> list:
     if not params_seq:
         raise ValueError("params_seq = [] is out of range; allowed: a non-empty sequence of Parameters")
     for i, p in enumerate(params_seq):
-        check_params(p, f"params_seq[{i}]")
+        if type(p) is not Parameters:  # the common case without formatting the name
+            check_params(p, f"params_seq[{i}]")
     return params_seq
 
 
+_NUMBER_FIELDS = operator.attrgetter("M1", "M2", "K", "Kb", "Km", "alpha", "kappa", "v")
+
+
 def _pack(params_seq: list, law: ContactLaw, t_end, rtol: float, initial) -> Batch:
-    n = len(params_seq)
-    C = np.empty((n, N_COEF))
-    Y0 = np.empty((n, 5))
-    T = np.empty(n)
-    S = np.empty(n)
-    indentation, v, M1, contact_time = (np.empty(n) for _ in range(4))
-    for i, p in enumerate(params_seq):
-        s = scales(p)
-        C[i] = pack(p, law)
-        Y0[i] = _initial(p, initial)
-        T[i] = s.horizon if t_end is None else check_t_end(t_end, s.contact_time)
-        S[i] = s.max_step
-        indentation[i], v[i], M1[i], contact_time[i] = s.indentation, p.v, p.M1, s.contact_time
-    # the tolerances of all runs at once: per run they cost more than the rest of the packing
-    return Batch(law, C, Y0, T, state_tolerances(rtol, indentation, v, M1, contact_time), S)
+    """The rows of :func:`pack`, :func:`scales` and the initial states, on columns: per case only the
+    fields are read (and what the law computes per case). The same IEEE operations in the same order
+    as the per-case code (``hertz_indentation``'s powers stay per case), hence the same bits."""
+    y0 = initial_state(0.0) if initial is None else np.concatenate([_checked_initial(initial), [0.0]])
+    M1, M2, K, Kb, Km, alpha, kappa, v = np.array([_NUMBER_FIELDS(p) for p in params_seq]).reshape(-1, 8).T
+    targets = [p.target for p in params_seq]
+    springs = np.array([t == "plate" for t in targets])
+    C = np.zeros((len(v), N_COEF))
+    C[:, M1_], C[:, M2_], C[:, K_], C[:, ALPHA_] = M1, M2, K, alpha
+    C[:, KB_], C[:, KM_] = np.where(springs, Kb, 0.0), np.where(springs, Km, 0.0)
+    C[:, DAMP_] = _damping_column(law, params_seq, K, v, kappa)
+    C[:, SPRINGS_], C[:, RIGID_], C[:, GUARD_] = springs, [t == "rigid" for t in targets], law.runaway_factor
+    if law.entry.coefficients is not None:
+        for i, p in enumerate(params_seq):
+            own = law.coefficients(p)
+            C[i, LAW_:LAW_ + len(own)] = own
+    C[:, IMPEDANCE_] = [p.impedance if t == "infinite" else 0.0 for p, t in zip(params_seq, targets, strict=True)]
+    indentation = np.array([p.hertz_indentation for p in params_seq])
+    contact_time = hertz_contact_time(alpha, indentation, v)
+    with np.errstate(divide="ignore"):  # Kb = 0: no period (Parameters.target_period)
+        period = np.where(springs & (Kb != 0), 2 * math.pi * np.sqrt(M2 / Kb), math.inf)
+    finite = np.isfinite(period)
+    Y0 = np.tile(y0, (len(v), 1))
+    if initial is None:
+        Y0[:, 2] = v
+    horizon = HORIZON_CAP_PERIODS * np.where(finite, period, contact_time)
+    return Batch(law, C, Y0, _horizons(t_end, horizon, contact_time),
+                 state_tolerances(rtol, indentation, v, M1, contact_time), np.where(finite, period / 8, math.inf))
+
+
+def _damping_column(law: ContactLaw, params_seq: list, K: np.ndarray, v: np.ndarray, kappa: np.ndarray):
+    """:meth:`ContactLaw.kappa` of every case (the same operations on columns)."""
+    if law.damping_source in (None, "kappa"):
+        return 0.0 if law.damping_source is None else kappa
+    if law.entry.chi is not None:
+        return law.entry.chi(law.restitution) * K / v
+    return [law.kappa(p) for p in params_seq]  # the exact inverse: a root per case
+
+
+def _horizons(t_end, default: np.ndarray, contact_time: np.ndarray) -> np.ndarray:
+    """Each case's horizon: ``default``, or ``t_end`` checked against each case's contact time (the
+    first case it is too short for is named, as :func:`check_t_end` per case would)."""
+    if t_end is None:
+        return default
+    checked = check_t_end(t_end, contact_time[0])
+    too_short = np.flatnonzero(~(MIN_HORIZON_CONTACT_TIMES * contact_time <= checked))
+    if too_short.size:
+        check_t_end(t_end, contact_time[too_short[0]])
+    return np.full(len(contact_time), checked)
 
 
 def run_batch(batch: Batch, *, rtol: float, settle: bool = True, stop_on=None, n_threads: int = 1,
@@ -724,9 +775,9 @@ def simulate_many(params_seq, law: ContactLaw | str = "paper", t_end: float | No
                "backend": backend}
     if n_threads == 1 or len(chunks) == 1 or backend == "cuda":
         return _joined([run_batch(_pack(chunk, law, t_end, rtol, initial), **options) for chunk in chunks])
-    # Packing is Python, serial and a fifth of the work: a second thread packs the next chunks while
-    # this one runs the last in the worker threads (whose compiled runs release the GIL), so the
-    # packing no longer adds to the run time. The runs stay in this thread, where signals arrive.
+    # Packing is Python and serial (on columns ~2 us a case, 2-3 % of a run): a second thread packs the
+    # next chunks while this one runs the last in the worker threads (whose compiled runs release the
+    # GIL), so the packing does not add to the run time. The runs stay in this thread, where signals arrive.
     with ThreadPoolExecutor(1) as packer:
         packed = [packer.submit(_pack, chunk, law, t_end, rtol, initial) for chunk in chunks]
         try:
