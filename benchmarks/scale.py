@@ -107,7 +107,8 @@ def main(argv=None) -> int:
     text = (f"## Parallel scaling\n\n{machine()}\n\n{start_load} at the start, {end_load} at the end. "
             f"`python benchmarks/scale.py{' --quick' if args.quick else ''}`\n\n"
             f"{n_points} points each (the atlas {side} x {side}), median of {repeats}; paper for the sweep and the "
-            "atlas, hunt-crossley for simulate_many. The GPU backend of the scale issue is not built: no GPU "
+            "atlas, hunt-crossley for simulate_many. CPU backends only: the GPU's (backend=\"cuda\") is timed by "
+            "benchmarks/gpu.py on a machine with one; no GPU "
             f"rows. simulate_many's packing (serial Python, one thread beside the workers): {pack_us:.2g} us a case "
             f"(process CPU time, median of {3 * repeats}), its runs {run_us:.3g} us a case on one worker.\n\n"
             + table(header, rows))
