@@ -209,44 +209,28 @@ def _cuda_usable() -> bool:
     return cuda.unavailable() is None
 
 
-@pytest.mark.skipif(_cuda_usable(), reason="this machine has a usable GPU: nothing to refuse")
-def test_without_a_gpu_the_cli_refuses_in_one_line(tmp_path):
-    """No GPU here: --backend cuda exits 2 with one line naming CUDA, before any work (no archive)."""
-    out_file = tmp_path / "a.nc"
-    out = subprocess.run([sys.executable, "-m", "phaseimpact.cli", "sweep", "--axis", "kappa=1e9:1e12:3:log",
-                          "--out", str(out_file), "--backend", "cuda"], capture_output=True, text=True,
-                         timeout=300, cwd=ROOT, env=dict(os.environ, PYTHONPATH=str(ROOT)))
-    assert out.returncode == 2, out.stderr
-    lines = out.stderr.strip().splitlines()
-    assert len(lines) == 1 and "CUDA is not usable" in lines[0], out.stderr
-    assert not out_file.exists()
+REFUSED_COMMANDS = {  # a command line with --backend cuda, and the files it must not write
+    "sweep": (["sweep", "--axis", "kappa=1e9:1e12:3:log", "--out", "{d}/a.nc"], ["a.nc"]),
+    "orbit-diagram": (["orbit-diagram", "--law", "hunt-crossley", "--kappa", "3e9", "--axis", "T=5e-4:4e-3:3",
+                       "--transients", "2", "--samples", "2", "--out", "{d}/o.png", "--archive", "{d}/o.nc"],
+                      ["o.png", "o.nc"]),
+    "critical-curve": (["critical-curve", "--axis", "v=1:2:2", "--out", "{d}/c.nc"], ["c.nc"]),
+}
 
 
 @pytest.mark.skipif(_cuda_usable(), reason="this machine has a usable GPU: nothing to refuse")
-def test_without_a_gpu_orbit_diagram_refuses_in_one_line(tmp_path):
-    """orbit-diagram --backend cuda without a GPU: exit 2, one line naming CUDA, no figure, no archive."""
-    figure, kept = tmp_path / "o.png", tmp_path / "o.nc"
-    out = subprocess.run([sys.executable, "-m", "phaseimpact.cli", "orbit-diagram", "--law", "hunt-crossley",
-                          "--kappa", "3e9", "--axis", "T=5e-4:4e-3:3", "--transients", "2", "--samples", "2",
-                          "--out", str(figure), "--archive", str(kept), "--backend", "cuda"], capture_output=True,
-                         text=True, timeout=300, cwd=ROOT, env=dict(os.environ, PYTHONPATH=str(ROOT)))
-    assert out.returncode == 2, out.stderr
-    lines = out.stderr.strip().splitlines()
-    assert len(lines) == 1 and "CUDA is not usable" in lines[0], out.stderr
-    assert not figure.exists() and not kept.exists()
-
-
-@pytest.mark.skipif(_cuda_usable(), reason="this machine has a usable GPU: nothing to refuse")
-def test_without_a_gpu_critical_curve_refuses_in_one_line(tmp_path):
-    """critical-curve --backend cuda without a GPU: exit 2, one line naming CUDA, no archive."""
-    out_file = tmp_path / "c.nc"
-    out = subprocess.run([sys.executable, "-m", "phaseimpact.cli", "critical-curve", "--axis", "v=1:2:2",
-                          "--out", str(out_file), "--backend", "cuda"], capture_output=True, text=True,
-                         timeout=300, cwd=ROOT, env=dict(os.environ, PYTHONPATH=str(ROOT)))
+@pytest.mark.parametrize("command", sorted(REFUSED_COMMANDS))
+def test_without_a_gpu_the_cli_refuses_in_one_line(tmp_path, command):
+    """No GPU here: --backend cuda exits 2 with one line naming CUDA, before any work (no figure, no
+    archive)."""
+    argv, written = REFUSED_COMMANDS[command]
+    out = subprocess.run([sys.executable, "-m", "phaseimpact.cli", *(a.format(d=tmp_path) for a in argv),
+                          "--backend", "cuda"], capture_output=True, text=True, timeout=300, cwd=ROOT,
+                         env=dict(os.environ, PYTHONPATH=str(ROOT)))
     assert out.returncode == 2, out.stderr
     lines = out.stderr.strip().splitlines()
     assert len(lines) == 1 and "backend = 'cuda': CUDA is not usable" in lines[0], out.stderr
-    assert not out_file.exists()
+    assert not any((tmp_path / name).exists() for name in written)
 
 
 @pytest.mark.skipif(_cuda_usable(), reason="this machine has a usable GPU: nothing to refuse")
