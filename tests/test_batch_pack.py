@@ -2,6 +2,7 @@
 
 import numpy as np
 import pytest
+from _registry import restored_registry
 
 from phaseimpact import define_law, seed_parameters
 from phaseimpact.integrate import api
@@ -35,6 +36,13 @@ def per_case(cases, law, t_end, rtol, initial):
         rows.append((pack(p, law), api._initial(p, initial), s.horizon if t_end is None else api.check_t_end(
             t_end, s.contact_time), api._atol(p, rtol, None), s.max_step))
     return [np.array(column) for column in zip(*rows, strict=True)]
+
+
+@pytest.fixture(scope="module", autouse=True)
+def _user_law_leaves_with_the_module():
+    """Later tests enumerate the registry (test_laws' variants, test_precompile's fingerprint)."""
+    with restored_registry():
+        yield
 
 
 def user_law() -> ContactLaw:
