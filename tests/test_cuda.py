@@ -459,3 +459,22 @@ def test_gpu_corrector_does_not_read_a_failed_run(monkeypatch):
     monkeypatch.setattr(curve, "summary_runs", failing)
     with pytest.raises(RunFailed, match=r"kappa = 9\.\d+e\+11: step-size-collapse on the GPU"):
         curve._gpu_corrector(as_law("paper"), "kappa_c", 1, 1e-10, 1e-10)(seed_parameters(), 1e12, 0.1)
+
+
+def test_gpu_summaries_refuse_a_non_finite_arrival_before_any_launch(monkeypatch):
+    """api.summary_runs (the orbit diagram's launches): finite arrivals reach the launch as the runs'
+    initial (x1, x2, x1dot, x2dot); one NaN among them is simulate's ValueError, and nothing is launched."""
+    from phaseimpact import cuda
+    from phaseimpact.integrate import api
+    from phaseimpact.model import as_law
+
+    launched = []
+    monkeypatch.setattr(cuda, "run_batch_cuda", lambda code, batch, *rest: launched.append(batch))
+    cases = [seed_parameters(), seed_parameters(v=2.0)]
+    arrivals = np.array([[1e-6, 1e-6, 1.0, -0.1], [2e-6, 2e-6, 2.0, 0.3]])
+    api.summary_runs(as_law("paper"), cases, [None, None], rtol=1e-10, arrivals=arrivals)
+    assert len(launched) == 1 and np.array_equal(launched[0][1][:, :4], arrivals)
+    arrivals[1, 3] = np.nan
+    with pytest.raises(ValueError, match=r"initial = .* is out of range; allowed: 4 finite numbers"):
+        api.summary_runs(as_law("paper"), cases, [None, None], rtol=1e-10, arrivals=arrivals)
+    assert len(launched) == 1
