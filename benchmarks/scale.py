@@ -38,7 +38,7 @@ from _common import emit, load, machine, save_section, save_targets, table, targ
 
 from phaseimpact import seed_parameters, simulate_many  # noqa: E402
 from phaseimpact.continuation import Axis, atlas, sweep  # noqa: E402
-from phaseimpact.integrate.api import PACK_CHUNK, pack_batch  # noqa: E402
+from phaseimpact.integrate.batch import PACK_CHUNK, pack_batch  # noqa: E402
 from phaseimpact.model import as_law  # noqa: E402
 
 RTOL = 1e-10

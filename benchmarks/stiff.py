@@ -22,7 +22,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from _common import emit, load, machine, save_section, save_targets, table, timed  # noqa: E402
 
 from phaseimpact import seed_parameters  # noqa: E402
-from phaseimpact.integrate.api import pack_batch, run_batch  # noqa: E402
+from phaseimpact.integrate.batch import pack_batch, run_batch  # noqa: E402
 
 COLUMNS = ("t_run", "max_force", "dissipated_energy", "first_stick_delta")
 RTOLS = (1e-8, 1e-9, 1e-10, 1e-11)

@@ -1,5 +1,5 @@
 """The per-point path allocates nothing: many runs go through the driver's per-point kernels in a
-workspace the host makes once per thread and chunk (``api.run_batch``, handed to ``driver.run_block``),
+workspace the host makes once per thread and chunk (``batch.run_batch``, handed to ``driver.run_block``),
 counted with numba's runtime allocation statistics; a run whose stick points overflow the chunk's
 rows is run again on the full path."""
 
@@ -14,6 +14,7 @@ import numpy as np
 
 from phaseimpact import seed_parameters, simulate
 from phaseimpact.integrate import api
+from phaseimpact.integrate.batch import pack_batch, run_batch
 
 # numba counts its allocations only when NUMBA_NRT_STATS is set as its runtime starts: a process of its own
 COUNT = r"""
@@ -21,7 +22,7 @@ import json
 import numpy as np
 from numba.core.runtime import rtsys
 from phaseimpact import seed_parameters, simulate, simulate_many
-from phaseimpact.integrate import api
+from phaseimpact.integrate import batch
 
 def allocations(n, threads):
     cases = [seed_parameters(v=1.0, kappa=k) for k in np.geomspace(1e9, 1e13, n)]
@@ -33,13 +34,13 @@ simulate_many([seed_parameters(v=1.0)], "paper", n_threads=2)  # the engine load
 before = rtsys.get_allocation_stats().alloc
 simulate(seed_parameters(v=1.0), "paper")
 trajectory = rtsys.get_allocation_stats().alloc - before
-print(json.dumps({"chunk": api.PACK_CHUNK, "trajectory": trajectory, "one": allocations(1, 1),
+print(json.dumps({"chunk": batch.PACK_CHUNK, "trajectory": trajectory, "one": allocations(1, 1),
                   "many": allocations(10_000, 1), "many_two_threads": allocations(10_000, 2)}))
 """
 
 
 def test_a_sweep_makes_no_numba_allocation():
-    """10 000 runs in 5 chunks of api.PACK_CHUNK, in one thread or two, make no numba allocation at
+    """10 000 runs in 5 chunks of batch.PACK_CHUNK, in one thread or two, make no numba allocation at
     all: each thread's workspace is one numpy buffer the host makes per chunk, and run_block (a
     kernel: no reference counting) takes it and the batch without numba's runtime (the driver of
     issue 36 made 32 per thread and chunk: the workspace's 22 arrays and the 10 it was handed; the
@@ -61,9 +62,9 @@ def test_a_run_that_overflows_its_stick_rows_gives_the_full_path_result():
     run is flagged (its count above the capacity) and run again on the full path (event log), and
     its columns equal both a roomy batch and ``simulate`` bit for bit."""
     p = seed_parameters(v=7.0, kappa=4.16865e11)
-    batch = api.pack_batch([p], "paper", None, 1e-10)
-    tight = api.run_batch(batch, rtol=1e-10, capacity=1)
-    roomy = api.run_batch(batch, rtol=1e-10, capacity=32)
+    batch = pack_batch([p], "paper", None, 1e-10)
+    tight = run_batch(batch, rtol=1e-10, capacity=1)
+    roomy = run_batch(batch, rtol=1e-10, capacity=32)
     alone = simulate(p, "paper")
     t, delta, dwell = alone.stick_points()
     assert len(t) == tight.stick_count[0] == roomy.stick_count[0] == 4

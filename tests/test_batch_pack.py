@@ -1,4 +1,4 @@
-"""simulate_many's packing on columns (api._pack) against simulate's per-case packing, bit for bit."""
+"""simulate_many's packing on columns (batch._pack) against simulate's per-case packing, bit for bit."""
 
 import numpy as np
 import pytest
@@ -6,6 +6,7 @@ from _registry import restored_registry
 
 from phaseimpact import define_law, seed_parameters
 from phaseimpact.integrate import api
+from phaseimpact.integrate.batch import pack_batch
 from phaseimpact.model import REGISTRY, ContactLaw
 from phaseimpact.model.rhs import pack
 
@@ -60,7 +61,7 @@ def test_columns_equal_the_per_case_packing_bit_for_bit(law, t_end, initial):
     cases = varied_cases()
     if law.name == "thornton":  # Hertz only
         cases = [p.replace(alpha=1.5) for p in cases]
-    batch = api.pack_batch(cases, law, t_end, 1e-10, initial)
+    batch = pack_batch(cases, law, t_end, 1e-10, initial)
     expected = per_case(cases, law, t_end, 1e-10, initial)
     for name, want in zip(("C", "Y0", "t_end", "atol", "max_step"), expected, strict=True):
         got = getattr(batch, name)
@@ -73,7 +74,7 @@ def test_a_horizon_too_short_names_the_first_case_it_is_too_short_for():
     t_end = 1e-13 * api.scales(slow).contact_time * 0.5
     assert t_end >= 1e-13 * api.scales(fast).contact_time  # long enough for the first case only
     with pytest.raises(ValueError, match="t_end") as caught:
-        api.pack_batch([fast, fast, slow], "paper", t_end, 1e-10)
+        pack_batch([fast, fast, slow], "paper", t_end, 1e-10)
     with pytest.raises(ValueError) as per_case_error:
         api.check_t_end(t_end, api.scales(slow).contact_time)
     assert str(caught.value) == str(per_case_error.value)
@@ -82,4 +83,4 @@ def test_a_horizon_too_short_names_the_first_case_it_is_too_short_for():
 def test_a_case_the_law_cannot_pack_is_refused_by_the_law():
     cases = [seed_parameters(limiting_pressure=2e9), seed_parameters()]  # thornton needs p_y
     with pytest.raises(ValueError, match="limiting contact pressure"):
-        api.pack_batch(cases, "thornton", None, 1e-10)
+        pack_batch(cases, "thornton", None, 1e-10)

@@ -335,11 +335,12 @@ PTX = textwrap.dedent("""
 
     from phaseimpact import cuda as gpu, seed_parameters
     from phaseimpact.integrate import api, driver as d
+    from phaseimpact.integrate.batch import pack_batch
 
     # The engine's @njit functions become device functions when the kernel calls them; numba asks the
     # current device for its compute capability there, and there is none: the H100's (9.0) instead.
     numba.cuda.dispatcher.get_current_device = lambda: types.SimpleNamespace(compute_capability=(9, 0))
-    batch = api.pack_batch([seed_parameters()], "paper", None, 1e-10)
+    batch = pack_batch([seed_parameters()], "paper", None, 1e-10)
     work = gpu.workspaces(1, batch.C.shape[1], 32)
     outputs = (np.empty((1, d.N_SUMMARY)), np.empty((1, 32)), np.empty((1, 32)), np.empty((1, 32)),
                np.empty(1, np.int64))
@@ -462,19 +463,19 @@ def test_gpu_corrector_does_not_read_a_failed_run(monkeypatch):
 
 
 def test_gpu_summaries_refuse_a_non_finite_arrival_before_any_launch(monkeypatch):
-    """api.summary_runs (the orbit diagram's launches): finite arrivals reach the launch as the runs'
+    """batch.summary_runs (the orbit diagram's launches): finite arrivals reach the launch as the runs'
     initial (x1, x2, x1dot, x2dot); one NaN among them is simulate's ValueError, and nothing is launched."""
     from phaseimpact import cuda
-    from phaseimpact.integrate import api
+    from phaseimpact.integrate.batch import summary_runs
     from phaseimpact.model import as_law
 
     launched = []
     monkeypatch.setattr(cuda, "run_batch_cuda", lambda code, batch, *rest: launched.append(batch))
     cases = [seed_parameters(), seed_parameters(v=2.0)]
     arrivals = np.array([[1e-6, 1e-6, 1.0, -0.1], [2e-6, 2e-6, 2.0, 0.3]])
-    api.summary_runs(as_law("paper"), cases, [None, None], rtol=1e-10, arrivals=arrivals)
+    summary_runs(as_law("paper"), cases, [None, None], rtol=1e-10, arrivals=arrivals)
     assert len(launched) == 1 and np.array_equal(launched[0][1][:, :4], arrivals)
     arrivals[1, 3] = np.nan
     with pytest.raises(ValueError, match=r"initial = .* is out of range; allowed: 4 finite numbers"):
-        api.summary_runs(as_law("paper"), cases, [None, None], rtol=1e-10, arrivals=arrivals)
+        summary_runs(as_law("paper"), cases, [None, None], rtol=1e-10, arrivals=arrivals)
     assert len(launched) == 1

@@ -15,6 +15,7 @@ import pytest
 
 MODULES = (
     "phaseimpact.integrate.api",
+    "phaseimpact.integrate.batch",
     "phaseimpact.integrate.result",
     "phaseimpact.continuation",
     "phaseimpact.continuation.sweep",

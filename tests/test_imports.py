@@ -4,7 +4,9 @@ each other in a cycle. Read from the sources (``ast``), not by importing them.
 
 A layer's unit is the first name under the package (``phaseimpact.integrate.api`` is in
 ``integrate``), so ``archive`` and ``cli`` are units whether they are modules or packages; ``""`` is
-the package's face, ``phaseimpact/__init__.py``.
+the package's face, ``phaseimpact/__init__.py``. A dotted unit (``integrate.batch``) layers a
+package's own modules: it is the unit of the modules under it, and a package's face (its
+``__init__.py``) may import any module of its package, as it re-exports them.
 """
 
 from __future__ import annotations
@@ -23,6 +25,7 @@ LAYERS = (
     ("parameters",),
     ("model",),  # all physics: laws, equations of motion, restitution, contact mechanics
     ("integrate", "_oracle", "cuda"),  # trajectories (the scipy oracle of the checks; the GPU's launches)
+    ("integrate.batch", "integrate.precompile"),  # many runs at once, over integrate.api's one; the warm-up
     ("case", "settings"),  # case files (read the laws' names) and their --set settings
     ("analysis", "quantities", "checks"),  # one trajectory or one law at a time
     ("continuation",),  # sweeps, atlases, transitions, curves (the only joblib/Dask importer)
@@ -69,10 +72,14 @@ def _imports(package_root: Path, path: Path) -> list[tuple[str, int, bool]]:
     return found
 
 
-def _unit(module: str) -> str:
-    """The layer's unit of a module: the first name under the package, "" for the package itself."""
-    parts = module.split(".")
-    return parts[1] if len(parts) > 1 else ""
+def _unit(module: str, units=frozenset()) -> str:
+    """The layer's unit of a module: the longest of ``units`` it is in (``integrate.batch``), else the
+    first name under the package; "" for the package itself."""
+    parts = module.split(".")[1:]
+    for end in range(len(parts), 1, -1):
+        if ".".join(parts[:end]) in units:
+            return ".".join(parts[:end])
+    return parts[0] if parts else ""
 
 
 def layering_errors(package_root: Path, layers=LAYERS, known_cycles=frozenset()) -> list[str]:
@@ -86,14 +93,15 @@ def layering_errors(package_root: Path, layers=LAYERS, known_cycles=frozenset())
     for path in sorted(package_root.rglob("*.py")):
         module = _module(package_root, path)
         top_graph[module], any_graph[module] = set(), set()
-        if _unit(module) not in level:
+        if _unit(module, level) not in level:
             errors.append(f"{path.relative_to(package_root.parent)}: {module} is in no layer")
             continue
         for target, line, at_top in _imports(package_root, path):
             any_graph[module].add(target)
             if at_top:
                 top_graph[module].add(target)
-            if level.get(_unit(target), -1) > level[_unit(module)]:
+            own_module = path.name == "__init__.py" and target.startswith(module + ".")
+            if not own_module and level.get(_unit(target, level), -1) > level[_unit(module, level)]:
                 errors.append(f"{path.relative_to(package_root.parent)}:{line}: {module} imports {target}, "
                               f"a layer above it")
     for cycle in _cycles(top_graph):
@@ -147,10 +155,11 @@ def test_the_package_imports_downwards_only_and_has_no_cycle():
 def test_every_declared_unit_exists():
     """A layer naming a module that is gone would let its replacement go unchecked."""
     for unit in (u for layer in LAYERS for u in layer if u):
-        assert (ROOT / "phaseimpact" / f"{unit}.py").is_file() or (ROOT / "phaseimpact" / unit).is_dir(), unit
+        path = ROOT / "phaseimpact" / unit.replace(".", "/")
+        assert path.with_suffix(".py").is_file() or path.is_dir(), unit
 
 
-LAYERS_OF_TEST = (("_jit",), ("model",), ("integrate",), ("continuation",), ("cli",), ("",))
+LAYERS_OF_TEST = (("_jit",), ("model",), ("integrate",), ("integrate.batch",), ("continuation",), ("cli",), ("",))
 
 
 def _package(tmp_path: Path, files: dict[str, str]) -> Path:
@@ -177,10 +186,15 @@ def _package(tmp_path: Path, files: dict[str, str]) -> Path:
     ({"model/laws.py": "def f():\n    from . import rhs\n", "model/rhs.py": "from .laws import force\n"},
      ["import cycle (inside functions): pkg.model.laws -> pkg.model.rhs -> pkg.model.laws"]),
     ({"plotting.py": ""}, ["pkg/plotting.py: pkg.plotting is in no layer"]),
+    ({"integrate/batch.py": "", "integrate/api.py": "def f():\n    from .batch import run_batch\n"},
+     ["pkg/integrate/api.py:2: pkg.integrate.api imports pkg.integrate.batch, a layer above it"]),
     ({"_jit.py": "", "integrate/driver.py": "from .. import _jit\nfrom ..model import rhs\n", "model/rhs.py": "",
       "cli.py": "from .integrate import driver\n"}, []),
+    ({"integrate/api.py": "", "integrate/batch.py": "from .api import check\n",
+      "integrate/__init__.py": "from .api import simulate\nfrom .batch import simulate_many\n",
+      "continuation/__init__.py": "from ..integrate.batch import run_batch\n"}, []),
 ], ids=["nested-upward", "package-face", "absolute-upward", "package-to-package", "cycle", "cycle-in-function",
-        "undeclared", "allowed"])
+        "undeclared", "within-a-package", "allowed", "within-a-package-allowed"])
 def test_the_check_finds_upward_imports_cycles_and_strays(tmp_path, files, expected):
     assert layering_errors(_package(tmp_path, files), LAYERS_OF_TEST) == expected
 

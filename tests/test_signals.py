@@ -24,6 +24,7 @@ import pytest
 from phaseimpact import _signals, archive, seed_parameters, simulate, simulate_many
 from phaseimpact.integrate import api
 from phaseimpact.integrate import driver as d
+from phaseimpact.integrate.batch import pack_batch
 from phaseimpact.integrate.record import workspace_size
 from phaseimpact.integrate.rk4 import run_rk4
 from phaseimpact.model import as_law, pack
@@ -95,7 +96,7 @@ def _interrupted_block(pipe, start: int, step: int) -> np.ndarray:
     """The statuses after run_block's runs start, start + step, ... of 3 * POLL_RUNS runs, with a
     byte in the pipe from the beginning (-7: a run the block did not touch)."""
     seq = [seed_parameters(v=1.0, kappa=k) for k in np.geomspace(1e9, 1e14, 3 * d.POLL_RUNS)]
-    batch = api.pack_batch(seq, as_law("paper"), None, 1e-10)
+    batch = pack_batch(seq, as_law("paper"), None, 1e-10)
     n = len(batch)
     summary = np.full((n, d.N_SUMMARY), -7.0)
     st = np.empty((3, n, 32))
@@ -151,17 +152,17 @@ except KeyboardInterrupt as stop:
 """
 
 
-# simulate_many in threads over several packed chunks (api.PACK_CHUNK), run by a runner thread
+# simulate_many in threads over several packed chunks (batch.PACK_CHUNK), run by a runner thread
 MANY_SCRIPT = """
 import sys, time
 from phaseimpact import seed_parameters, simulate_many
-from phaseimpact.integrate import api
+from phaseimpact.integrate import batch
 p = seed_parameters(v=1e4, kappa=1e18)
 simulate_many([p], "hunt-crossley", 1e-4)  # loads the compiled engine
 print("running", flush=True)
 start = time.perf_counter()
 try:
-    simulate_many([p] * (3 * api.PACK_CHUNK), "hunt-crossley", 0.05, n_threads=2)  # minutes of compiled work
+    simulate_many([p] * (3 * batch.PACK_CHUNK), "hunt-crossley", 0.05, n_threads=2)  # minutes of compiled work
 except KeyboardInterrupt as stop:
     print(type(stop).__name__, round(time.perf_counter() - start, 3), flush=True)
 """

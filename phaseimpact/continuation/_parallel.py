@@ -22,7 +22,7 @@ import warnings
 import numpy as np
 
 from .. import _signals
-from ..integrate.api import run_batch
+from ..integrate.batch import run_batch
 
 __all__ = ["BACKENDS", "run_chunks", "check_jobs", "check_scheduler", "connect", "warm_workers", "tasks_in_flight",
            "MAX_DASK_TASKS"]

@@ -22,7 +22,8 @@ import numpy as np
 from tqdm.auto import tqdm
 
 from ..case import Case
-from ..integrate.api import check_rtol, summary_runs
+from ..integrate.api import check_rtol
+from ..integrate.batch import summary_runs
 from ..integrate.driver import S_STATUS, STATUSES, SUCCESS
 from ..model.laws import ContactLaw, as_law
 from ..parameters import Parameters

@@ -15,7 +15,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..case import Case
-from ..integrate.api import Batch, check_rtol, hertz_contact_time, pack_batch, scales, state_tolerances
+from ..integrate.api import check_rtol, hertz_contact_time, scales, state_tolerances
+from ..integrate.batch import Batch, pack_batch
 from ..model.laws import ContactLaw
 from ..model.rhs import ALPHA_, DAMP_, K_, M1_, pack
 from ..parameters import KAPPA_MAX, PARAMETER_NAMES, V_RANGE, Parameters, is_number
@@ -417,7 +418,7 @@ class Grid:
         -------
         Batch
             Coefficients, initial states, horizons, tolerances and step caps, one row per point,
-            for :func:`phaseimpact.integrate.api.run_batch`.
+            for :func:`phaseimpact.integrate.batch.run_batch`.
 
         Raises
         ------

@@ -21,7 +21,8 @@ Examples
 4760 N, e = 0.924
 """
 
-from .api import INTEGRATORS, RTOL_RANGE, Scales, scales, simulate, simulate_many
+from .api import INTEGRATORS, RTOL_RANGE, Scales, scales, simulate
+from .batch import simulate_many
 from .events import EVENT_KINDS
 from .result import OUTCOMES, STATUSES, Columns, Event, Trajectory
 

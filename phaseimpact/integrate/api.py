@@ -1,32 +1,30 @@
-"""Entry points: :func:`simulate` (one run, a :class:`Trajectory`) and :func:`simulate_many`
-(many runs in parallel threads, :class:`Columns`). Both check every argument before any work,
-derive horizons and tolerances from the case's own scales, and call the one compiled driver."""
+"""One run: :func:`simulate` (a :class:`Trajectory`) and :func:`summary_run` (a summary and a
+final state, in this thread's held workspace), with the checks and scales every run shares:
+each argument is checked before any work, horizons and tolerances come from the case's own
+scales, and the run goes on the one compiled driver. Many runs at once are :mod:`.batch`'s."""
 
 from __future__ import annotations
 
 import functools
 import math
 import numbers
-import operator
 import threading
-from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 
 import numpy as np
 
 from .. import _signals
-from ..model.forms import ALPHA_, DAMP_, GUARD_, IMPEDANCE_, K_, KB_, KM_, LAW_, M1_, M2_, RIGID_, SPRINGS_
 from ..model.laws import ContactLaw, as_law
 from ..model.rhs import N_COEF, initial_state, pack
 from ..parameters import Parameters, is_number
 from . import driver as d
-from . import logs, radau5
+from . import radau5
 from .events import EVENT_KINDS
-from .record import W_SUMMARY, W_Y, Y_STATE, workspace, workspace_size
-from .result import Columns, Trajectory
+from .record import W_SUMMARY, W_Y, Y_STATE, workspace
+from .result import Trajectory
 from .rk4 import run_rk4
 
-__all__ = ["simulate", "simulate_many", "Scales", "scales", "INTEGRATORS", "RTOL_RANGE"]
+__all__ = ["simulate", "Scales", "scales", "INTEGRATORS", "RTOL_RANGE"]
 
 #: The integrators :func:`simulate` accepts: ``exact`` (event-driven DOP853, Radau IIA for stiff
 #: phases) and ``rk4`` (the seed's fixed-step RK4 on eq. 8 read literally).
@@ -440,171 +438,6 @@ def _integrator_name(rk4_step: float, rtol: float, stiff: bool) -> str:
     return f"exact[{'DOP853+Radau5' if stiff else 'DOP853'}, rtol={rtol:g}]"
 
 
-@dataclass(frozen=True)
-class Batch:
-    """Packed inputs of many runs of one law: coefficients (n, N_COEF), initial states (n, 5),
-    horizons, absolute tolerances (n, 7, see :func:`state_tolerances`) and step caps (n,)."""
-
-    law: ContactLaw
-    C: np.ndarray
-    Y0: np.ndarray
-    t_end: np.ndarray
-    atol: np.ndarray
-    max_step: np.ndarray
-
-    def __len__(self) -> int:
-        return len(self.C)
-
-
-#: Where :func:`simulate_many` runs: threads of this process, or a GPU (:mod:`phaseimpact.cuda`).
-SIMULATE_MANY_BACKENDS = ("threads", "cuda")
-#: Runs packed at a time by :func:`simulate_many` (any size gives the same numbers: runs are independent).
-PACK_CHUNK = 2048
-
-
-def pack_batch(params_seq, law: ContactLaw, t_end, rtol: float, initial=None) -> Batch:
-    """Pack a sequence of :class:`Parameters` (one law) for :func:`run_batch`."""
-    law = as_law(law)
-    return _pack(_checked_sequence(params_seq), law, t_end, rtol, initial)
-
-
-def _checked_sequence(params_seq) -> list:
-    if isinstance(params_seq, Parameters) or not hasattr(params_seq, "__iter__"):
-        raise TypeError(f"params_seq = {params_seq!r} has the wrong type ({type(params_seq).__name__}); allowed: a "
-                        "sequence of Parameters")
-    params_seq = list(params_seq)
-    if not params_seq:
-        raise ValueError("params_seq = [] is out of range; allowed: a non-empty sequence of Parameters")
-    for i, p in enumerate(params_seq):
-        if type(p) is not Parameters:  # the common case without formatting the name
-            check_params(p, f"params_seq[{i}]")
-    return params_seq
-
-
-_NUMBER_FIELDS = operator.attrgetter("M1", "M2", "K", "Kb", "Km", "alpha", "kappa", "v")
-
-
-def _pack(params_seq: list, law: ContactLaw, t_end, rtol: float, initial) -> Batch:
-    """The rows of :func:`pack`, :func:`scales` and the initial states, on columns: per case only the
-    fields are read (and what the law computes per case). The same IEEE operations in the same order
-    as the per-case code (``hertz_indentation``'s powers stay per case), hence the same bits."""
-    y0 = initial_state(0.0) if initial is None else np.concatenate([_checked_initial(initial), [0.0]])
-    M1, M2, K, Kb, Km, alpha, kappa, v = np.array([_NUMBER_FIELDS(p) for p in params_seq]).reshape(-1, 8).T
-    targets = [p.target for p in params_seq]
-    springs = np.array([t == "plate" for t in targets])
-    C = np.zeros((len(v), N_COEF))
-    C[:, M1_], C[:, M2_], C[:, K_], C[:, ALPHA_] = M1, M2, K, alpha
-    C[:, KB_], C[:, KM_] = np.where(springs, Kb, 0.0), np.where(springs, Km, 0.0)
-    C[:, DAMP_] = _damping_column(law, params_seq, K, v, kappa)
-    C[:, SPRINGS_], C[:, RIGID_], C[:, GUARD_] = springs, [t == "rigid" for t in targets], law.runaway_factor
-    if law.entry.coefficients is not None:
-        for i, p in enumerate(params_seq):
-            own = law.coefficients(p)
-            C[i, LAW_:LAW_ + len(own)] = own
-    C[:, IMPEDANCE_] = [p.impedance if t == "infinite" else 0.0 for p, t in zip(params_seq, targets, strict=True)]
-    indentation = np.array([p.hertz_indentation for p in params_seq])
-    contact_time = hertz_contact_time(alpha, indentation, v)
-    with np.errstate(divide="ignore"):  # Kb = 0: no period (Parameters.target_period)
-        period = np.where(springs & (Kb != 0), 2 * math.pi * np.sqrt(M2 / Kb), math.inf)
-    finite = np.isfinite(period)
-    Y0 = np.tile(y0, (len(v), 1))
-    if initial is None:
-        Y0[:, 2] = v
-    horizon = HORIZON_CAP_PERIODS * np.where(finite, period, contact_time)
-    return Batch(law, C, Y0, _horizons(t_end, horizon, contact_time),
-                 state_tolerances(rtol, indentation, v, M1, contact_time), np.where(finite, period / 8, math.inf))
-
-
-def _damping_column(law: ContactLaw, params_seq: list, K: np.ndarray, v: np.ndarray, kappa: np.ndarray):
-    """:meth:`ContactLaw.kappa` of every case (the same operations on columns)."""
-    if law.damping_source in (None, "kappa"):
-        return 0.0 if law.damping_source is None else kappa
-    if law.entry.chi is not None:
-        return law.entry.chi(law.restitution) * K / v
-    return [law.kappa(p) for p in params_seq]  # the exact inverse: a root per case
-
-
-def _horizons(t_end, default: np.ndarray, contact_time: np.ndarray) -> np.ndarray:
-    """Each case's horizon: ``default``, or ``t_end`` checked against each case's contact time (the
-    first case it is too short for is named, as :func:`check_t_end` per case would)."""
-    if t_end is None:
-        return default
-    checked = check_t_end(t_end, contact_time[0])
-    too_short = np.flatnonzero(~(MIN_HORIZON_CONTACT_TIMES * contact_time <= checked))
-    if too_short.size:
-        check_t_end(t_end, contact_time[too_short[0]])
-    return np.full(len(contact_time), checked)
-
-
-def run_batch(batch: Batch, *, rtol: float, settle: bool = True, stop_on=None, n_threads: int = 1,
-              capacity: int = 32, stiff: bool = True, backend: str = "threads") -> Columns:
-    """Run a packed batch in ``n_threads`` threads, or one GPU thread per run (``backend="cuda"``,
-    checked by :func:`phaseimpact.cuda.check` first); each run is independent of the others, so the columns
-    do not depend on the thread count or on how a sweep was cut into batches."""
-    stop_kind, stop_count = _stop_on(stop_on)
-    stiff_after = _stiff_after(stiff)
-    n = len(batch)
-    summary = np.empty((n, d.N_SUMMARY))
-    st = np.empty((3, n, capacity))
-    count = np.empty(n, np.int64)
-    args = (batch.law.code, (batch.C, batch.Y0, batch.t_end, batch.atol, batch.max_step),
-            (rtol, settle, stop_kind, stop_count, MAX_STEPS, MAX_EVENTS, stiff_after))
-    outputs = (summary, st[0], st[1], st[2], count)
-    threads = max(1, min(int(n_threads), n))
-    # each thread's workspace, made here once for the chunk (the compiled runs allocate nothing)
-    work = np.zeros((threads, workspace_size(batch.C.shape[1], capacity)))
-    if not _signals.installed:
-        _signals.install()
-    native = batch.law.entry.native
-    while True:
-        if native is not None:
-            native.reset()
-        if backend == "cuda":
-            from .. import cuda
-
-            cuda.run_batch_cuda(*args, outputs)
-        elif threads == 1:
-            d.run_block(*args, 0, n, 1, outputs, work[0])
-        else:  # thread k runs k, k + threads, ...: equal loads (run_block); the driver releases the GIL
-            with ThreadPoolExecutor(threads) as pool:
-                list(pool.map(lambda k: d.run_block(*args, k, n, threads, outputs, work[k]), range(threads)))
-        woken = bool(np.any(summary[:, d.S_STATUS] == d.INTERRUPTED)) or _woken(d.SUCCESS, native)
-        if not (woken or _signals.deferred):
-            break
-        _signals.check(woken)  # raises for Ctrl-C or SIGTERM; after an old wake-up, runs again
-    if native is not None and native.faulted:
-        _mark_law_faults(batch, summary, native, rtol, settle, stop_kind, stop_count, stiff_after)
-    # the stick points of every run in run order: each run's first min(count, capacity) from the
-    # buffers (one masked gather: a Python loop over the runs was the serial part of a threaded sweep)
-    kept = np.arange(capacity) < np.minimum(count, capacity)[:, None]
-    points = [st[j][kept] for j in range(3)]
-    for i in np.flatnonzero(count > capacity)[::-1]:  # from the last, so earlier offsets stay valid
-        # more stick phases than the buffer holds (near kappa_c): rerun this one for all of them
-        out = _run_one(batch, i, rtol, settle, stop_kind, stop_count, stiff_after, native)
-        k = int(count[i])
-        full = np.empty((3, k))
-        s = out[0]
-        logs.stick_points(out[1], s[d.S_T_STOP], s[d.S_OUTCOME] == d.PERMANENT_STICK, full[0], full[1], full[2])
-        offset = int(np.minimum(count[:i], capacity).sum())
-        points = [np.concatenate([p[:offset], full[j], p[offset + capacity:]]) for j, p in enumerate(points)]
-    return Columns.from_summary(summary, count, *points)
-
-
-def _run_one(batch: Batch, i: int, rtol, settle, stop_kind, stop_count, stiff_after, native):
-    """Run ``i`` of ``batch`` alone, summary and stick points (again after an old wake-up)."""
-    while True:
-        if native is not None:
-            native.reset()
-        out = d.run(batch.law.code, batch.C[i], batch.Y0[i], batch.atol[i], batch.t_end[i], batch.max_step[i],
-                    (rtol, settle, stop_kind, stop_count, MAX_STEPS, MAX_EVENTS, stiff_after), d.SAVE_SUMMARY,
-                    _NO_TIMES)
-        codes = out[0].tolist()  # the summary's numbers: cheaper than reading entries of the array one by one
-        woken = _woken(codes[d.S_STATUS], native)
-        if not (woken or _signals.deferred):
-            return out
-        _signals.check(woken)
-
-
 _held = threading.local()  # each thread's workspace for summary_run: made once, reused run after run
 
 
@@ -647,154 +480,3 @@ def summary_run(params: Parameters, law: ContactLaw | str = "paper", t_end: floa
     if native is not None and native.faulted and summary[d.S_STATUS] != d.SUCCESS:
         summary[d.S_STATUS] = d.NON_FINITE  # the law's NaN failed the run, as in simulate
     return summary, ws[W_Y][Y_STATE].copy()
-
-
-def summary_runs(law: ContactLaw, params_seq, t_ends, *, rtol: float, stop_when_settled: bool = True,
-                 stop_on=None, arrivals=None) -> tuple[np.ndarray, np.ndarray]:
-    """:func:`summary_run` of every case of ``params_seq`` in one GPU launch, one thread each (the
-    ``cuda`` backends of the critical curve and the orbit diagram): the summaries (n x
-    ``driver.N_SUMMARY``) and final states (n x 5) it would give, from the same inputs. ``t_ends``:
-    each run's horizon (None: the case's own); ``arrivals`` (n x 4, optional): each run's initial
-    ``(x1, x2, x1dot, x2dot)`` (``W`` from the seed state, as ``initial`` does). The caller checks
-    ``law`` and ``rtol`` and calls :func:`phaseimpact.cuda.check` first."""
-    from .. import cuda
-
-    packed = [_packed(p, law, rtol) for p in params_seq]  # summary_run's inputs, cached
-    starts = np.stack([y0 for _, _, y0, _ in packed])
-    if arrivals is not None:
-        unusable = np.flatnonzero(~np.all(np.isfinite(arrivals), axis=1))
-        if unusable.size:  # the ValueError summary_run would give
-            _initial(params_seq[unusable[0]], arrivals[unusable[0]])
-        starts[:, :4] = arrivals
-    horizons = np.array([s.horizon if t_end is None else check_t_end(t_end, s.contact_time)
-                         for (_, _, _, s), t_end in zip(packed, t_ends, strict=True)])
-    batch = (np.stack([c for c, _, _, _ in packed]), starts, horizons,
-             np.stack([atol for _, atol, _, _ in packed]), np.array([s.max_step for _, _, _, s in packed]))
-    stop_kind, stop_count = _stop_on(stop_on)
-    options = (rtol, check_bool("stop_when_settled", stop_when_settled), stop_kind, stop_count, MAX_STEPS,
-               MAX_EVENTS, _stiff_after(True))
-    n = len(packed)
-    summary, final = np.empty((n, d.N_SUMMARY)), np.empty((n, 5))
-    no_sticks = np.empty((n, 1))  # the stick points are not read: one slot each
-    cuda.run_batch_cuda(law.code, batch, options, (summary, no_sticks, no_sticks.copy(), no_sticks.copy(),
-                                                   np.empty(n, np.int64)), final)
-    return summary, final
-
-
-def _mark_law_faults(batch: Batch, summary, native, rtol, settle, stop_kind, stop_count, stiff_after) -> None:
-    """Give the status ``non-finite`` to the failed runs whose user law raised or gave NaN or inf.
-
-    The law's fault record is one for the whole batch (its runs share the compiled function, in
-    several threads): each failed run is run again alone (the same numbers: runs are independent)
-    to see whether its law faulted. Only failed runs can be the law's: a run whose law faulted on
-    a rejected trial step and then went on is a success."""
-    for i in np.flatnonzero(summary[:, d.S_STATUS] != d.SUCCESS):
-        _run_one(batch, i, rtol, settle, stop_kind, stop_count, stiff_after, native)
-        if native.faulted:
-            summary[i, d.S_STATUS] = d.NON_FINITE
-
-
-def simulate_many(params_seq, law: ContactLaw | str = "paper", t_end: float | None = None, *,
-                  rtol: float = 1e-10, stop_when_settled: bool = True, stop_on=None, initial=None,
-                  n_threads: int = 1, stiff: bool = True, backend: str = "threads") -> Columns:
-    """Many impacts (one per :class:`Parameters` of ``params_seq``), summaries only, as columns.
-
-    Same driver and arguments as :func:`simulate`; runs go in ``n_threads`` threads inside this
-    process and the result is bit-identical for any thread count.
-
-    Parameters
-    ----------
-    params_seq : sequence of Parameters
-        One case per run (non-empty), all integrated with ``law``.
-    law : ContactLaw or str, default "paper"
-        A law of :data:`phaseimpact.model.LAWS` with its options, or its name.
-    t_end : float, optional
-        Horizon of every run, s (> 0, and at least ``1e-13`` contact times of each case); default:
-        each run until its outcome settles, capped at its :attr:`Scales.horizon`.
-    rtol : float, default 1e-10
-        Relative tolerance, within :data:`RTOL_RANGE`; absolute tolerances from each case's scales.
-    stop_when_settled : bool, default True
-        Stop each run once nothing can change any more.
-    stop_on : str or (str, int), optional
-        Stop each run at the n-th event of a kind, as for :func:`simulate`.
-    initial : 4 numbers, optional
-        ``(x1, x2, x1dot, x2dot)`` (m, m, m/s, m/s) of every run instead of seed eq. 6.
-    n_threads : int, default 1
-        Threads of this process (>= 1); the compiled driver releases the GIL.
-    stiff : bool, default True
-        Radau IIA for stiff phases, as for :func:`simulate`.
-    backend : {"threads", "cuda"}, default "threads"
-        ``cuda``: one GPU thread per run, the same per-point kernel compiled for the GPU
-        (``n_threads`` is then not read); refused before any work for a user law or without a
-        usable GPU.
-
-    Returns
-    -------
-    Columns
-        One entry per run, in the order of ``params_seq``: codes of status, outcome and stop
-        reason, the summary columns and the stick phases (a ragged array).
-
-    Raises
-    ------
-    TypeError
-        If ``params_seq`` is not a sequence of :class:`~phaseimpact.Parameters`.
-    ValueError
-        For an empty ``params_seq``, an unknown law, or any argument out of range (named in the
-        message).
-
-    Examples
-    --------
-    >>> from phaseimpact import seed_parameters, simulate_many
-    >>> base = seed_parameters(v=1.0)
-    >>> c = simulate_many([base.replace(kappa=k) for k in (1e9, 1e12, 1e13)], "paper")
-    >>> len(c), list(c.outcome_names())
-    (3, ['permanent-stick', 'permanent-stick', 'ratchet-escape'])
-    >>> c.n_stick.tolist()
-    [1, 1, 2]
-    """
-    law = as_law(law)
-    rtol = check_rtol(rtol)
-    if t_end is not None:
-        t_end = check_real("t_end", t_end, "a finite number > 0", lambda x: x > 0)
-    if not (isinstance(n_threads, numbers.Integral) and not isinstance(n_threads, bool) and n_threads >= 1):
-        raise ValueError(f"n_threads = {n_threads!r} is out of range; allowed: an integer >= 1")
-    _stiff_after(stiff)
-    check_bool("stop_when_settled", stop_when_settled)
-    _stop_on(stop_on)
-    if backend not in SIMULATE_MANY_BACKENDS:
-        raise ValueError(f"backend = {backend!r} is out of range; allowed: one of {', '.join(SIMULATE_MANY_BACKENDS)}")
-    if backend == "cuda":
-        from .. import cuda
-
-        cuda.check(law)
-    params_seq = _checked_sequence(params_seq)  # every case, before any run
-    if t_end is not None:  # long enough for the case of the longest contact
-        check_t_end(t_end, max(hertz_contact_time(p.alpha, p.hertz_indentation, p.v) for p in params_seq))
-    chunks = [params_seq[i:i + PACK_CHUNK] for i in range(0, len(params_seq), PACK_CHUNK)]
-    options = {"rtol": rtol, "settle": stop_when_settled, "stop_on": stop_on, "n_threads": n_threads, "stiff": stiff,
-               "backend": backend}
-    if n_threads == 1 or len(chunks) == 1 or backend == "cuda":
-        return _joined([run_batch(_pack(chunk, law, t_end, rtol, initial), **options) for chunk in chunks])
-    # Packing is Python and serial (on columns ~2 us a case, 2-3 % of a run): a second thread packs the
-    # next chunks while this one runs the last in the worker threads (whose compiled runs release the
-    # GIL), so the packing does not add to the run time. The runs stay in this thread, where signals arrive.
-    with ThreadPoolExecutor(1) as packer:
-        packed = [packer.submit(_pack, chunk, law, t_end, rtol, initial) for chunk in chunks]
-        try:
-            return _joined([run_batch(batch.result(), **options) for batch in packed])
-        except BaseException:  # Ctrl-C or SIGTERM: the chunks not yet packed are not packed
-            packer.shutdown(cancel_futures=True)
-            raise
-
-
-def _joined(parts: list[Columns]) -> Columns:
-    """The columns of consecutive chunks as one."""
-    if len(parts) == 1:
-        return parts[0]
-
-    def cat(name):
-        return np.concatenate([getattr(part, name) for part in parts])
-
-    values = {name: np.concatenate([part.values[name] for part in parts]) for name in parts[0].values}
-    return Columns(cat("status"), cat("outcome"), cat("stop_reason"), values, cat("stick_count"), cat("stick_t"),
-                   cat("stick_delta"), cat("stick_dwell"))

@@ -31,7 +31,8 @@ def warmup() -> dict:
     and the cache's ``files`` and ``bytes``."""
     from ..model import law_variants
     from ..parameters import seed_parameters
-    from .api import simulate, simulate_many, summary_run
+    from .api import simulate, summary_run
+    from .batch import simulate_many
 
     info = cache_info()
     start = time.perf_counter()

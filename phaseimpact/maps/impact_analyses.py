@@ -119,8 +119,8 @@ def _diagram_on_gpu(imap: ModelImpactMap, param: str, values, transients: int, s
     one launch. Each value's run gets what :meth:`ModelImpactMap.step` gives :func:`~phaseimpact.simulate`
     (the case's packed coefficients and tolerances, the period as horizon, the arrival as initial state,
     no stop when settled); its summary gives the peak force, its final state the next arrival."""
-    from ..integrate import api
     from ..integrate import driver as d
+    from ..integrate.batch import summary_runs
 
     maps = [imap.at(param, float(value)) for value in values]
     for m in maps:
@@ -132,8 +132,8 @@ def _diagram_on_gpu(imap: ModelImpactMap, param: str, values, transients: int, s
     z = np.stack([m.origin for m in maps]).astype(float)
     for step in range(transients + samples):
         arrivals = np.column_stack([z[:, 0], z[:, 0], [p.v for p in cases], z[:, 1]])  # ModelImpactMap._arrival
-        summary, final = api.summary_runs(imap.law, cases, horizons, rtol=imap.rtol, stop_when_settled=False,
-                                          arrivals=arrivals)
+        summary, final = summary_runs(imap.law, cases, horizons, rtol=imap.rtol, stop_when_settled=False,
+                                      arrivals=arrivals)
         if step >= transients:
             plate[:, step - transients] = z
             peak_force[:, step - transients] = summary[:, d.S_MAX_FORCE]
