@@ -47,8 +47,7 @@ from .api import (
 from .record import workspace_size
 from .result import Columns
 
-__all__ = ["simulate_many", "Batch", "pack_batch", "run_batch", "summary_runs", "SIMULATE_MANY_BACKENDS",
-           "PACK_CHUNK"]
+__all__ = ["simulate_many"]
 
 
 @dataclass(frozen=True)
