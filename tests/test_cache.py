@@ -62,8 +62,9 @@ def test_an_edit_of_python_that_is_not_compiled_keeps_the_cache(tmp_path):
     package = _copy_package(tmp_path)
     before = _jit.engine_digest(package)
     assert before == _jit.engine_digest(ROOT / "phaseimpact")
-    for name in ("integrate/api.py", "integrate/result.py", "integrate/__init__.py", "model/regime.py",
-                 "model/laminate.py", "model/__init__.py", "cli/__init__.py", "cuda.py", "__init__.py"):
+    for name in ("integrate/api.py", "integrate/batch.py", "integrate/result.py", "integrate/__init__.py",
+                 "model/regime.py", "model/laminate.py", "model/__init__.py", "cli/__init__.py", "cuda.py",
+                 "__init__.py"):
         _edit(package / name)
         assert _jit.engine_digest(package) == before, name
 
