@@ -3,7 +3,7 @@
 
 A run's whole state lives in a workspace: a tuple of views (:func:`carve`) of one float64 buffer
 of :func:`workspace_size` numbers, its integer, flag and complex members viewed as such. The buffer
-is made once per thread and chunk of runs by the host (:func:`.api.run_batch`, which hands it to
+is made once per thread and chunk of runs by the host (:func:`.batch.run_batch`, which hands it to
 :func:`.driver.run_block`), once per point of a GPU launch (:mod:`phaseimpact.cuda`), or once per
 trajectory (:func:`workspace`, for :func:`.driver.run`), never inside the per-point kernels, which
 allocate nothing: the form a GPU thread needs too (numba-cuda compiles tuples of arrays and
