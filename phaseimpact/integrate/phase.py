@@ -131,7 +131,9 @@ def phase_events(code, c, mode, side, energy_limit, u, y, f, force, g):
         g[DELTADOT] = u[V1]  # as integrated: x1dot - x2dot of the physical state has lost its digits
 
 
-@kernel
+# inlined at numba level: the root finders call it ten times an event, and a call passes the whole
+# workspace (a tuple of ~20 arrays, ~170 machine words): 6-8 % of a run (benchmarks/trajectory.py --against)
+@kernel(inline="always")
 def event_at(code, ws, column, target, s):
     """Event function ``column`` at ``s`` on the dense output of the run's step (``R_S``, ``R_H``
     from row ``U_U``, interpolant ``U_DENSE``); the pseudo column ``TIME_COLUMN`` is the physical
