@@ -15,7 +15,9 @@ ratio of two medians taken minutes apart measures the drift as much as the scali
 therefore times every worker count of a workload back to back (their order alternating between
 repeats), and the efficiency is the median over the repeats of ``T(1) / (n T(n))`` within one
 repeat. The same pairing times a control: ``n`` threads of a compiled arithmetic loop that touches
-no memory and shares nothing, the efficiency this machine itself gives (its ceiling).
+no memory and shares nothing, the efficiency this machine itself gives (its ceiling). "Cores busy"
+is the process's CPU time over ``n`` times the wall time: below 100 % by the idle and serial time of
+the run, whatever the speed of a core at that minute.
 
     python benchmarks/scale.py [--quick] [--n 8000]
 """
@@ -87,13 +89,16 @@ def main(argv=None) -> int:
     contenders.update({("control: arithmetic only", "threads", n): (lambda n=n: _spin_threads(n)) for n in counts})
     results = {key: fn() for key, fn in contenders.items()}  # warm-up: compiles, starts loky's workers
     times = {key: [] for key in contenders}
+    busy = {key: [] for key in contenders}  # CPU time of the process over n times the wall time
     kinds = list(dict.fromkeys((what, how) for what, how, _ in contenders))
     for r in range(repeats):
         for what, how in kinds:
             for n in (counts if r % 2 == 0 else counts[::-1]):  # back to back, the order alternating
-                start = time.perf_counter()
+                start, cpu = time.perf_counter(), time.process_time()
                 contenders[(what, how, n)]()
-                times[(what, how, n)].append(time.perf_counter() - start)
+                wall = time.perf_counter() - start
+                times[(what, how, n)].append(wall)
+                busy[(what, how, n)].append((time.process_time() - cpu) / (n * wall))
     rows, targets = [], []
     for what, how in kinds:
         one = times[(what, how, 1)]
@@ -104,7 +109,8 @@ def main(argv=None) -> int:
             efficiency = speed_up / n
             same = "-" if what.startswith("control") else (
                 "identical" if _same(reference, results[(what, how, n)]) else "DIFFERENT")
-            rows.append((what, how, n, f"{t:.3g}", f"{speed_up:.2f}", f"{100 * efficiency:.0f} %",
+            used = "-" if how != "threads" else f"{100 * statistics.median(busy[(what, how, n)]):.0f} %"
+            rows.append((what, how, n, f"{t:.3g}", f"{speed_up:.2f}", f"{100 * efficiency:.0f} %", used,
                          f"{karp_flatt(speed_up, n):.3f}" if n > 1 else "-", same))
             emit(f"{what}, {how}, {n}: {t:.3g} s, speed-up {speed_up:.2f}, efficiency {100 * efficiency:.0f} %")
             if n == 2 and how == "threads" and not what.startswith("control"):
@@ -115,14 +121,17 @@ def main(argv=None) -> int:
     run_us = 1e6 * statistics.median(times[("simulate_many", "threads", 1)]) / n_points
     emit(f"simulate_many's packing: {pack_us:.2g} us a case, a run {run_us:.3g} us a case on one worker")
     end_load = load()
-    header = ("workload", "workers", "n", "time [s]", "speed-up", "efficiency", "serial fraction (Karp-Flatt)",
+    header = ("workload", "workers", "n", "time [s]", "speed-up", "efficiency", "cores busy",
+              "serial fraction (Karp-Flatt)",
               "result vs 1 worker")
     text = (f"## Parallel scaling\n\n{machine()}\n\n{start_load} at the start, {end_load} at the end. "
             f"`python benchmarks/scale.py{' --quick' if args.quick else ''}`\n\n"
             f"{n_points} points each (the atlas {side} x {side}), {repeats} repeats; paper for the sweep and the "
             "atlas, hunt-crossley for simulate_many. Times are medians; speed-up and efficiency the medians over "
             "the repeats of T(1)/T(n) timed back to back (the machine's speed drifts between repeats); the "
-            "control is n threads of arithmetic alone (this machine's own ceiling). CPU backends only: the GPU's "
+            "control is n threads of arithmetic alone (this machine's own ceiling); cores busy is the process's CPU "
+            "time over n times the wall time (threads: what is left is idle or serial time, whatever the core's "
+            "speed). CPU backends only: the GPU's "
             "(backend=\"cuda\") is timed by "
             "benchmarks/gpu.py on a machine with one; no GPU "
             f"rows. simulate_many's packing (serial Python, one thread beside the workers): {pack_us:.2g} us a case "
@@ -136,7 +145,7 @@ def main(argv=None) -> int:
     return 0
 
 
-SPIN_ITERATIONS = 40_000_000  # about 0.1 s of one core
+SPIN_ITERATIONS = 200_000_000  # about 0.4 s of one core, as long as a sweep
 
 
 @numba.njit(nogil=True, cache=False)

@@ -23,6 +23,7 @@ import pytest
 
 from phaseimpact import _signals, archive, seed_parameters, simulate, simulate_many
 from phaseimpact.integrate import api
+from phaseimpact.integrate import batch as batches
 from phaseimpact.integrate import driver as d
 from phaseimpact.integrate.batch import pack_batch
 from phaseimpact.integrate.record import workspace_size
@@ -122,6 +123,30 @@ def test_an_interleaved_block_marks_only_its_own_runs_interrupted(pipe):
     assert np.all(status[0::2] == -7.0)
     assert np.all(status[mine[mine < first_polled]] == d.SUCCESS)
     assert np.all(status[mine[mine >= first_polled]] == d.INTERRUPTED)
+
+
+def test_threads_start_no_task_after_one_was_interrupted(pipe):
+    """run_batch's threads take interleaved tasks as they come free; once a task has seen Ctrl-C,
+    the tasks not yet started run nothing and mark their runs interrupted (a chunk stops within a
+    poll of its running tasks, not of every task)."""
+    threads = 2
+    tasks = batches.TASKS_PER_THREAD * threads
+    n = tasks * (d.POLL_RUNS + 6)  # each task polls once, at its POLL_RUNS-th run
+    seq = [seed_parameters(v=1.0, kappa=k) for k in np.geomspace(1e9, 1e11, n)]
+    batch = pack_batch(seq, as_law("paper"), None, 1e-10)
+    summary = np.full((n, d.N_SUMMARY), -7.0)
+    st = np.empty((3, n, 32))
+    os.write(pipe, b"\x02")
+    batches._run_in_threads((batch.law.code, (batch.C, batch.Y0, batch.t_end, batch.atol, batch.max_step),
+                             (1e-10, True, -1, 0, api.MAX_STEPS, api.MAX_EVENTS, api._stiff_after(True))),
+                            (summary, *st, np.empty(n, np.int64)),
+                            np.zeros((threads, workspace_size(batch.C.shape[1], 32))), n)
+    status = summary[:, d.S_STATUS]
+    task_of = np.arange(n) % tasks
+    ran = status == d.SUCCESS
+    assert np.all(ran | (status == d.INTERRUPTED))  # every run accounted for, none left untouched
+    # only the tasks running when the first poll came (the first one, or the first two on two threads)
+    assert set(task_of[ran]) in ({0}, {1}, {0, 1}) and ran.sum() in (d.POLL_RUNS - 1, 2 * (d.POLL_RUNS - 1))
 
 
 @pytest.mark.parametrize(("signum", "raised"), [(signal.SIGINT, KeyboardInterrupt),
