@@ -8,6 +8,24 @@ import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
 
+#: The files of the suite's long poles, each minutes on two cores: the sdist sample (its unpacked package
+#: compiles cold), the whole-library cold session, the CUDA simulator's grids. ``make test`` runs the files
+#: on pytest-xdist workers, one file per worker at a time (``--dist loadfile``: a module fixture is made
+#: once); these start first, so that no worker is left running one of them at the end.
+LONG_POLES = ("tests/test_packaging.py", "tests/test_precompile.py", "tests/test_cuda.py")
+
+
+def pytest_collection_modifyitems(items):
+    """The files of :data:`LONG_POLES` first, then the files with a slow test, then the rest; each file's
+    tests together and in their order, the files in collection order within each rank."""
+    rank: dict[str, int] = {}
+    for item in items:
+        path = item.nodeid.split("::")[0]
+        own = LONG_POLES.index(path) if path in LONG_POLES else len(LONG_POLES) + (
+            0 if item.get_closest_marker("slow") else 1)
+        rank[path] = min(rank.get(path, own), own)
+    items.sort(key=lambda item: rank[item.nodeid.split("::")[0]])  # stable
+
 
 def build_distribution(kind: str, out: Path) -> Path:
     """``kind`` ("wheel" or "sdist") built from this checkout by setuptools' PEP 517 backend into ``out``."""
