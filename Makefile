@@ -5,6 +5,7 @@ BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 QUICK ?=
 JOBS ?= 2
+TEST_JOBS ?= 2
 
 .PHONY: test test-sdist test-ptx test-numba-range docs reproduce lint benchmarks stress peers clean
 
@@ -17,9 +18,13 @@ $(STAMP): pyproject.toml | $(BIN)/python
 	$(BIN)/python -m pip install --progress-bar on -e ".[test]"
 	touch $(STAMP)
 
+# The engine is compiled into its cache once, in one process (seconds when it is warm), so that the
+# TEST_JOBS pytest-xdist workers never compile the same kernels cold side by side. Each worker runs whole
+# files (loadfile: a module fixture is made once), in tests/conftest.py's order: the long poles first.
 test: $(STAMP)
 	$(BIN)/ruff check .
-	$(BIN)/python -m pytest -q
+	$(BIN)/phaseimpact warmup
+	$(BIN)/python -m pytest -q -n $(TEST_JOBS) --dist loadfile --no-loadscope-reorder
 
 # The documentation site (mkdocs.yml, docs/) into site/; --strict: any warning fails the build
 # (make test builds it too, strict, in tests/test_docs.py, and runs every code block of its pages and the README).

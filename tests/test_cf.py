@@ -288,6 +288,7 @@ def test_to_xarray_written_by_xarray_passes_the_cf_checks(kind, exports, tmp_pat
 
 
 def test_the_trajectory_time_and_the_transitions_kappa_are_coordinates(exports):
+    pytest.importorskip("cf_xarray")  # registers the .cf accessor (an earlier test in this process may not have)
     run = exports["trajectory"]
     assert run.cf.axes == {"T": ["t"]} and run.t.attrs["units"] == "s" and run.force.dims == ("t",)
     found = exports["transitions"]
@@ -297,6 +298,7 @@ def test_the_trajectory_time_and_the_transitions_kappa_are_coordinates(exports):
 
 
 def test_basins_and_orbit_diagrams_name_their_axes(exports):
+    pytest.importorskip("cf_xarray")  # registers the .cf accessor
     assert exports["basins"].cf.axes == {"X": ["x2"], "Y": ["x2dot"]}
     assert exports["orbit-diagram"].cf.axes == {"X": ["kappa"]}
 
