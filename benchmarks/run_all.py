@@ -26,10 +26,10 @@ sys.path.insert(0, str(HERE))
 from _common import FIGURES, RESULTS, emit, load, machine  # noqa: E402
 
 #: In run order: peers (heyoka) before work_precision, which draws its points.
-SCRIPTS = ("startup", "trajectory", "throughput", "critical", "peers", "work_precision", "scene_savings", "stress",
-           "stiff", "atlas", "train", "scale")
-SECTIONS = ("trajectory", "trajectory_against", "throughput", "critical", "startup", "work_precision", "peers",
-            "stiff", "atlas", "scene_savings", "stress", "train", "scale", "gpu")
+SCRIPTS = ("startup", "compile_profile", "trajectory", "throughput", "critical", "peers", "work_precision",
+           "scene_savings", "stress", "stiff", "atlas", "train", "scale")
+SECTIONS = ("trajectory", "trajectory_against", "throughput", "critical", "startup", "compile_profile",
+            "work_precision", "peers", "stiff", "atlas", "scene_savings", "stress", "train", "scale", "gpu")
 #: gpu.py is not in SCRIPTS: it is run on a GPU machine (its section says where it was, or that it was not);
 #: trajectory_against comes from ``trajectory.py --against TREE`` (another checkout), run by hand.
 

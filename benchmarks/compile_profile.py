@@ -1,0 +1,135 @@
+"""Where a user's first compile goes: the engine's first ``simulate`` on an empty cache, broken down
+by numba's event API (``numba.core.event``: one ``numba:compile`` event per compiled function, one
+``numba:llvm_lock`` event per call into LLVM), against numba's own floor for one small function.
+
+A fresh process with ``NUMBA_CACHE_DIR`` pointing to an empty temporary directory imports numba,
+compiles five small stand-alone functions with plain ``numba.njit`` (a 6-line loop each, after one
+to warm numba up: the floor any compiled function pays, whatever it does), then makes the call a
+user's first ``phaseimpact simulate`` makes (Hunt-Crossley, summary) under the listeners. A
+function's own time is its compile event's time less the events nested in it (the functions it
+calls, compiled on first sight, and its LLVM calls); the LLVM time is the sum of the LLVM events.
+What this shows: how much of the first command is numba's fixed cost per function times the
+number of functions the engine compiles, how much is LLVM, and which functions cost the most.
+
+    python benchmarks/compile_profile.py
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import statistics
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from _common import VENV_BIN, emit, load, machine, save_section, table  # noqa: E402
+
+PROBE = r"""
+import json, math, time
+import numba
+import numpy as np
+from numba.core import event
+
+t = time.perf_counter()
+numba.njit(lambda x: x + 1.0)(1.0)
+warm_numba = time.perf_counter() - t
+floor = []
+for i in range(5):  # distinct functions: numba compiles each anew
+    ns = {"math": math}
+    exec(f'''
+def small_{i}(k, h, y, y_new, rtol, atol):
+    acc = 0.0
+    for j in range(6):
+        scale = atol[j] + max(abs(y[j]), abs(y_new[j])) * rtol
+        acc += (k[0, j] * h / scale) ** 2
+    return math.sqrt(acc / 6)
+''', ns)
+    f = numba.njit(ns[f"small_{i}"])
+    a, y = np.ones((16, 6)), np.ones(6)
+    t = time.perf_counter()
+    f(a, 0.1, y, y, 1e-10, y)
+    floor.append(time.perf_counter() - t)
+
+
+class Clock(event.Listener):
+    # one stack for both kinds: a compile's own time excludes what nests in it
+    def __init__(self):
+        self.stack, self.rows = [], []
+
+    def on_start(self, ev):
+        name = getattr(ev.data.get("dispatcher"), "py_func", None) if ev.data else None
+        label = f"{name.__module__}.{name.__qualname__}" if name is not None else ""
+        self.stack.append([ev.kind, label, time.perf_counter(), 0.0])
+
+    def on_end(self, ev):
+        kind, label, start, nested = self.stack.pop()
+        spent = time.perf_counter() - start
+        if self.stack:
+            self.stack[-1][3] += spent
+        self.rows.append((kind, label, spent - nested))
+
+
+from phaseimpact import seed_parameters, simulate
+p = seed_parameters(v=1.0, kappa=3e9)
+clock = Clock()
+t = time.perf_counter()
+with event.install_listener("numba:compile", clock), event.install_listener("numba:llvm_lock", clock):
+    simulate(p, "hunt-crossley", 2e-3)
+total = time.perf_counter() - t
+print(json.dumps({"warm_numba": warm_numba, "floor": floor, "total": total, "rows": clock.rows}))
+"""
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__)
+    ap.add_argument("--quick", action="store_true", help="the same one cold process (for run_all)")
+    ap.parse_args(argv)
+    start_load = load()
+    emit("# Where the first compile goes\n")
+    emit(machine())
+    with tempfile.TemporaryDirectory(prefix="numba-cold-") as cache:
+        env = {**os.environ, "NUMBA_CACHE_DIR": cache}
+        res = subprocess.run([str(VENV_BIN / "python"), "-c", PROBE], env=env, capture_output=True, text=True,
+                             check=True)
+    out = json.loads(res.stdout.strip().splitlines()[-1])
+    compiles = [(label, own) for kind, label, own in out["rows"] if kind == "numba:compile"]
+    llvm = sum(own for kind, _, own in out["rows"] if kind == "numba:llvm_lock")
+    llvm_calls = sum(1 for kind, *_ in out["rows"] if kind == "numba:llvm_lock")
+    numba_own = sum(own for _, own in compiles)
+    floor = statistics.median(out["floor"])
+    by_function: dict[str, list[float]] = {}
+    for label, own in compiles:
+        by_function.setdefault(label.removeprefix("phaseimpact."), []).append(own)
+    top = sorted(by_function.items(), key=lambda kv: -sum(kv[1]))[:12]
+    end_load = load()
+    rows = [("the call (simulate, Hunt-Crossley, on an empty cache)", f"{out['total']:.3g}", ""),
+            ("numba's own work: typing and lowering, summed over the functions", f"{numba_own:.3g}",
+             f"{len(compiles)} compiles of {len(by_function)} functions"),
+            ("LLVM: optimisation and machine code", f"{llvm:.3g}", f"{llvm_calls} calls into LLVM"),
+            ("numba's floor: one small function (plain numba.njit, a 6-line loop), median of 5", f"{floor:.3g}",
+             ", ".join(f"{x:.3f}" for x in out["floor"])),
+            ("the floor times the compiles", f"{floor * len(compiles):.3g}",
+             f"{floor * len(compiles) / out['total']:.0%} of the call"),
+            ("numba's own warm-up (its first compile in a process)", f"{out['warm_numba']:.3g}", "")]
+    repeated = sorted((name, len(owns)) for name, owns in by_function.items() if len(owns) > 1)
+    text = (table(("what", "seconds", "note"), rows)
+            + "\n\nCompiled more than once (once per set of argument types): "
+            + (", ".join(f"`{name}` x{n}" for name, n in repeated) or "none") + "."
+            + "\n\nThe functions with the most own compile time (typing and lowering, without what nests in "
+              "them; LLVM's time is in its own row):\n\n"
+            + table(("function", "own [s]", "compiles"),
+                    [(f"`{name}`", f"{sum(owns):.2f}", len(owns)) for name, owns in top]))
+    emit(f"\n{start_load} at the start, {end_load} at the end.\n")
+    emit(text)
+    save_section("compile_profile",
+                 f"## Where the first compile goes\n\n{machine()}\n\n{start_load} at the start, {end_load} at the "
+                 "end. `python benchmarks/compile_profile.py`\n\n" + text)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
