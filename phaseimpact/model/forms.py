@@ -152,7 +152,7 @@ def _native_partials(code, delta, deltadot, mode, K, damping, alpha):
 
 
 # The branches of the laws added after the first ones call out-of-line kernels (the inlining rule
-# of the module's guide): the steppers' stages inline contact_force and force_partials whole.
+# of the laws module's guide): one line per form here, each law's physics in its own kernel.
 @kernel(python=True)
 def contact_force(code, delta, deltadot, mode, K, damping, alpha):
     """Contact force ``P`` (N, positive pushing the bodies apart) while slipping or free.
