@@ -8,8 +8,9 @@ to warm numba up: the floor any compiled function pays, whatever it does), then 
 user's first ``phaseimpact simulate`` makes (Hunt-Crossley, summary) under the listeners. A
 function's own time is its compile event's time less the events nested in it (the functions it
 calls, compiled on first sight, and its LLVM calls); the LLVM time is the sum of the LLVM events.
-What this shows: how much of the first command is numba's fixed cost per function times the
-number of functions the engine compiles, how much is LLVM, and which functions cost the most.
+What this shows: how much of the first command is numba's own work (typing and lowering) and how
+much LLVM's, how the former compares with numba's fixed cost per function times the number of
+functions the engine compiles, and which functions and modules cost the most.
 
     python benchmarks/compile_profile.py
 """
@@ -34,27 +35,6 @@ import numba
 import numpy as np
 from numba.core import event
 
-t = time.perf_counter()
-numba.njit(lambda x: x + 1.0)(1.0)
-warm_numba = time.perf_counter() - t
-floor = []
-for i in range(5):  # distinct functions: numba compiles each anew
-    ns = {"math": math}
-    exec(f'''
-def small_{i}(k, h, y, y_new, rtol, atol):
-    acc = 0.0
-    for j in range(6):
-        scale = atol[j] + max(abs(y[j]), abs(y_new[j])) * rtol
-        acc += (k[0, j] * h / scale) ** 2
-    return math.sqrt(acc / 6)
-''', ns)
-    f = numba.njit(ns[f"small_{i}"])
-    a, y = np.ones((16, 6)), np.ones(6)
-    t = time.perf_counter()
-    f(a, 0.1, y, y, 1e-10, y)
-    floor.append(time.perf_counter() - t)
-
-
 class Clock(event.Listener):
     # one stack for both kinds: a compile's own time excludes what nests in it
     def __init__(self):
@@ -71,6 +51,29 @@ class Clock(event.Listener):
         if self.stack:
             self.stack[-1][3] += spent
         self.rows.append((kind, label, spent - nested))
+
+
+t = time.perf_counter()
+numba.njit(lambda x: x + 1.0)(1.0)
+warm_numba = time.perf_counter() - t
+floor = []  # (numba's own seconds, LLVM's seconds) of each small function
+for i in range(5):  # distinct functions: numba compiles each anew
+    ns = {"math": math}
+    exec(f'''
+def small_{i}(k, h, y, y_new, rtol, atol):
+    acc = 0.0
+    for j in range(6):
+        scale = atol[j] + max(abs(y[j]), abs(y_new[j])) * rtol
+        acc += (k[0, j] * h / scale) ** 2
+    return math.sqrt(acc / 6)
+''', ns)
+    f = numba.njit(ns[f"small_{i}"])
+    a, y = np.ones((16, 6)), np.ones(6)
+    small = Clock()
+    with event.install_listener("numba:compile", small), event.install_listener("numba:llvm_lock", small):
+        f(a, 0.1, y, y, 1e-10, y)
+    floor.append([sum(own for kind, _, own in small.rows if kind == kind_) for kind_ in
+                  ("numba:compile", "numba:llvm_lock")])
 
 
 from phaseimpact import seed_parameters, simulate
@@ -100,20 +103,28 @@ def main(argv=None) -> int:
     llvm = sum(own for kind, _, own in out["rows"] if kind == "numba:llvm_lock")
     llvm_calls = sum(1 for kind, *_ in out["rows"] if kind == "numba:llvm_lock")
     numba_own = sum(own for _, own in compiles)
-    floor = statistics.median(out["floor"])
+    floor_numba = statistics.median(numba_s for numba_s, _ in out["floor"])
+    floor_llvm = statistics.median(llvm_s for _, llvm_s in out["floor"])
     by_function: dict[str, list[float]] = {}
     for label, own in compiles:
         by_function.setdefault(label.removeprefix("phaseimpact."), []).append(own)
     top = sorted(by_function.items(), key=lambda kv: -sum(kv[1]))[:12]
+    modules: dict[str, list] = {}
+    for name, owns in by_function.items():
+        module = modules.setdefault(name.split(".<locals>")[0].rsplit(".", 1)[0], [0.0, 0])
+        module[0] += sum(owns)
+        module[1] += len(owns)
+    by_module = sorted(modules.items(), key=lambda kv: -kv[1][0])
     end_load = load()
     rows = [("the call (simulate, Hunt-Crossley, on an empty cache)", f"{out['total']:.3g}", ""),
             ("numba's own work: typing and lowering, summed over the functions", f"{numba_own:.3g}",
              f"{len(compiles)} compiles of {len(by_function)} functions"),
             ("LLVM: optimisation and machine code", f"{llvm:.3g}", f"{llvm_calls} calls into LLVM"),
-            ("numba's floor: one small function (plain numba.njit, a 6-line loop), median of 5", f"{floor:.3g}",
-             ", ".join(f"{x:.3f}" for x in out["floor"])),
-            ("the floor times the compiles", f"{floor * len(compiles):.3g}",
-             f"{floor * len(compiles) / out['total']:.0%} of the call"),
+            ("numba's floor: its own work for one small function (plain numba.njit, a 6-line loop), median "
+             "of 5", f"{floor_numba:.3g}", "runs: " + ", ".join(f"{x:.3f}" for x, _ in out["floor"])
+             + f"; LLVM for it (a whole library: optimised and emitted alone) {floor_llvm:.3g} s"),
+            ("numba's floor times the compiles", f"{floor_numba * len(compiles):.3g}",
+             f"{floor_numba * len(compiles) / numba_own:.0%} of numba's own work"),
             ("numba's own warm-up (its first compile in a process)", f"{out['warm_numba']:.3g}", "")]
     repeated = sorted((name, len(owns)) for name, owns in by_function.items() if len(owns) > 1)
     text = (table(("what", "seconds", "note"), rows)
@@ -122,7 +133,11 @@ def main(argv=None) -> int:
             + "\n\nThe functions with the most own compile time (typing and lowering, without what nests in "
               "them; LLVM's time is in its own row):\n\n"
             + table(("function", "own [s]", "compiles"),
-                    [(f"`{name}`", f"{sum(owns):.2f}", len(owns)) for name, owns in top]))
+                    [(f"`{name}`", f"{sum(owns):.2f}", len(owns)) for name, owns in top])
+            + "\n\nBy module (numba's own work; the stiff solver, `integrate.radau5`, is compiled by every first "
+              "command, whether its runs turn stiff or not):\n\n"
+            + table(("module", "own [s]", "compiles"),
+                    [(f"`{name}`", f"{own:.2f}", n) for name, (own, n) in by_module]))
     emit(f"\n{start_load} at the start, {end_load} at the end.\n")
     emit(text)
     save_section("compile_profile",
