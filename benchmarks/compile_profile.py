@@ -59,7 +59,7 @@ class Clock(event.Listener):
 t = time.perf_counter()
 numba.njit(lambda x: x + 1.0)(1.0)
 warm_numba = time.perf_counter() - t
-floor = []  # (numba's own seconds, LLVM's seconds) of each small function
+alone = []  # (numba's own seconds, LLVM's seconds) of each small function
 for i in range(5):  # distinct functions: numba compiles each anew
     ns = {"math": math}
     exec(f'''
@@ -75,7 +75,7 @@ def small_{i}(k, h, y, y_new, rtol, atol):
     small = Clock()
     with event.install_listener("numba:compile", small), event.install_listener("numba:llvm_lock", small):
         f(a, 0.1, y, y, 1e-10, y)
-    floor.append([sum(own for kind, _, own in small.rows if kind == kind_) for kind_ in
+    alone.append([sum(own for kind, _, own in small.rows if kind == kind_) for kind_ in
                   ("numba:compile", "numba:llvm_lock")])
 
 
@@ -86,7 +86,7 @@ t = time.perf_counter()
 with event.install_listener("numba:compile", clock), event.install_listener("numba:llvm_lock", clock):
     simulate(p, "hunt-crossley", 2e-3)
 total = time.perf_counter() - t
-print(json.dumps({"warm_numba": warm_numba, "floor": floor, "total": total, "rows": clock.rows}))
+print(json.dumps({"warm_numba": warm_numba, "alone": alone, "total": total, "rows": clock.rows}))
 """
 
 
@@ -106,17 +106,19 @@ def main(argv=None) -> int:
     llvm = sum(own for kind, _, own in out["rows"] if kind == "numba:llvm_lock")
     llvm_calls = sum(1 for kind, *_ in out["rows"] if kind == "numba:llvm_lock")
     numba_own = sum(own for _, own in compiles)
-    floor_numba = statistics.median(numba_s for numba_s, _ in out["floor"])
-    floor_llvm = statistics.median(llvm_s for _, llvm_s in out["floor"])
-    by_function: dict[str, list[float]] = {}
+    alone_numba = statistics.median(numba_s for numba_s, _ in out["alone"])
+    alone_llvm = statistics.median(llvm_s for _, llvm_s in out["alone"])
+    by_function: dict[str, list[float]] = {}  # a function's own time of each of its compiles
     for label, own in compiles:
         by_function.setdefault(label.removeprefix("phaseimpact."), []).append(own)
-    top = sorted(by_function.items(), key=lambda kv: -sum(kv[1]))[:12]
-    small = [sum(owns) for owns in by_function.values() if sum(owns) < SMALL]
+    own_of = {name: sum(owns) for name, owns in by_function.items()}
+    top = sorted(own_of, key=own_of.get, reverse=True)[:12]
+    top_own = sum(own_of[name] for name in top)
+    small = [own for own in own_of.values() if own < SMALL]
     modules: dict[str, list] = {}
     for name, owns in by_function.items():
         module = modules.setdefault(name.split(".<locals>")[0].rsplit(".", 1)[0], [0.0, 0])
-        module[0] += sum(owns)
+        module[0] += own_of[name]
         module[1] += len(owns)
     by_module = sorted(modules.items(), key=lambda kv: -kv[1][0])
     end_load = load()
@@ -124,14 +126,14 @@ def main(argv=None) -> int:
             ("numba's own work: typing and lowering, summed over the functions", f"{numba_own:.3g}",
              f"{len(compiles)} compiles of {len(by_function)} functions"),
             ("LLVM: optimisation and machine code", f"{llvm:.3g}", f"{llvm_calls} calls into LLVM"),
-            (f"the {len(top)} functions with the most own work (below)", f"{sum(sum(o) for _, o in top):.3g}",
-             f"{sum(sum(o) for _, o in top) / numba_own:.0%} of numba's own work"),
+            (f"the {len(top)} functions with the most own work (below)", f"{top_own:.3g}",
+             f"{top_own / numba_own:.0%} of numba's own work"),
             (f"the {len(small)} functions under {SMALL} s each", f"{sum(small):.3g}",
              f"{sum(small) / numba_own:.0%} of numba's own work"),
             ("a 6-line function compiled alone (plain numba.njit, with its wrapper for calls from Python): "
-             "numba's own work, median of 5", f"{floor_numba:.3g}",
-             "runs: " + ", ".join(f"{x:.3f}" for x, _ in out["floor"])
-             + f"; LLVM for it (a whole library, optimised and emitted alone) {floor_llvm:.3g} s"),
+             "numba's own work, median of 5", f"{alone_numba:.3g}",
+             "runs: " + ", ".join(f"{x:.3f}" for x, _ in out["alone"])
+             + f"; LLVM for it (a whole library, optimised and emitted alone) {alone_llvm:.3g} s"),
             ("numba's own warm-up (its first compile in a process)", f"{out['warm_numba']:.3g}", "")]
     repeated = sorted((name, len(owns)) for name, owns in by_function.items() if len(owns) > 1)
     text = (table(("what", "seconds", "note"), rows)
@@ -140,7 +142,7 @@ def main(argv=None) -> int:
             + "\n\nThe functions with the most own compile time (typing and lowering, without what nests in "
               "them; LLVM's time is in its own row):\n\n"
             + table(("function", "own [s]", "compiles"),
-                    [(f"`{name}`", f"{sum(owns):.2f}", len(owns)) for name, owns in top])
+                    [(f"`{name}`", f"{own_of[name]:.2f}", len(by_function[name])) for name in top])
             + "\n\nBy module (numba's own work; the stiff solver, `integrate.radau5`, is compiled by every first "
               "command, whether its runs turn stiff or not):\n\n"
             + table(("module", "own [s]", "compiles"),
