@@ -293,13 +293,14 @@ def _solve_system(lu, piv, ws, h_over_mu, b):
 
 
 @kernel
-def _norm(ws, row, n_rows, scale_row):
-    """RMS of rows ``row..row+n_rows-1`` of ``ws`` on the scale ``ws[scale_row]``; inf when not finite."""
+def _norm(rows, scale):
+    """RMS of ``rows`` (views of the workspace's rows: one signature for every caller, where row
+    numbers passed as constants compiled a copy per call site) on ``scale``; inf when not finite."""
     acc = 0.0
-    for i in range(n_rows):
+    for i in range(rows.shape[0]):
         for j in range(N_STATE):
-            acc += (ws[row + i, j] / ws[scale_row, j]) ** 2
-    return math.sqrt(acc / (n_rows * N_STATE)) if math.isfinite(acc) else math.inf
+            acc += (rows[i, j] / scale[j]) ** 2
+    return math.sqrt(acc / (rows.shape[0] * N_STATE)) if math.isfinite(acc) else math.inf
 
 
 @kernel
@@ -343,7 +344,7 @@ def _collocation(code, c, mode, side, u, h, newton_tol, stiff):
         for j in range(N_STATE):
             ws[DW_ + 1, j] = zc[j].real
             ws[DW_ + 2, j] = zc[j].imag
-        dw_norm = _norm(ws, DW_, 3, ERR_)
+        dw_norm = _norm(ws[DW_:DW_ + 3], ws[ERR_])
         if dw_norm_old >= 0.0:
             rate = dw_norm / dw_norm_old
         if rate >= 0.0 and (rate >= 1.0 or rate ** (NEWTON_MAXITER - k) / (1.0 - rate) * dw_norm > newton_tol):
@@ -462,7 +463,7 @@ def attempt(code, c, mode, side, s, s_bound, h_abs, stiff, rows):
             ws[SCALE_, j] = ws[ATOL_, j] + max(abs(u[j]), abs(u[j] + z3)) * rtol  # the error's scale
             ws[ERR_, j] = fu[j] + (E1 * ws[Z_, j] + E2 * ws[Z_ + 1, j] + E3 * z3) / h
         _solve_system(stiff[LU_REAL], stiff[PIV][PIV_REAL], ws, h / MU_REAL, ws[ERR_])
-        err = _norm(ws, ERR_, 1, SCALE_)
+        err = _norm(ws[ERR_:ERR_ + 1], ws[SCALE_])
         if rejected and err > 1.0:
             # the estimate after a rejection, filtered once more (Hairer's rule for stiff components)
             tmp, ftmp = stiff[TMP], stiff[FTMP]
@@ -473,7 +474,7 @@ def attempt(code, c, mode, side, s, s_bound, h_abs, stiff, rows):
             for j in range(N_STATE):
                 ws[ERR_, j] = ftmp[j] + (E1 * ws[Z_, j] + E2 * ws[Z_ + 1, j] + E3 * ws[Z_ + 2, j]) / h
             _solve_system(stiff[LU_REAL], stiff[PIV][PIV_REAL], ws, h / MU_REAL, ws[ERR_])
-            err = _norm(ws, ERR_, 1, SCALE_)
+            err = _norm(ws[ERR_:ERR_ + 1], ws[SCALE_])
         if err <= 1.0:
             break
         safety = 0.9 * (2 * NEWTON_MAXITER + 1) / (2 * NEWTON_MAXITER + iterations)
