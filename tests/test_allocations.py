@@ -40,7 +40,7 @@ print(json.dumps({"chunk": batch.PACK_CHUNK, "trajectory": trajectory, "one": al
 
 
 def test_a_sweep_makes_no_numba_allocation():
-    """10 000 runs in 5 chunks of batch.PACK_CHUNK, in one thread or two, make no numba allocation at
+    """10 000 runs in chunks of batch.PACK_CHUNK, in one thread or two, make no numba allocation at
     all: each thread's workspace is one numpy buffer the host makes per chunk, and run_block (a
     kernel: no reference counting) takes it and the batch without numba's runtime (the driver of
     issue 36 made 32 per thread and chunk: the workspace's 22 arrays and the 10 it was handed; the

@@ -131,7 +131,7 @@ def test_threads_start_no_task_after_one_was_interrupted(pipe):
     poll of its running tasks, not of every task)."""
     threads = 2
     tasks = batches.TASKS_PER_THREAD * threads
-    n = tasks * (d.POLL_RUNS + 6)  # each task polls once, at its POLL_RUNS-th run
+    n = 2 * tasks * (d.POLL_RUNS + 6)  # each of the first tasks polls once, at its POLL_RUNS-th run
     seq = [seed_parameters(v=1.0, kappa=k) for k in np.geomspace(1e9, 1e11, n)]
     batch = pack_batch(seq, as_law("paper"), None, 1e-10)
     summary = np.full((n, d.N_SUMMARY), -7.0)
@@ -142,11 +142,28 @@ def test_threads_start_no_task_after_one_was_interrupted(pipe):
                             (summary, *st, np.empty(n, np.int64)),
                             np.zeros((threads, workspace_size(batch.C.shape[1], 32))), n)
     status = summary[:, d.S_STATUS]
-    task_of = np.arange(n) % tasks
     ran = status == d.SUCCESS
     assert np.all(ran | (status == d.INTERRUPTED))  # every run accounted for, none left untouched
-    # only the tasks running when the first poll came (the first one, or the first two on two threads)
-    assert set(task_of[ran]) in ({0}, {1}, {0, 1}) and ran.sum() in (d.POLL_RUNS - 1, 2 * (d.POLL_RUNS - 1))
+    # only the tasks running when the first poll came (the first one, or the first two on two
+    # threads): runs j, j + tasks, ... of the chunk's first part, before the smaller tasks of its end
+    head = n - n // batches.TAIL_SHARE
+    runs = np.flatnonzero(ran)
+    assert runs.max() < head
+    assert set(runs % tasks) in ({0}, {1}, {0, 1}) and ran.sum() in (d.POLL_RUNS - 1, 2 * (d.POLL_RUNS - 1))
+
+
+@pytest.mark.parametrize(("n", "threads"), [(1, 2), (7, 2), (100, 2), (600, 2), (4096, 2), (8000, 2), (2000, 16),
+                                            (4096, 16)])
+def test_threads_take_every_run_once_and_the_chunks_end_in_small_tasks(n, threads):
+    """thread_tasks: every run in exactly one task; no task of the chunk's end larger than one of
+    its start (the task that finishes a chunk, alone on the cores, is short)."""
+    tasks = batches.thread_tasks(n, threads)
+    runs = np.concatenate([np.arange(*t) for t in tasks])
+    assert np.array_equal(np.sort(runs), np.arange(n))
+    sizes = [len(range(*t)) for t in tasks]
+    assert sizes[-1] <= sizes[0]
+    if n >= 4096 and threads == 2:  # a chunk of a sweep on two threads: 112 or more runs a task
+        assert 4 * sizes[-1] <= sizes[0]
 
 
 @pytest.mark.parametrize(("signum", "raised"), [(signal.SIGINT, KeyboardInterrupt),

@@ -71,7 +71,9 @@ class Batch:
 #: Where :func:`simulate_many` runs: threads of this process, or a GPU (:mod:`phaseimpact.cuda`).
 SIMULATE_MANY_BACKENDS = ("threads", "cuda")
 #: Runs packed at a time by :func:`simulate_many` (any size gives the same numbers: runs are independent).
-PACK_CHUNK = 2048
+#: Each chunk's end leaves threads idle (its last task, the hand-off from the packer), so chunks are
+#: large; a chunk's batch and columns take about 10 MB.
+PACK_CHUNK = 8192
 
 
 def pack_batch(params_seq, law: ContactLaw, t_end, rtol: float, initial=None) -> Batch:
@@ -207,33 +209,56 @@ def run_batch(batch: Batch, *, rtol: float, settle: bool = True, stop_on=None, n
 #: that finishes one takes the next: a thread slowed by another (simulate_many's packer shares the
 #: cores) no longer leaves the others idle at the chunk's end for up to a third of the chunk.
 TASKS_PER_THREAD = 16
+#: The chunk's last runs (this share of them) go in tasks of their own, smaller, taken last: the task
+#: that finishes the chunk, running while the other threads are idle, is short. (One size for all
+#: left the threads idle for half a task each at the end of every chunk: 1.6 % of two threads'
+#: time, more on many.)
+TAIL_SHARE = 8
+#: Fewest runs in one of those small tasks: a task costs a few tens of µs of Python to start.
+MIN_TAIL_TASK_RUNS = 8
+
+
+def thread_tasks(n: int, threads: int) -> list[tuple[int, int, int]]:
+    """How :func:`_run_in_threads` cuts ``n`` runs: ``(start, stop, step)`` of each task, every
+    ``step``-th run of ``[start, stop)``, in the order the threads take them. :data:`TASKS_PER_THREAD`
+    interleaved tasks a thread over the first runs, then the last ``n // TAIL_SHARE`` runs in up to as
+    many smaller ones (of at least :data:`MIN_TAIL_TASK_RUNS` runs); all runs in the first kind when
+    the smaller would not be smaller."""
+    tasks = min(n, TASKS_PER_THREAD * threads)
+    tail = n // TAIL_SHARE
+    tail_tasks = min(tasks, tail // MIN_TAIL_TASK_RUNS)
+    if tail_tasks == 0 or tail / tail_tasks >= (n - tail) / tasks:
+        return [(j, n, tasks) for j in range(tasks)]
+    head = n - tail
+    return [(j, head, tasks) for j in range(tasks)] + [(head + j, n, tail_tasks) for j in range(tail_tasks)]
 
 
 def _run_in_threads(args: tuple, outputs: tuple, work: np.ndarray, n: int) -> None:
     """:func:`~.driver.run_block` over ``len(work)`` threads (the driver releases the GIL), in
-    interleaved tasks taken as threads come free, each in a workspace no running task holds."""
+    interleaved tasks (:func:`thread_tasks`) taken as threads come free, each in a workspace no
+    running task holds."""
     threads = len(work)
-    tasks = min(n, TASKS_PER_THREAD * threads)
     free = queue.SimpleQueue()  # at most ``threads`` tasks run at once, so one is always free
     for k in range(threads):
         free.put(work[k])
     status = outputs[d.O_SUMMARY][:, d.S_STATUS]
     stopped = threading.Event()
 
-    def task(j: int) -> None:
+    def task(runs: tuple[int, int, int]) -> None:
+        start, stop, step = runs
         if stopped.is_set():  # Ctrl-C or SIGTERM seen by an earlier task: the rest is not started
-            status[j::tasks] = d.INTERRUPTED
+            status[start:stop:step] = d.INTERRUPTED
             return
         ws = free.get()
         try:
-            d.run_block(*args, j, n, tasks, outputs, ws)
+            d.run_block(*args, start, stop, step, outputs, ws)
         finally:
             free.put(ws)
-        if np.any(status[j::tasks] == d.INTERRUPTED):
+        if np.any(status[start:stop:step] == d.INTERRUPTED):
             stopped.set()
 
     with ThreadPoolExecutor(threads) as pool:
-        list(pool.map(task, range(tasks)))
+        list(pool.map(task, thread_tasks(n, threads)))
 
 
 def _run_one(batch: Batch, i: int, rtol, settle, stop_kind, stop_count, stiff_after, native):
