@@ -7,9 +7,9 @@ Efficiency at ``n`` workers is ``T(1) / (n T(n))``; the serial fraction is Karp 
 Seed case, rtol 1e-10, each run until its outcome settles: a ``paper`` sweep of ``N`` kappa in
 [1e8, 1e13], a ``paper`` atlas over (kappa, v), a ``hunt-crossley`` ``simulate_many`` of ``N``
 ``Parameters``, and the same cases packed beforehand and run in one ``run_batch`` call (the
-engine's threads without simulate_many's packing and chunks: where its time goes). The worker counts are 1, 2, 4, ... up to the machine's cores; the contenders take
-turns within each repeat, and every parallel result is checked bit for bit against the
-one-worker result.
+engine's threads without simulate_many's packing and chunks: where its time goes). The worker
+counts are 1, 2, 4, ... up to the machine's cores; the contenders take turns within each repeat,
+and every parallel result is checked bit for bit against the one-worker result.
 
 On a shared machine the speed of one core drifts by tens of per cent from minute to minute, so a
 ratio of two medians taken minutes apart measures the drift as much as the scaling. Each repeat

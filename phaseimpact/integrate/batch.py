@@ -209,8 +209,8 @@ def run_batch(batch: Batch, *, rtol: float, settle: bool = True, stop_on=None, n
 #: that finishes one takes the next: a thread slowed by another (simulate_many's packer shares the
 #: cores) no longer leaves the others idle at the chunk's end for up to a third of the chunk.
 TASKS_PER_THREAD = 16
-#: The chunk's last runs (this share of them) go in tasks of their own, smaller, taken last: the task
-#: that finishes the chunk, running while the other threads are idle, is short. (One size for all
+#: The chunk's last ``1 / TAIL_SHARE`` of its runs go in tasks of their own, smaller, taken last: the
+#: task that finishes the chunk, running while the other threads are idle, is short. (One size for all
 #: left the threads idle for half a task each at the end of every chunk: 1.6 % of two threads'
 #: time, more on many.)
 TAIL_SHARE = 8
