@@ -1,17 +1,17 @@
 """Where a user's first compile goes: the engine's first ``simulate`` on an empty cache, broken down
 by numba's event API (``numba.core.event``: one ``numba:compile`` event per compiled function, one
-``numba:llvm_lock`` event per call into LLVM), beside numba's own work for one small function compiled
-alone.
+``numba:llvm_lock`` event per call into LLVM, one ``numba:run_pass`` event per compiler pass),
+beside numba's own work for one small function compiled alone.
 
 A fresh process with ``NUMBA_CACHE_DIR`` pointing to an empty temporary directory imports numba,
 compiles five small stand-alone functions with plain ``numba.njit`` (a 6-line loop each, after one
-to warm numba up), then makes the call a
-user's first ``phaseimpact simulate`` makes (Hunt-Crossley, summary) under the listeners. A
-function's own time is its compile event's time less the events nested in it (the functions it
-calls, compiled on first sight, and its LLVM calls); the LLVM time is the sum of the LLVM events.
-What this shows: how much of the first command is numba's own work (typing and lowering) and how
-much LLVM's, whether numba's work is in the many small functions or the few large ones, and which
-functions and modules cost the most.
+to warm numba up), then makes the call a user's first ``phaseimpact simulate`` makes
+(Hunt-Crossley, summary) under the listeners. A function's own time is its compile event's time
+less the events nested in it (the functions it calls, compiled on first sight, and its LLVM calls);
+the LLVM time is the sum of the LLVM events; a pass's own time likewise excludes the compiles and
+LLVM calls nested in it. What this shows: how much of the first command is numba's own work (typing
+and lowering) and how much LLVM's, which of numba's compiler passes take it, whether numba's work is
+in the many small functions or the few large ones, and which functions and modules cost the most.
 
     python benchmarks/compile_profile.py
 """
@@ -31,6 +31,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from _common import VENV_BIN, emit, load, machine, save_section, table  # noqa: E402
 
 SMALL = 0.3  # s: a function "small" in the breakdown
+PASSES = 8  # compiler passes named in the breakdown
 
 PROBE = r"""
 import json, math, time
@@ -54,6 +55,25 @@ class Clock(event.Listener):
         if self.stack:
             self.stack[-1][3] += spent
         self.rows.append((kind, label, spent - nested))
+
+
+class PassClock(event.Listener):
+    # numba's compiler passes (typing, lowering, ...): a pass's own time excludes the compiles and
+    # the LLVM calls that nest in it (a callee compiled while its caller is typed, LLVM in lowering)
+    def __init__(self):
+        self.stack, self.own = [], {}
+
+    def on_start(self, ev):
+        name = ev.data["name"].split(" [")[0] if ev.kind == "numba:run_pass" else None
+        self.stack.append([name, time.perf_counter(), 0.0])
+
+    def on_end(self, ev):
+        name, start, nested = self.stack.pop()
+        spent = time.perf_counter() - start
+        if self.stack:
+            self.stack[-1][2] += spent
+        if name is not None:
+            self.own[name] = self.own.get(name, 0.0) + spent - nested
 
 
 t = time.perf_counter()
@@ -81,12 +101,15 @@ def small_{i}(k, h, y, y_new, rtol, atol):
 
 from phaseimpact import seed_parameters, simulate
 p = seed_parameters(v=1.0, kappa=3e9)
-clock = Clock()
+clock, passes = Clock(), PassClock()
 t = time.perf_counter()
-with event.install_listener("numba:compile", clock), event.install_listener("numba:llvm_lock", clock):
+with event.install_listener("numba:compile", clock), event.install_listener("numba:llvm_lock", clock), \
+        event.install_listener("numba:compile", passes), event.install_listener("numba:llvm_lock", passes), \
+        event.install_listener("numba:run_pass", passes):
     simulate(p, "hunt-crossley", 2e-3)
 total = time.perf_counter() - t
-print(json.dumps({"warm_numba": warm_numba, "alone": alone, "total": total, "rows": clock.rows}))
+print(json.dumps({"warm_numba": warm_numba, "alone": alone, "total": total, "rows": clock.rows,
+                  "passes": passes.own}))
 """
 
 
@@ -136,6 +159,13 @@ def main(argv=None) -> int:
              + f"; LLVM for it (a whole library, optimised and emitted alone) {alone_llvm:.3g} s"),
             ("numba's own warm-up (its first compile in a process)", f"{out['warm_numba']:.3g}", "")]
     repeated = sorted((name, len(owns)) for name, owns in by_function.items() if len(owns) > 1)
+    passes = sorted(out["passes"].items(), key=lambda kv: -kv[1])
+    in_passes = sum(own for _, own in passes)
+    pass_rows = [(f"`{name}`", f"{own:.2f}", f"{own / numba_own:.0%}") for name, own in passes[:PASSES]]
+    others = in_passes - sum(own for _, own in passes[:PASSES])
+    pass_rows.append((f"the other {len(passes) - PASSES} passes", f"{others:.2f}", f"{others / numba_own:.0%}"))
+    pass_rows.append(("outside the passes (the dispatcher, caching the compiled code)",
+                      f"{numba_own - in_passes:.2f}", f"{(numba_own - in_passes) / numba_own:.0%}"))
     text = (table(("what", "seconds", "note"), rows)
             + "\n\nCompiled more than once (once per set of argument types): "
             + (", ".join(f"`{name}` x{n}" for name, n in repeated) or "none") + "."
@@ -143,6 +173,9 @@ def main(argv=None) -> int:
               "them; LLVM's time is in its own row):\n\n"
             + table(("function", "own [s]", "compiles"),
                     [(f"`{name}`", f"{own_of[name]:.2f}", len(by_function[name])) for name in top])
+            + "\n\nBy compiler pass (numba's `numba:run_pass` events; a pass's own time, without the compiles "
+              "and the LLVM calls nested in it; shares of numba's own work):\n\n"
+            + table(("pass", "own [s]", "share"), pass_rows)
             + "\n\nBy module (numba's own work; the stiff solver, `integrate.radau5`, is compiled by every first "
               "command, whether its runs turn stiff or not):\n\n"
             + table(("module", "own [s]", "compiles"),
