@@ -40,13 +40,17 @@ import numpy as np
 from numba.core import event
 
 class Clock(event.Listener):
-    # one stack for both kinds: a compile's own time excludes what nests in it
+    # one stack for every kind it listens to: an event's own time excludes what nests in it (a
+    # callee compiled while its caller is typed, the LLVM calls of lowering, a compile's passes)
     def __init__(self):
         self.stack, self.rows = [], []
 
     def on_start(self, ev):
-        name = getattr(ev.data.get("dispatcher"), "py_func", None) if ev.data else None
-        label = f"{name.__module__}.{name.__qualname__}" if name is not None else ""
+        if ev.kind == "numba:run_pass":
+            label = ev.data["name"].split(" [")[0]
+        else:
+            name = getattr(ev.data.get("dispatcher"), "py_func", None) if ev.data else None
+            label = f"{name.__module__}.{name.__qualname__}" if name is not None else ""
         self.stack.append([ev.kind, label, time.perf_counter(), 0.0])
 
     def on_end(self, ev):
@@ -55,25 +59,6 @@ class Clock(event.Listener):
         if self.stack:
             self.stack[-1][3] += spent
         self.rows.append((kind, label, spent - nested))
-
-
-class PassClock(event.Listener):
-    # numba's compiler passes (typing, lowering, ...): a pass's own time excludes the compiles and
-    # the LLVM calls that nest in it (a callee compiled while its caller is typed, LLVM in lowering)
-    def __init__(self):
-        self.stack, self.own = [], {}
-
-    def on_start(self, ev):
-        name = ev.data["name"].split(" [")[0] if ev.kind == "numba:run_pass" else None
-        self.stack.append([name, time.perf_counter(), 0.0])
-
-    def on_end(self, ev):
-        name, start, nested = self.stack.pop()
-        spent = time.perf_counter() - start
-        if self.stack:
-            self.stack[-1][2] += spent
-        if name is not None:
-            self.own[name] = self.own.get(name, 0.0) + spent - nested
 
 
 t = time.perf_counter()
@@ -101,7 +86,7 @@ def small_{i}(k, h, y, y_new, rtol, atol):
 
 from phaseimpact import seed_parameters, simulate
 p = seed_parameters(v=1.0, kappa=3e9)
-clock, passes = Clock(), PassClock()
+clock, passes = Clock(), Clock()  # compiles less what nests in them; passes less what nests in them
 t = time.perf_counter()
 with event.install_listener("numba:compile", clock), event.install_listener("numba:llvm_lock", clock), \
         event.install_listener("numba:compile", passes), event.install_listener("numba:llvm_lock", passes), \
@@ -109,7 +94,7 @@ with event.install_listener("numba:compile", clock), event.install_listener("num
     simulate(p, "hunt-crossley", 2e-3)
 total = time.perf_counter() - t
 print(json.dumps({"warm_numba": warm_numba, "alone": alone, "total": total, "rows": clock.rows,
-                  "passes": passes.own}))
+                  "passes": [(label, own) for kind, label, own in passes.rows if kind == "numba:run_pass"]}))
 """
 
 
@@ -159,7 +144,10 @@ def main(argv=None) -> int:
              + f"; LLVM for it (a whole library, optimised and emitted alone) {alone_llvm:.3g} s"),
             ("numba's own warm-up (its first compile in a process)", f"{out['warm_numba']:.3g}", "")]
     repeated = sorted((name, len(owns)) for name, owns in by_function.items() if len(owns) > 1)
-    passes = sorted(out["passes"].items(), key=lambda kv: -kv[1])
+    pass_own: dict[str, float] = {}
+    for name, own in out["passes"]:
+        pass_own[name] = pass_own.get(name, 0.0) + own
+    passes = sorted(pass_own.items(), key=lambda kv: -kv[1])
     in_passes = sum(own for _, own in passes)
     pass_rows = [(f"`{name}`", f"{own:.2f}", f"{own / numba_own:.0%}") for name, own in passes[:PASSES]]
     others = in_passes - sum(own for _, own in passes[:PASSES])
