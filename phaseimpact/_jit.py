@@ -27,6 +27,13 @@ function Python code calls (the entries ``run``, ``run_block`` and ``run_rk4``, 
 ``tests/test_integrate.py`` finds every call from Python in the package, tests, benchmarks and
 studies and checks that its target has the wrapper.
 
+A small kernel the hot loops call says ``forceinline=True``: numba gives its LLVM function the
+``alwaysinline`` attribute, and LLVM inlines it into every caller after optimising it once. Numba's
+own inlining (``inline="always"``) types and lowers the function again inside each caller: for the
+same machine code (the run loop's assembly is identical either way), a first compile took about
+1.2x as long. It is left to :func:`.integrate.record.carve` and :func:`.integrate.radau5.carve`, the two kernels that
+return views: typed in each caller, their views are the caller's own.
+
 Numba is imported only when something is compiled. Until then (``phaseimpact cases``, ``params``,
 building a case: they import the laws but integrate nothing) a decorated function is a
 :class:`_Deferred` placeholder; the first use of one, or the first decoration once numba is
@@ -590,9 +597,10 @@ def _compile_pending() -> None:
 
 
 def _compiler(reference_counted: bool):
-    def decorate(function=None, *, python: bool = False, inline: str = "never", nogil: bool = False):
-        options = dict(_nrt=reference_counted, inline=inline, nogil=nogil, no_cpython_wrapper=not python,
-                       no_cfunc_wrapper=True)
+    def decorate(function=None, *, python: bool = False, forceinline: bool = False, inline: str = "never",
+                 nogil: bool = False):
+        options = dict(_nrt=reference_counted, forceinline=forceinline, inline=inline, nogil=nogil,
+                       no_cpython_wrapper=not python, no_cfunc_wrapper=True)
 
         def compile_(f):
             if "numba" in sys.modules:  # numba's import is paid: compile-ready functions, placeholders too
@@ -605,7 +613,7 @@ def _compiler(reference_counted: bool):
     return decorate
 
 
-#: ``@kernel``, ``@kernel(inline="always")``, ``@kernel(python=True)``: a compiled helper that
+#: ``@kernel``, ``@kernel(forceinline=True)``, ``@kernel(python=True)``: a compiled helper that
 #: allocates nothing.
 kernel = _compiler(reference_counted=False)
 #: ``@allocating``, ``@allocating(python=True, nogil=True)``: a compiled function that creates arrays.

@@ -66,7 +66,7 @@ def jacobi(u, m, out):
         _jacobi_landen(u, m, out)
 
 
-@kernel(inline="always")
+@kernel(forceinline=True)
 def _jacobi_near_zero(u, m, out):
     """:func:`jacobi` for ``0 <= m < 1e-9``: A&S 16.13, first order in ``m``."""
     t = math.sin(u)
@@ -78,7 +78,7 @@ def _jacobi_near_zero(u, m, out):
     out[3] = u - ai
 
 
-@kernel(inline="always")
+@kernel(forceinline=True)
 def _jacobi_near_one(u, m, out):
     """:func:`jacobi` for ``1 - 1e-10 <= m <= 1``: A&S 16.15, first order in ``1 - m``."""
     if abs(u) > 709.0:  # cosh, sinh, exp overflow (Python's math raises): NaN, as scipy's mostly is
@@ -96,7 +96,7 @@ def _jacobi_near_one(u, m, out):
     out[2] = phi + ai * (twon + u)
 
 
-@kernel(inline="always")
+@kernel(forceinline=True)
 def _jacobi_landen(u, m, out):
     """:func:`jacobi` for ``1e-9 <= m < 1 - 1e-10``: the AGM's descending Landen transformation and
     the backward recurrence for the amplitude."""
@@ -164,7 +164,7 @@ def _jacobi_landen(u, m, out):
     out[3] = phi
 
 
-@kernel(inline="always")
+@kernel(forceinline=True)
 def _delta_amplitude(m, sn, cn, phi, previous):
     """:func:`jacobi`'s ``dn`` from the Landen branch's ``sn, cn``, its amplitude ``phi`` (``phi_0``)
     and that of the first level, ``previous`` (``phi_1``)."""

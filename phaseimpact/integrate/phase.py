@@ -92,7 +92,7 @@ def integration_state(code, mode, side, y, t, u):
     u[TIME] = t
 
 
-@kernel(inline="always")  # in the root finders' loops: a call costs more than it
+@kernel(forceinline=True)  # in the root finders' loops: a call costs more than it
 def dense(c, side, F, u0, s0, h, s, out):
     """The integration state at ``s`` inside the step ``[s0, s0 + h]`` from ``u0``: the flight's
     closed form, or the interpolant ``F`` of the step (:func:`_interpolant`)."""
@@ -131,9 +131,9 @@ def phase_events(code, c, mode, side, energy_limit, u, y, f, force, g):
         g[DELTADOT] = u[V1]  # as integrated: x1dot - x2dot of the physical state has lost its digits
 
 
-# inlined at numba level: the root finders call it ten times an event, and a call passes the whole
+# always inlined: the root finders call it ten times an event, and a call passes the whole
 # workspace (a tuple of ~20 arrays, ~170 machine words): 6-8 % of a run (benchmarks/trajectory.py --against)
-@kernel(inline="always")
+@kernel(forceinline=True)
 def event_at(code, ws, column, target, s):
     """Event function ``column`` at ``s`` on the dense output of the run's step (``R_S``, ``R_H``
     from row ``U_U``, interpolant ``U_DENSE``); the pseudo column ``TIME_COLUMN`` is the physical
@@ -158,9 +158,9 @@ def event_at(code, ws, column, target, s):
     return event_value(code, c, ys, fs, force, mode, ws[W_REAL][R_ENERGY_LIMIT], column)
 
 
-# inlined at numba level, like the two below: with their flight branch LLVM stopped inlining
-# these small dispatchers into the run, which cost runs without a flight 5-9 %
-@kernel(inline="always")
+# always inlined, like the two below: with their flight branch LLVM's own heuristics stopped
+# inlining these small dispatchers into the run, which cost runs without a flight 5-9 %
+@kernel(forceinline=True)
 def fresh_step(code, ws, h, u_new, fu_new):
     """A step of exactly ``h`` from the run's state (``R_S``, row ``U_U``) with the phase's current
     method into ``u_new``, ``fu_new`` (the state at a root, a stop or the horizon); returns the

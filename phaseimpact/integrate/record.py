@@ -74,7 +74,7 @@ N_FIXED = (radau5.WORKSPACE_SIZE + N_REAL + N_INT + N_ATOL + N_Y_ROWS * 5 + N_G_
 Y_AT = radau5.WORKSPACE_SIZE + N_REAL + N_INT + N_ATOL
 
 
-@kernel(python=True, inline="always")
+@kernel(python=True, forceinline=True)
 def workspace_size(n_coef, capacity):
     """The float64 numbers of a workspace for ``n_coef`` coefficients and ``capacity`` stick points
     (even: consecutive workspaces in one array keep Radau's complex members aligned)."""

@@ -58,7 +58,7 @@ RK_F, RK_TMP, RK_Y_NEW, RK_F_NEW, RK_K = range(5)
 N_RK_ROWS = RK_K + 4
 
 
-@kernel(inline="always")  # the loop's own arithmetic
+@kernel(forceinline=True)  # the loop's own arithmetic
 def _rk4_step(code, c, y, mode, h, rows):
     """One classic RK4 step of ``h`` from ``y`` into row ``RK_Y_NEW``; returns whether it is finite."""
     tmp, y_new, k1, k2, k3, k4 = rows[RK_TMP], rows[RK_Y_NEW], rows[RK_K], rows[RK_K + 1], rows[RK_K + 2], \

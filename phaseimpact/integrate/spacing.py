@@ -13,7 +13,7 @@ __all__ = ["ulp_above"]
 _SMALLEST = 5e-324
 
 
-@kernel(inline="always", python=True)
+@kernel(forceinline=True, python=True)
 def ulp_above(s):
     """``np.nextafter(s, inf) - s`` for a finite ``s``, bit for bit (``tests/test_cuda.py``)."""
     if s == 0.0:  # frexp gives no exponent for zero

@@ -147,7 +147,7 @@ def quiet_start(quiet, y, mode, g):
         g[quiet] = departure_sign(quiet, y, mode) * _TINY
 
 
-@kernel(inline="always")  # the hot loop's own code: a call costs more than it
+@kernel(forceinline=True)  # the hot loop's own code: a call costs more than it
 def _dop853_attempt(code, ws, s, s_bound, h_abs):
     """One accepted DOP853 step from ``(s, u)`` (row ``U_U``; at most to ``s_bound``) into rows
     ``U_NEW``, ``U_FU_NEW``, first try ``h_abs``.
@@ -266,7 +266,7 @@ def advance(code, ws, next_sample, steps_left):
     return ADV_END, steps, evaluations
 
 
-@kernel(inline="always")  # the hot loop's own code, like the two below
+@kernel(forceinline=True)  # the hot loop's own code, like the two below
 def _flight_attempt(code, ws, s, s_bound, h_abs):
     """A flight's step (closed form, the flight's invariants in rows ``U_STAGES``), as
     :func:`_dop853_attempt` returns it: to ``s_bound`` at once when no event can happen any more
@@ -283,7 +283,7 @@ def _flight_attempt(code, ws, s, s_bound, h_abs):
     return True, s_new, flight_step, force_new, 0
 
 
-@kernel(inline="always")
+@kernel(forceinline=True)
 def _step_end(code, ws, s_new, force_new):
     """The physical state and rate at a step's end (rows ``Y_NEW``, ``Y_F_NEW`` from ``U_NEW``,
     ``U_FU_NEW``); returns ``(force, evaluations)``."""
@@ -302,14 +302,14 @@ def _step_end(code, ws, s_new, force_new):
     return force_new, 0
 
 
-@kernel(inline="always")
+@kernel(forceinline=True)
 def _advanced(real, s, h, h_abs, h_next, force, force_new):
     """Where :func:`advance` stands, into the run's record."""
     real[R_S], real[R_H], real[R_H_ABS], real[R_H_NEXT], real[R_FORCE], real[R_FORCE_NEW] = (
         s, h, h_abs, h_next, force, force_new)
 
 
-@kernel(inline="always")
+@kernel(forceinline=True)
 def phase_step(code, ws):
     """Initial step of the run's phase (scipy's rule; the record's mode and side, rows ``U_U``,
     ``U_FU``, ``U_ATOL``), in its own independent variable."""
@@ -457,9 +457,9 @@ def restart(code, ws, column, s_restart):
     return kind, action, t
 
 
-# inlined at numba level, like fresh_step: with their flight branch LLVM stopped inlining these
-# small dispatchers into the run, which cost runs without a flight 5-9 %
-@kernel(inline="always")
+# always inlined, like fresh_step: with their flight branch LLVM's own heuristics stopped inlining
+# these small dispatchers into the run, which cost runs without a flight 5-9 %
+@kernel(forceinline=True)
 def step_interpolant(code, ws):
     """The interpolant of the step :func:`advance` left into rows ``U_DENSE`` (a flight's
     invariants, see :func:`~.phase.dense`); returns the evaluations spent."""

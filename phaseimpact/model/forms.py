@@ -72,7 +72,7 @@ def make_code(form: int, flags: int, address: int = 0) -> int:
     return (address << ADDRESS_SHIFT) | (form << FORM_SHIFT) | flags
 
 
-@kernel(python=True, inline="always")
+@kernel(python=True, forceinline=True)
 def hertz_power(ad, alpha):
     """``ad**alpha`` for ``ad >= 0``; Hertz's 3/2 as the cheaper ``ad*sqrt(ad)``."""
     if alpha == 1.5:
@@ -80,7 +80,7 @@ def hertz_power(ad, alpha):
     return ad**alpha
 
 
-@kernel(inline="always")
+@kernel(forceinline=True)
 def _root(ad, alpha):
     """``ad**(alpha - 1)`` for ``ad >= 0``; ``sqrt(ad)`` for Hertz's 3/2."""
     if alpha == 1.5:
@@ -93,13 +93,13 @@ def _sign(x):
     return 1.0 if x > 0 else (-1.0 if x < 0 else 0.0)
 
 
-@kernel(python=True, inline="always")
+@kernel(python=True, forceinline=True)
 def is_filippov(code):
     """Whether the law's sign factor needs stick/slip modes (flag :data:`FILIPPOV`)."""
     return (code & FILIPPOV) != 0
 
 
-@kernel(python=True, inline="always")
+@kernel(python=True, forceinline=True)
 def is_unilateral(code):
     """Whether the law acts only while ``delta > 0`` (flag :data:`UNILATERAL`)."""
     return (code & UNILATERAL) != 0
@@ -228,13 +228,13 @@ def contact_potential(code, delta, K, alpha):
     return math.nan
 
 
-@kernel(python=True, inline="always")
+@kernel(python=True, forceinline=True)
 def has_memory(code):
     """Whether the law keeps state over a run (flag :data:`MEMORY`, set from :attr:`LawEntry.memory`)."""
     return (code & MEMORY) != 0
 
 
-@kernel(python=True, inline="always")
+@kernel(python=True, forceinline=True)
 def contact_gap(code, c, x1, x2):
     """How far the bodies at ``x1``, ``x2`` are from touching (m): the indentation ``x1 - x2``, or for
     a law with memory ``x1 - (x2 + delta_p)``, past the residual indentation ``delta_p`` of its dent:
@@ -249,7 +249,7 @@ def contact_gap(code, c, x1, x2):
     return x1 - x2
 
 
-@kernel(python=True, inline="always")
+@kernel(python=True, forceinline=True)
 def dent_depth(code, c):
     """The residual indentation ``delta_p`` of a law with memory, m (0 for other laws, and before the
     first yield): where :func:`contact_gap` is zero."""
@@ -323,7 +323,7 @@ def remember(code, c, delta):
     return False
 
 
-@kernel(python=True, inline="always")
+@kernel(python=True, forceinline=True)
 def force_of(code, c, delta, deltadot, mode):
     """The contact force of a run with packed coefficients ``c`` (what the engine calls): the
     law's :func:`contact_force`, or a law with memory read from ``c`` (its form's memory branch;
@@ -335,7 +335,7 @@ def force_of(code, c, delta, deltadot, mode):
     return contact_force(code, delta, deltadot, mode, c[K_], c[DAMP_], c[ALPHA_])
 
 
-@kernel(python=True, inline="always")
+@kernel(python=True, forceinline=True)
 def partials_of(code, c, delta, deltadot, mode):
     """``(dP/ddelta, dP/ddeltadot)`` of :func:`force_of`."""
     if has_memory(code):
@@ -354,7 +354,7 @@ def potential_of(code, c, delta):
     return contact_potential(code, delta, c[K_], c[ALPHA_])
 
 
-@kernel(python=True, inline="always")  # read at every step of a stick (the stick-break event)
+@kernel(python=True, forceinline=True)  # read at every step of a stick (the stick-break event)
 def stick_bound(code, delta, K, damping, alpha):
     """The largest force a stuck Filippov contact gives at ``delta`` (N): ``|P(delta, 0)|``, the
     law's force at rest (``paper``: its elastic term ``K |delta|^alpha``). The stick holds while

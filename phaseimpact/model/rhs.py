@@ -189,7 +189,7 @@ def contact_side(code, c, y, mode):
     return side
 
 
-@kernel(python=True, inline="always")
+@kernel(python=True, forceinline=True)
 def relative_slip(code, mode, side):
     """Whether a phase integrates ``deltadot`` in place of ``x1dot`` (slot ``V1`` of ``u``): the
     slips of a Filippov law. Near the critical damping a slip's relative speed is 1e-7 to 1e-12 of
@@ -277,7 +277,7 @@ def rhs(code, c, y, mode, out):
     return force
 
 
-@kernel(python=True, inline="always")
+@kernel(python=True, forceinline=True)
 def damping_rate(code, c, u, mode, side):
     """How fast the contact damps the relative motion at the integration state ``u`` of a phase
     of kind ``side``: ``dP/d(deltadot) (1/M1 + 1/M2)`` per unit of the phase's independent
