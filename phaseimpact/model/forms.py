@@ -152,8 +152,10 @@ def _native_partials(code, delta, deltadot, mode, K, damping, alpha):
 
 
 # The branches of the laws added after the first ones call out-of-line kernels (the inlining rule
-# of the laws module's guide): one line per form here, each law's physics in its own kernel.
-@kernel(python=True)
+# of the laws module's guide): one line per form here, each law's physics in its own kernel. The
+# two dispatchers are inlined into the right-hand side (LLVM's heuristics called them: a call at
+# every evaluation), their laws' kernels stay calls.
+@kernel(python=True, forceinline=True)
 def contact_force(code, delta, deltadot, mode, K, damping, alpha):
     """Contact force ``P`` (N, positive pushing the bodies apart) while slipping or free.
 
@@ -181,7 +183,7 @@ def contact_force(code, delta, deltadot, mode, K, damping, alpha):
     return math.nan  # a form without a branch here (register refuses it): never another law's force
 
 
-@kernel(python=True)
+@kernel(python=True, forceinline=True)
 def force_partials(code, delta, deltadot, mode, K, damping, alpha):
     """``(dP/ddelta, dP/ddeltadot)`` of :func:`contact_force` (exact; zero where ``P`` is 0).
 

@@ -61,10 +61,10 @@ package:
    **Inlining rule:** the branch calls an out-of-line kernel of the form's own
    (``_kuwabara_kono_force``, ``_thornton``), never writes the physics inline: the dispatchers
    :func:`contact_force` and :func:`force_partials` stay one line per form, each kernel is
-   compiled once, and every law's physics sits in one place. (Speed does not ask for inlining:
-   LLVM calls ``contact_force`` from ``rhs_values`` and ``rhs_values`` from the DOP853 step, and
-   ``rhs_values`` inlined by numba into every caller ran no faster and compiled longer: see the
-   CHANGELOG.) Only the first laws' one-line forms are inline.
+   compiled once, and every law's physics sits in one place. (Speed does not ask for more: LLVM
+   inlines the two dispatchers into ``rhs_values`` (``forceinline``) and calls the law's kernel;
+   ``rhs_values`` stays a call from the DOP853 stages, where inlined into every stage it ran
+   slower and compiled longer: see the CHANGELOG.) Only the first laws' one-line forms are inline.
 3. :func:`register` a :class:`LawEntry` (every field by keyword): name, form, damping source
    (``"kappa"``, ``"restitution"`` or None), the flags, the options it allows (``"clamp"``,
    ``"bilateral"``, ``"contact"``), the damping's exponent ``damping_power(alpha)`` (its unit is
