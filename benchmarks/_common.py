@@ -12,6 +12,7 @@ import json
 import os
 import platform
 import statistics
+import subprocess
 import sys
 import time
 from pathlib import Path
@@ -90,6 +91,12 @@ def _fmt(x) -> str:
 def us(seconds: float) -> str:
     """Seconds as microseconds, 3 significant digits."""
     return f"{seconds * 1e6:.3g}"
+
+
+def commit_of(tree) -> str:
+    """The short commit of a checkout (``--against`` reports)."""
+    done = subprocess.run(["git", "-C", str(tree), "rev-parse", "--short", "HEAD"], capture_output=True, text=True)
+    return done.stdout.strip() or "no git"
 
 
 def save_section(name: str, text: str) -> None:

@@ -13,7 +13,14 @@ LLVM calls nested in it. What this shows: how much of the first command is numba
 and lowering) and how much LLVM's, which of numba's compiler passes take it, whether numba's work is
 in the many small functions or the few large ones, and which functions and modules cost the most.
 
-    python benchmarks/compile_profile.py
+``--against TREE`` times the same first call in this checkout and another one (e.g. ``git worktree
+add /tmp/old <commit>``), side by side: each pair is two cold processes started together, one per
+tree (one per core on a 2-core machine, so that the machine's speed of the moment hits both alike),
+each on an empty cache and compiling in its own process (``PHASEIMPACT_COMPILE_PROCESSES=1`` for
+older trees that split the compile over a helper process); it prints each pair's times, the median
+ratio, and saves ``results/compile_against.md``.
+
+    python benchmarks/compile_profile.py [--against TREE [--pairs N]]
 """
 
 from __future__ import annotations
@@ -28,7 +35,7 @@ import tempfile
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from _common import VENV_BIN, emit, load, machine, save_section, table  # noqa: E402
+from _common import VENV_BIN, commit_of, emit, load, machine, save_section, table  # noqa: E402
 
 SMALL = 0.3  # s: a function "small" in the breakdown
 PASSES = 8  # compiler passes named in the breakdown
@@ -98,10 +105,70 @@ print(json.dumps({"warm_numba": warm_numba, "alone": alone, "total": total, "row
 """
 
 
+#: A user's first call, timed from the import (``--against``): any tree with ``simulate``.
+FIRST_CALL = r"""
+import time
+start = time.perf_counter()
+from phaseimpact import seed_parameters, simulate
+simulate(seed_parameters(v=1.0, kappa=3e9), "hunt-crossley", 2e-3)
+print(time.perf_counter() - start)
+"""
+
+
+def _cold_pair(trees: list[Path]) -> list[tuple[float, float]]:
+    """The first call in each tree, cold, all started together: (wall, CPU time) per tree."""
+    with tempfile.TemporaryDirectory(prefix="numba-cold-") as cache:
+        procs = []
+        for i, root in enumerate(trees):
+            env = {**os.environ, "PYTHONPATH": str(root), "NUMBA_CACHE_DIR": f"{cache}/{i}",
+                   "PHASEIMPACT_COMPILE_PROCESSES": "1"}
+            procs.append(subprocess.Popen([str(VENV_BIN / "python"), "-c", FIRST_CALL], env=env, cwd=root,
+                                          text=True, stdout=subprocess.PIPE, stderr=subprocess.DEVNULL))
+        times = []
+        for proc in procs:
+            _, status, usage = os.wait4(proc.pid, 0)
+            assert os.waitstatus_to_exitcode(status) == 0, f"the first call failed in {trees[len(times)]}"
+            times.append((float(proc.stdout.read().split()[-1]), usage.ru_utime + usage.ru_stime))
+            proc.stdout.close()
+        return times
+
+
+def against(tree: Path, pairs: int) -> int:
+    """This checkout's first compile against ``tree``'s, ``pairs`` cold pairs side by side (which
+    tree starts first alternates)."""
+    here = Path(__file__).resolve().parent.parent
+    start_load = load()
+    rows, ratios = [], []
+    for k in range(pairs):
+        order = [tree, here] if k % 2 == 0 else [here, tree]
+        measured = dict(zip(order, _cold_pair(order), strict=True))
+        (before, before_cpu), (after, after_cpu) = measured[tree], measured[here]
+        ratios.append(after / before)
+        rows.append((k + 1, f"{before:.1f}", f"{after:.1f}", f"{after / before:.2f}", f"{before_cpu:.1f}",
+                     f"{after_cpu:.1f}"))
+        emit(f"pair {k + 1}: {before:.1f} s against {after:.1f} s")
+    end_load = load()
+    text = (f"`{tree}` ({commit_of(tree)}, before) against this checkout ({commit_of(here)}, after): a user's first "
+            "call (`simulate`, Hunt-Crossley, from the import) on an empty cache, compiled in one process, the two "
+            f"trees' processes started together, {pairs} pairs. Median after / before: "
+            f"**{statistics.median(ratios):.2f}**.\n\n"
+            + table(("pair", "before, wall [s]", "after, wall [s]", "after / before", "before, CPU [s]",
+                     "after, CPU [s]"), rows)
+            + f"\n\n{start_load} at the start, {end_load} at the end. "
+              "`python benchmarks/compile_profile.py --against TREE`")
+    emit(text)
+    save_section("compile_against", f"## The first compile, before and after\n\n{machine()}\n\n{text}")
+    return 0
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__)
     ap.add_argument("--quick", action="store_true", help="the same one cold process (for run_all)")
-    ap.parse_args(argv)
+    ap.add_argument("--against", type=Path, help="another checkout to time the first compile against")
+    ap.add_argument("--pairs", type=int, default=3, help="--against: cold pairs (default 3)")
+    args = ap.parse_args(argv)
+    if args.against is not None:
+        return against(args.against.resolve(), args.pairs)
     start_load = load()
     emit("# Where the first compile goes\n")
     emit(machine())

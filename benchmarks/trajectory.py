@@ -43,7 +43,7 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from _common import emit, load, machine, per_call, save_section, save_targets, table, target, us  # noqa: E402
+from _common import commit_of, emit, load, machine, per_call, save_section, save_targets, table, target, us  # noqa: E402
 
 from phaseimpact import seed_parameters, simulate  # noqa: E402
 from phaseimpact._oracle import oracle  # noqa: E402
@@ -210,7 +210,7 @@ def against(tree: Path, rounds: int, repeats: int) -> int:
         rows.append((case[0], us(med["before"]["simulate"]), us(med["after"]["simulate"]), f"{ratio['simulate']:.2f}",
                      us(med["before"]["loop"]), us(med["after"]["loop"]), f"{ratio['loop']:.2f}",
                      "0 (bit for bit)" if differs == 0 else f"{differs:.1e}"))
-    text = (f"`{tree}` ({_commit(tree)}, before) against this checkout ({_commit(here)}, after): a worker process "
+    text = (f"`{tree}` ({commit_of(tree)}, before) against this checkout ({commit_of(here)}, after): a worker process "
             f"per tree, {rounds * repeats} "
             "turns each, alternating batch by batch (each batch the mean of about 20 ms of calls, the thread's CPU "
             "time: on a loaded machine the wall time counts other processes' turns too); each time the "
@@ -239,11 +239,6 @@ def _largest_difference(bits_a: list, bits_b: list) -> float:
     b = np.array([float.fromhex(x) for x in bits_b])
     scale = np.maximum(np.abs(a), np.abs(b))
     return float(np.max(np.where(a == b, 0.0, np.abs(a - b) / np.where(scale > 0, scale, 1.0))))
-
-
-def _commit(tree: Path) -> str:
-    done = subprocess.run(["git", "-C", str(tree), "rev-parse", "--short", "HEAD"], capture_output=True, text=True)
-    return done.stdout.strip() or "no git"
 
 
 def main(argv=None) -> int:
