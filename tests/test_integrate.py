@@ -315,31 +315,37 @@ def test_engine_kernels_are_compiled_without_reference_counting():
     """Every compiled function of the engine is declared through ``phaseimpact._jit``, and only the
     few that create arrays keep numba's reference counting: a plain ``numba.njit`` on a helper would
     bring back an incref and a decref of every array argument at every call (more than half the
-    time of a trajectory)."""
+    time of a trajectory). Each also sets ``forceinline`` (true or false): numba lets a function that
+    leaves it unset inherit it from the caller it is first compiled in, so what LLVM inlines would
+    depend on the order of compilation."""
     from numba.core.registry import CPUDispatcher
 
     from phaseimpact.integrate import (
         _dop853_stages,
         dop853,
         driver,
+        elliptic,
         events,
+        flight,
         logs,
         phase,
         radau5,
         record,
         rk4,
         rootfind,
+        spacing,
         step,
     )
-    from phaseimpact.model import laws
+    from phaseimpact.model import forms, laws
     from phaseimpact.model import rhs as rhs_module
 
     counted = set()
-    for module in (laws, rhs_module, events, _dop853_stages, dop853, radau5, record, phase, rootfind, logs, step,
-                   driver, rk4):
+    for module in (forms, laws, rhs_module, events, _dop853_stages, dop853, radau5, record, phase, rootfind, logs,
+                   step, driver, rk4, elliptic, flight, spacing):
         for name, obj in vars(module).items():
             if isinstance(obj, CPUDispatcher) and obj.py_func.__module__ == module.__name__:
                 assert "_nrt" in obj.targetoptions, f"{module.__name__}.{name} is not declared through _jit"
+                assert obj.targetoptions.get("forceinline") in (True, False), f"{module.__name__}.{name}"
                 if obj.targetoptions["_nrt"]:
                     counted.add(name)
     assert counted == {"run", "run_rk4", "grow", "new_logs", "workspace"}
