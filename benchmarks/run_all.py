@@ -29,7 +29,8 @@ from _common import FIGURES, RESULTS, emit, load, machine  # noqa: E402
 SCRIPTS = ("startup", "compile_profile", "trajectory", "throughput", "critical", "peers", "work_precision",
            "scene_savings", "stress", "stiff", "atlas", "train", "scale")
 SECTIONS = ("trajectory", "trajectory_against", "throughput", "critical", "startup", "compile_profile",
-            "compile_against", "work_precision", "peers", "stiff", "atlas", "scene_savings", "stress", "train", "scale", "gpu")
+            "compile_against", "work_precision", "peers", "stiff", "atlas", "scene_savings", "stress", "train",
+            "scale", "gpu")
 #: gpu.py is not in SCRIPTS: it is run on a GPU machine (its section says where it was, or that it was not);
 #: trajectory_against and compile_against come from ``trajectory.py --against TREE`` and
 #: ``compile_profile.py --against TREE`` (another checkout), run by hand.
