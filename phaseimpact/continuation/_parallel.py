@@ -172,15 +172,50 @@ def _quiet_teardown():
         log.setLevel(level)
 
 
+class _AfterAStop(logging.Filter):
+    """Drops what ``distributed`` logs once this process has acted on a signal (``_signals``) since
+    the filter was made. joblib cancels a stopped caller's futures while the signal's exception
+    passes through it, before :func:`_quiet_teardown` begins, and a result being gathered then is
+    logged ("Couldn't gather 1 keys, rescheduling"): noise beside the one line the caller prints."""
+
+    def __init__(self):
+        super().__init__()
+        self.since = _signals._acted[0]
+
+    def filter(self, record) -> bool:
+        return _signals._acted[0] == self.since
+
+
+@contextlib.contextmanager
+def _quiet_after_a_stop():
+    """:class:`_AfterAStop` on the handlers of ``distributed``'s logger (its own, which its child
+    loggers' records reach), for the block."""
+    quiet, handlers = _AfterAStop(), list(logging.getLogger("distributed").handlers)
+    for handler in handlers:
+        handler.addFilter(quiet)
+    try:
+        yield
+    finally:
+        for handler in handlers:
+            handler.removeFilter(quiet)
+
+
 def run_chunks(batches, *, rtol: float, settle: bool, stop_on, n_jobs: int, backend: str, scheduler=None):
     """Yield the :class:`~phaseimpact.integrate.Columns` of each batch, in order."""
     if backend in ("threads", "cuda"):
         for batch in batches:
             yield run_batch(batch, rtol=rtol, settle=settle, stop_on=stop_on, n_threads=n_jobs, backend=backend)
         return
+    client, owned = connect(scheduler, n_jobs) if backend == "dask" else (None, False)
+    with _quiet_after_a_stop() if client is not None else contextlib.nullcontext():
+        yield from _run_chunks_with(client, owned, batches, rtol, settle, stop_on, n_jobs)
+
+
+def _run_chunks_with(client, owned: bool, batches, rtol, settle, stop_on, n_jobs):
+    """:func:`run_chunks` on joblib's processes, or on ``client``'s Dask cluster (closed after the
+    work if ``owned``)."""
     import joblib
 
-    client, owned = connect(scheduler, n_jobs) if backend == "dask" else (None, False)
     results = None
     stopped = False
     try:
