@@ -31,8 +31,8 @@ A small kernel the hot loops call says ``forceinline=True``: numba gives its LLV
 ``alwaysinline`` attribute, and LLVM inlines it into every caller after optimising it once. Numba's
 own inlining (``inline="always"``) types and lowers the function again inside each caller: for the
 same machine code (the run loop's assembly is identical either way), a first compile took about
-1.2x as long. It is left to :func:`.integrate.record.carve` and :func:`.integrate.radau5.carve`, the two kernels that
-return views: typed in each caller, their views are the caller's own.
+1.2x as long. It is left to :func:`.integrate.record.carve` and :func:`.integrate.radau5.carve`,
+the two kernels that return views: typed in each caller, their views are the caller's own.
 
 Numba is imported only when something is compiled. Until then (``phaseimpact cases``, ``params``,
 building a case: they import the laws but integrate nothing) a decorated function is a

@@ -87,7 +87,7 @@ def generate_source() -> str:
         "from ..model.rhs import rhs_integration, rhs_values",
         "",
         "",
-        "@kernel(forceinline=True)  # into its callers, as the law's dispatcher into the rates: 1.1x faster runs",
+        "@kernel(forceinline=True)  # into its callers; with the law's dispatchers: runs 1.07-1.09x faster",
         "def step(code, c, mode, side, y, f, h, K, y_new, f_new):",
         '    """One step of size ``h`` from ``(y, f)``: fills stages ``K[0..12]``, ``y_new``, ``f_new``;',
         '    returns the contact force at ``y_new``."""',
