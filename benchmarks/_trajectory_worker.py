@@ -3,14 +3,16 @@
 It imports that checkout's package and its own ``benchmarks/trajectory.py`` (its cases, tolerance,
 driver arguments and compiled loop: the driver's signature changes between commits, older ones
 took two dozen positional arguments), prints its tree and the results' bits, then for each line
-``go`` on stdin the CPU time of one call of ``simulate`` and of the compiled loop in each case (each
-the mean of a batch of calls lasting about 20 ms). Only the public ``seed_parameters`` and
-``simulate`` are imported from the package itself, so any commit with the benchmark can be timed.
+``go`` on stdin the CPU time of one call of ``simulate``, of the compiled loop and of ``simulate`` on a
+new case each call (``params.replace``) in each case (each the mean of a batch of calls lasting
+about 20 ms). Only the public ``seed_parameters``, ``Parameters.replace`` and ``simulate`` are used
+from the package itself, so any commit with the benchmark can be timed.
 """
 
 from __future__ import annotations
 
 import importlib.util
+import itertools
 import json
 import sys
 import time
@@ -52,7 +54,13 @@ def main() -> int:
         tr = call()
         # quantities every version has (the summary's columns changed between commits)
         bits.append([float(x).hex() for x in np.concatenate([[tr.max_force, tr.t_stop], tr.final_state])])
-        for fn in (_batch(call), lambda n, a=args_: bench._loop(n, *a)):
+        kappas = itertools.cycle(params.kappa * (1 + 1e-12 * np.arange(4096)))
+
+        def new_case(params=params, law=law, t_end=t_end, stop_on=stop_on, kappas=kappas):
+            # a new case per call, as a loop over kappa makes them: nothing of the case is cached
+            return simulate(params.replace(kappa=float(next(kappas))), law, t_end, rtol=bench.RTOL, stop_on=stop_on)
+
+        for fn in (_batch(call), lambda n, a=args_: bench._loop(n, *a), _batch(new_case)):
             fn(10)
             start = time.perf_counter()
             fn(10)

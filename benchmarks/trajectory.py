@@ -10,7 +10,9 @@ Seed case ``seed_parameters(v=1.0, kappa=3e9)``, rtol 1e-10, summary, stop when 
 
 Columns: the median time of one ``simulate`` call; of one ``driver.run`` inside a compiled
 (numba) loop, i.e. the engine without any Python; the difference (the Python layer: argument
-checks, packing, the Trajectory); and ``driver.run`` called from Python. Alternatives: the
+checks, the Trajectory; the case's packing is cached); ``driver.run`` called from Python; and
+``simulate`` on a new case each call (``params.replace(kappa=...)`` included, nothing cached: what
+a loop over kappa pays per run). Alternatives: the
 scipy oracle (``phaseimpact/_oracle.py``: ``solve_ivp`` DOP853 on the same law entries with the same
 events, phase by phase) and a plain ``solve_ivp`` DOP853 run on the same right-hand side
 without events (what a user would write; its max force is only the largest over its steps).
@@ -30,6 +32,7 @@ per-call times, their ratios and the largest relative difference of the results,
 from __future__ import annotations
 
 import argparse
+import itertools
 import json
 import os
 import statistics
@@ -108,6 +111,17 @@ def repeat(fn):
         for _ in range(n):
             fn()
     return many
+
+
+def new_case_each_call(params, law, t_end, stop_on, rtol):
+    """``simulate`` on a new case per call, made by ``params.replace`` (included), as a loop over
+    kappa makes them: the caches of one case's packing and tolerances never hit (the kappas cycle
+    through more values than they hold)."""
+    kappas = itertools.cycle(params.kappa * (1 + 1e-12 * np.arange(4096)))
+
+    def call():
+        return simulate(params.replace(kappa=float(next(kappas))), law, t_end, rtol=rtol, stop_on=stop_on)
+    return call
 
 
 class _Timeout(Exception):
@@ -193,22 +207,23 @@ def against(tree: Path, rounds: int, repeats: int) -> int:
     for proc, _ in workers.values():
         proc.stdin.close()
         proc.wait()
-    runs = {name: [[{"simulate": t[2 * i], "loop": t[2 * i + 1], "bits": workers[name][1][i]}
+    runs = {name: [[{"simulate": t[3 * i], "loop": t[3 * i + 1], "new case": t[3 * i + 2], "bits": workers[name][1][i]}
                     for i in range(len(CASES))] for t in samples[name]] for name in samples}
     end_load = load()
     rows, ratios, worst = [], [], 0.0
     for i, case in enumerate(CASES):
         before = [r[i] for r in runs["before"]]
         after = [r[i] for r in runs["after"]]
-        med = {name: {k: statistics.median(r[k] for r in rs) for k in ("simulate", "loop")}
+        timed = ("simulate", "loop", "new case")
+        med = {name: {k: statistics.median(r[k] for r in rs) for k in timed}
                for name, rs in (("before", before), ("after", after))}
-        ratio = {k: statistics.median(b[k] / a[k] for b, a in zip(before, after, strict=True))
-                 for k in ("simulate", "loop")}
+        ratio = {k: statistics.median(b[k] / a[k] for b, a in zip(before, after, strict=True)) for k in timed}
         differs = _largest_difference(before[0]["bits"], after[0]["bits"])
         worst = max(worst, differs)
         ratios.append(ratio)
         rows.append((case[0], us(med["before"]["simulate"]), us(med["after"]["simulate"]), f"{ratio['simulate']:.2f}",
                      us(med["before"]["loop"]), us(med["after"]["loop"]), f"{ratio['loop']:.2f}",
+                     us(med["before"]["new case"]), us(med["after"]["new case"]), f"{ratio['new case']:.2f}",
                      "0 (bit for bit)" if differs == 0 else f"{differs:.1e}"))
     text = (f"`{tree}` ({commit_of(tree)}, before) against this checkout ({commit_of(here)}, after): a worker process "
             f"per tree, {rounds * repeats} "
@@ -218,7 +233,8 @@ def against(tree: Path, rounds: int, repeats: int) -> int:
             "both sides). Results: the largest difference of max force, t_stop and the final state, relative to "
             "each quantity's own scale (the largest of its two values).\n\n"
             + table(("case", "simulate before [µs]", "after [µs]", "before / after", "compiled loop before [µs]",
-                     "after [µs]", "before / after", "results: largest relative difference"), rows))
+                     "after [µs]", "before / after", "simulate, a new case each call, before [µs]", "after [µs]",
+                     "before / after", "results: largest relative difference"), rows))
     emit(text)
     emit(f"\n{start_load} at the start, {end_load} at the end")
     save_section("trajectory_against", f"## One trajectory, before and after\n\n{machine()}\n\n{start_load} at the "
@@ -266,8 +282,9 @@ def main(argv=None) -> int:
         check = d.run(*args_)[0]
         assert check[d.S_MAX_FORCE] == tr.max_force, "driver_args must mirror simulate"
         times = interleaved({"simulate": repeat(call), "loop": lambda n, a=args_: _loop(n, *a),
-                             "run": repeat(lambda a=args_: d.run(*a))}, repeats)
-        t_sim, t_loop, t_run = times["simulate"], times["loop"], times["run"]
+                             "run": repeat(lambda a=args_: d.run(*a)),
+                             "new case": repeat(new_case_each_call(params, law, t_end, stop_on, RTOL))}, repeats)
+        t_sim, t_loop, t_run, t_new = times["simulate"], times["loop"], times["run"], times["new case"]
         t_oracle = per_call(lambda p=params, law=law, h=t_end, s=stop_on: oracle(p, law, h, rtol=RTOL, stop_on=s),
                             repeats=3, min_time=0.0)
         plain = plain_scipy(params, law, tr.t_stop if t_end is None else t_end, RTOL)
@@ -292,18 +309,20 @@ def main(argv=None) -> int:
                                       f"{e10:.1e} (rtol 1e-10), {e13:.1e} (rtol 1e-13)", bool(max(e10, e13) <= 1e-9),
                                       "python benchmarks/trajectory.py"))
         rows.append((label, f"{tr.t_stop:.4g}", tr.nsteps, tr.nfev, us(t_sim), us(t_loop), us(t_sim - t_loop),
-                     us(t_run), ", ".join(errors), us(limit), f"{t_sim / limit:.2f}", f"{t_loop / limit:.2f}",
-                     f"{t_oracle * 1e3:.3g} ms ({t_oracle / t_sim:.0f}x)",
+                     us(t_run), us(t_new), ", ".join(errors), us(limit), f"{t_sim / limit:.2f}",
+                     f"{t_loop / limit:.2f}", f"{t_oracle * 1e3:.3g} ms ({t_oracle / t_sim:.0f}x)",
                      plain_cell))
         targets.append(target(f"one trajectory: {label}", f"<= {us(limit)} µs",
                               f"simulate {us(t_sim)} µs, compiled loop {us(t_loop)} µs",
                               bool(t_sim <= limit), "python benchmarks/trajectory.py"))
         emit(f"{label}: simulate {us(t_sim)} µs, compiled loop {us(t_loop)} µs, driver.run from Python "
-             f"{us(t_run)} µs; oracle {t_oracle * 1e3:.3g} ms, plain solve_ivp {t_plain * 1e3:.3g} ms "
+             f"{us(t_run)} µs, simulate on a new case each call {us(t_new)} µs; oracle {t_oracle * 1e3:.3g} ms, "
+             f"plain solve_ivp {t_plain * 1e3:.3g} ms "
              f"(nfev {nfev_plain}); t_stop {tr.t_stop:.4g} s, {tr.nsteps} steps, nfev {tr.nfev}")
     end_load = load()
     header = ("case", "t_stop [s]", "steps", "nfev", "simulate [µs]", "compiled loop [µs]", "Python layer [µs]",
-              "driver.run from Python [µs]", "error vs oracle at rtol 1e-13 (ours, rtol 1e-10)", "target [µs]",
+              "driver.run from Python [µs]", "simulate, a new case each call [µs]",
+              "error vs oracle at rtol 1e-13 (ours, rtol 1e-10)", "target [µs]",
               "simulate / target", "compiled / target",
               "scipy oracle, same events (x simulate)", "plain solve_ivp DOP853, no events (x simulate)")
     err_header = ("case", "quantity", "oracle at rtol 1e-13", "ours rtol 1e-10", "ours rtol 1e-13",

@@ -78,27 +78,35 @@ def require(name: str, value, allowed: str, ok: bool) -> None:
         raise ValueError(f"{name} = {value!r} is out of range; allowed: {allowed}")
 
 
+# The checks below test before they call ``require``: a case is validated on every ``replace``
+# (a loop over kappa makes one per run), and most inputs pass.
+
 def require_positive(name: str, value) -> None:
-    require(name, value, "a finite number > 0", is_finite_number(value) and value > 0)
+    if not (is_finite_number(value) and value > 0):
+        require(name, value, "a finite number > 0", False)
 
 
 def require_nonnegative(name: str, value) -> None:
-    require(name, value, "a finite number >= 0", is_finite_number(value) and value >= 0)
+    if not (is_finite_number(value) and value >= 0):
+        require(name, value, "a finite number >= 0", False)
 
 
 def require_in(name: str, value, bounds: tuple, unit: str = "") -> None:
     """``low <= value <= high`` for finite numbers; the message gives the range and the unit."""
     low, high = bounds
-    require(name, value, f"{low:g} <= {name} <= {high:g}" + (f" ({unit})" if unit else ""),
-            is_finite_number(value) and low <= value <= high)
+    if not (is_finite_number(value) and low <= value <= high):
+        require(name, value, f"{low:g} <= {name} <= {high:g}" + (f" ({unit})" if unit else ""), False)
 
 
 def require_choice(name: str, value, choices) -> None:
-    require(name, value, "one of " + ", ".join(map(str, choices)), value in choices)
+    if value not in choices:
+        require(name, value, "one of " + ", ".join(map(str, choices)), False)
 
 
 def is_number(value) -> bool:
     """True for any real number type (int, float, NumPy scalars and 0-d arrays), False for ``bool``."""
+    if type(value) is float or type(value) is int:  # the common case, without the ABC checks below
+        return True
     np = sys.modules.get("numpy")  # a NumPy value means NumPy is imported: asking costs no import
     if np is not None and isinstance(value, np.ndarray):  # a 0-d array is a scalar (a reduction's result)
         return value.ndim == 0 and value.dtype.kind in "iuf"
@@ -107,6 +115,8 @@ def is_number(value) -> bool:
 
 def is_finite_number(value) -> bool:
     """True for a finite real number (:func:`is_number`)."""
+    if type(value) is float:  # the common case
+        return math.isfinite(value)
     return is_number(value) and math.isfinite(value)
 
 
@@ -115,7 +125,7 @@ def _store_floats(obj, names) -> None:
     # so that results, JSON output and equality never depend on the caller's number type.
     for name in names:
         value = getattr(obj, name)
-        if value is not None:
+        if value is not None and type(value) is not float:
             object.__setattr__(obj, name, float(value))
 
 
@@ -186,7 +196,7 @@ class Material:
     yield_strength: float | None = None
 
     def __post_init__(self):
-        validate_material(dataclasses.asdict(self))
+        validate_material(vars(self))  # its fields: numbers, read only
         _store_floats(self, MATERIAL_FIELDS)
 
 
@@ -225,7 +235,7 @@ class Geometry:
     R2: float = 2e3
 
     def __post_init__(self):
-        validate_geometry(dataclasses.asdict(self))
+        validate_geometry(vars(self))
         _store_floats(self, GEOMETRY_NAMES)
 
     @property
@@ -349,7 +359,12 @@ class Parameters:
         ValueError: unknown parameter 'kapa'; allowed: M1, M2, K, Kb, Km, alpha, kappa, v, target, R, ...
         """
         _reject_unknown(changes, PARAMETER_NAMES)
-        return dataclasses.replace(self, **changes)
+        # dataclasses.replace without its walk over the fields and __init__: a loop over kappa makes
+        # a case per run; the fields are copied, then validated as any new case's
+        new = object.__new__(type(self))
+        vars(new).update(vars(self), **changes)
+        new.__post_init__()
+        return new
 
     @property
     def target_period(self) -> float:
@@ -588,8 +603,7 @@ def parameters_with(
             materials[body] = _replace_material(materials[body], f"{body}_", changes)
     passed = {name: overrides.pop(name) for name in ("alpha", "kappa", "target", "membrane") if name in overrides}
     if "kappa" in passed:  # an input: bounded as on the command line (searches may go beyond it)
-        require("kappa", passed["kappa"], f"0 <= kappa <= {KAPPA_MAX:g} (N s/m^(1+alpha))",
-                is_finite_number(passed["kappa"]) and 0 <= passed["kappa"] <= KAPPA_MAX)
+        require_in("kappa", passed["kappa"], (0, KAPPA_MAX), "N s/m^(1+alpha)")
     if "v" in overrides:
         v = overrides.pop("v")
     params = derive_parameters(materials["projectile"], materials["plate"], geometry, v=v, **passed)

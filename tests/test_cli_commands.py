@@ -20,7 +20,7 @@ from pathlib import Path
 import h5py
 import numpy as np
 import pytest
-from _cli import run
+from _cli import import_every_module, run
 
 import phaseimpact.analysis as analysis
 import phaseimpact.continuation as continuation
@@ -429,6 +429,7 @@ def test_portrait_marks_each_kappa_with_its_outcome(tmp_path):
 
 @pytest.fixture
 def no_work(monkeypatch):
+    import_every_module()  # before the patch: no lazy import keeps the stand-in
     def forbidden(*args, **kwargs):
         raise AssertionError("work started before the input was refused")
 

@@ -15,6 +15,7 @@ import time
 from pathlib import Path
 
 import pytest
+from _cli import import_every_module
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
@@ -41,6 +42,7 @@ def run(argv):
 @pytest.fixture
 def no_work(monkeypatch):
     """Any call into the engine fails the test: the refusal must come before any work."""
+    import_every_module()  # before the patch: no lazy import keeps the stand-in
     def forbidden(*args, **kwargs):
         raise AssertionError("work started before the input was refused")
 

@@ -125,7 +125,10 @@ class Scales:
 
 def hertz_contact_time(alpha, indentation, v):
     """Duration of the undamped impact, ``2 tau delta_max / v`` (s; scalars or arrays, ``alpha`` too)."""
-    tau = _hertz_tau(alpha) if np.ndim(alpha) == 0 else np.array([_hertz_tau(a) for a in np.asarray(alpha).tolist()])
+    if type(alpha) is float or np.ndim(alpha) == 0:  # (the first test spares a case np.ndim's cost)
+        tau = _hertz_tau(alpha)
+    else:
+        tau = np.array([_hertz_tau(a) for a in np.asarray(alpha).tolist()])
     return 2 * tau * indentation / v
 
 
@@ -186,6 +189,10 @@ def state_tolerances(rtol: float, indentation, v, M1, contact_time) -> np.ndarra
     or arrays): positions by the Hertz indentation, velocities by the impact speed, the work by
     the impact energy, the time by the contact time and ``w = sqrt(|delta|)`` (the position of a
     regularised contact phase) by the square root of the indentation."""
+    if type(indentation) is float:  # one case (simulate's): seven numbers, without broadcasting arrays
+        energy = 0.5 * M1 * (v * v)  # numpy's v ** 2 below is v * v: the same bits in either path
+        return np.array([rtol * indentation, rtol * indentation, rtol * v, rtol * v, rtol * energy,
+                         rtol * contact_time, rtol * math.sqrt(indentation)])
     columns = np.broadcast_arrays(indentation, indentation, v, v, 0.5 * np.asarray(M1) * np.asarray(v) ** 2,
                                   contact_time, np.sqrt(indentation))
     return rtol * np.stack(columns, axis=-1)
