@@ -34,6 +34,15 @@ same machine code (the run loop's assembly is identical either way), a first com
 1.2x as long. It is left to :func:`.integrate.record.carve` and :func:`.integrate.radau5.carve`,
 the two kernels that return views: typed in each caller, their views are the caller's own.
 
+A kernel that takes a run's workspace and runs once per step or event (the root finders, the
+event handling: :mod:`.integrate.step`, :mod:`.integrate.rootfind`, the driver's step kernels)
+says ``forceinline=True`` too, and so do the event function, the interpolant and the physical
+state the root finders call. The workspace is a tuple of 22 arrays passed by value: the LLVM
+functions that took it had 174 to 202 parameters. Numba gives its functions ``linkonce_odr`` linkage, so LLVM may not
+drop the arguments a callee never reads, and each call copied them all. Only the loop
+(``_loop``), its start and :func:`.integrate.step.advance` (which keeps its steps in a loop of its
+own) stay calls.
+
 Numba is imported only when something is compiled. Until then (``phaseimpact cases``, ``params``,
 building a case: they import the laws but integrate nothing) a decorated function is a
 :class:`_Deferred` placeholder; the first use of one, or the first decoration once numba is

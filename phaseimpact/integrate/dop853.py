@@ -24,7 +24,7 @@ ERROR_EXPONENT = -1.0 / 8.0  # error estimator of order 7
 SAFETY, MIN_FACTOR, MAX_FACTOR = 0.9, 0.2, 10.0
 
 
-@kernel
+@kernel(forceinline=True)
 def dense_eval(F, y, t_old, h, t, out):
     """State at ``t`` on the interpolant ``F`` of the step ``[t_old, t_old + h]`` from ``y``."""
     x = (t - t_old) / h if h != 0 else 0.0

@@ -346,7 +346,7 @@ def _take_steps(code, ws, times):
     return result
 
 
-@kernel
+@kernel(forceinline=True)
 def _look_at_step(code, ws, ev):
     """The step :func:`advance` left: where a regularised phase reaches the horizon in it, the
     events that fired located and the recorded ones logged. Returns ``(restart_col, s_restart,
@@ -384,7 +384,7 @@ def _look_at_step(code, ws, ev):
     return restart_col, s_restart, s_horizon, stop_record
 
 
-@kernel
+@kernel(forceinline=True)
 def _after_step(code, ws, ev, smp, times, restart_col, s_restart, s_horizon, stop_record):
     """After :func:`_look_at_step`: stop at a recorded event, take the samples in the step, stop on
     the horizon, restart at an event, or accept the whole step. Returns True when the run ends."""
@@ -439,7 +439,7 @@ def _extremes(ws, force, y):
     stats[STAT_MAX_INDENTATION] = max(stats[STAT_MAX_INDENTATION], y[X1] - y[X2])
 
 
-@kernel
+@kernel(forceinline=True)
 def _samples_in_step(code, ws, smp, times, restart_col, s_restart, s_horizon):
     """The output times in the step, up to where its motion stands: its end, the restart or the horizon."""
     real, ints, c, ur, yr = ws[W_REAL], ws[W_INT], ws[W_C], ws[W_U], ws[W_Y]
@@ -465,7 +465,7 @@ def _samples_in_step(code, ws, smp, times, restart_col, s_restart, s_horizon):
     ints[I_TIME_INDEX] = i_time
 
 
-@kernel
+@kernel(forceinline=True)
 def _restart_and_log(code, ws, ev, smp, restart_col, s_restart):
     """Restart at the event ``restart_col`` (:func:`restart`), log it and stop where it says so;
     returns True when the run ends."""

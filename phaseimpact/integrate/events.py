@@ -80,7 +80,7 @@ GO_ON, STOP_SETTLED, STOP_RUNAWAY = 0, 1, 2
 # law's factor travels in its packed coefficients (slot GUARD_, read by energy_limit_of).
 
 
-@kernel
+@kernel(forceinline=True)
 def event_value(code, c, y, f, force, mode, energy_limit, column):
     """Event function ``column`` at ``y`` (``f`` its derivative and ``force`` its contact force,
     read by ``FORCE_RATE`` only, so that a root finder on another event skips the right-hand
@@ -113,7 +113,7 @@ def event_value(code, c, y, f, force, mode, energy_limit, column):
     return -1.0
 
 
-@kernel(python=True)
+@kernel(python=True, forceinline=True)
 def event_values(code, c, y, f, force, mode, energy_limit, g):
     """All event functions at ``y`` into ``g`` (:func:`event_value`)."""
     for column in range(N_EVENTS):

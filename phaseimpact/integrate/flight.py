@@ -102,7 +102,7 @@ def next_centre(F, s):
     return centre
 
 
-@kernel(python=True)
+@kernel(python=True, forceinline=True)
 def state_at(c, F, u0, s0, s, out):
     """The integration state at ``s`` of the flight that was at ``u0`` at ``s0`` (its invariants in
     ``F[0]``, from :func:`coefficients`); the time is ``s`` itself (a plain phase). At ``s0`` it

@@ -64,7 +64,7 @@ def regularised(side):
     return side == 1 or side == -1
 
 
-@kernel
+@kernel(forceinline=True)
 def physical_state(code, mode, side, u, y):
     """Physical state ``y`` at the integration state ``u``."""
     y[X1] = u[X1] if not regularised(side) else u[X2] + side * u[0] * u[0]
@@ -74,7 +74,7 @@ def physical_state(code, mode, side, u, y):
         y[V1] = u[V1] + u[V2]
 
 
-@kernel
+@kernel(forceinline=True)
 def physical(code, c, mode, side, u, y, f):
     """Physical state ``y`` and ``dy/dt`` (``f``) at the integration state ``u``; returns the force."""
     physical_state(code, mode, side, u, y)

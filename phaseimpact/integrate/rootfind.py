@@ -35,7 +35,7 @@ from .record import (
 _EPS = np.finfo(np.float64).eps
 
 
-@kernel
+@kernel(forceinline=True)
 def brent(code, ws, column, target, xa, xb, fa, fb):
     """Zero of event ``column`` (:func:`~.phase.event_at`) in ``[xa, xb]`` (signs of ``fa``, ``fb``
     differ): scipy's brentq."""
@@ -85,7 +85,7 @@ def flight_rate(c, column, y):
     return math.nan
 
 
-@kernel
+@kernel(forceinline=True)
 def flight_root(code, ws, column, a, b, fa, fb):
     """Zero of event ``column`` in ``[a, b]`` (signs of ``fa``, ``fb`` differ) of a flight: Newton's
     method on the closed form with the event's exact rate, kept inside the bracket (bisection
@@ -117,7 +117,7 @@ def flight_root(code, ws, column, a, b, fa, fb):
     return x
 
 
-@kernel
+@kernel(forceinline=True)
 def locate(code, ws, column, g_start, g_end):
     """The first zero of event ``column`` in the run's step ``[s0, s1]`` on its dense output.
 
@@ -167,7 +167,7 @@ def locate(code, ws, column, g_start, g_end):
     return brent(code, ws, column, 0.0, a, b, ga, gb)
 
 
-@kernel
+@kernel(forceinline=True)
 def s_at_time(code, ws, time):
     """Where on the run's step the physical time is ``time`` (it lies within the step): ``s``
     itself in a plain phase, a root of ``t(s)`` on the dense output in a regularised one."""
@@ -184,7 +184,7 @@ def s_at_time(code, ws, time):
     return brent(code, ws, np.int64(TIME_COLUMN), time, s0, s1, fa, fb)
 
 
-@kernel
+@kernel(forceinline=True)
 def polish_root(code, ws, column, g_start, g_end, x):
     """Refine the root ``x`` of event ``column`` (found on the interpolant of the run's step
     ``[s, s_end]``) on steps from ``s`` that end at the trial points (Illinois' regula falsi).

@@ -328,7 +328,7 @@ def phase_step(code, ws):
                                (ur[U_TMP], ur[U_FU_NEW]))
 
 
-@kernel
+@kernel(forceinline=True)
 def locate_events(code, ws, s_horizon):
     """Locate the events that fired in the step ``[s, s + h]`` (record ``R_S``, ``R_H``) on its
     interpolant: their roots into row ``G_ROOTS`` (``fired`` cleared where the crossing did not
@@ -372,7 +372,7 @@ def locate_events(code, ws, s_horizon):
 
 
 
-@kernel
+@kernel(forceinline=True)
 def record_events(code, ws, ev, s_restart):
     """Log the recorded events (force peaks, reversals, reach) that fired in the step up to
     ``s_restart``, in time order (:func:`log_event`; ``ev`` has a free row for each event column);
@@ -410,7 +410,7 @@ def record_events(code, ws, ev, s_restart):
             break
     return stop_record, evaluations
 
-@kernel
+@kernel(forceinline=True)
 def restart(code, ws, column, s_restart):
     """Restart the run at the root ``s_restart`` of event ``column``: the state there from a fresh
     step that ends there (the stages beyond the root belong to the continuation, not to the
