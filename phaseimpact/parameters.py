@@ -359,12 +359,7 @@ class Parameters:
         ValueError: unknown parameter 'kapa'; allowed: M1, M2, K, Kb, Km, alpha, kappa, v, target, R, ...
         """
         _reject_unknown(changes, PARAMETER_NAMES)
-        # dataclasses.replace without its walk over the fields and __init__: a loop over kappa makes
-        # a case per run; the fields are copied, then validated as any new case's
-        new = object.__new__(type(self))
-        vars(new).update(vars(self), **changes)
-        new.__post_init__()
-        return new
+        return dataclasses.replace(self, **changes)
 
     @property
     def target_period(self) -> float:
