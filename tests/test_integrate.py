@@ -351,6 +351,32 @@ def test_engine_kernels_are_compiled_without_reference_counting():
     assert counted == {"run", "run_rk4", "grow", "new_logs", "workspace"}
 
 
+def test_kernels_that_take_the_workspace_are_inlined():
+    """A kernel that takes a run's workspace (``ws``, a tuple of 22 arrays passed by value: 174 to
+    202 LLVM parameters a call, which numba's ``linkonce_odr`` linkage keeps LLVM from trimming) is
+    ``forceinline``, so that the root finders and the event handling do not copy it at every call.
+    The exceptions run a few times per run: the entries, the loop, its start and end, and
+    ``advance``, which keeps its steps in a loop of its own."""
+    import inspect
+
+    from numba.core.registry import CPUDispatcher
+
+    from phaseimpact.integrate import driver, logs, phase, rootfind, step
+
+    called_per_run = {"_set_options", "open_logs", "_start", "_loop", "summarize", "run_point", "run_point_into",
+                      "run_held", "advance"}
+    takes_ws, not_inlined = set(), set()
+    for module in (driver, logs, phase, rootfind, step):
+        for name, obj in vars(module).items():
+            if isinstance(obj, CPUDispatcher) and obj.py_func.__module__ == module.__name__ \
+                    and "ws" in inspect.signature(obj.py_func).parameters:
+                takes_ws.add(name)
+                if not obj.targetoptions["forceinline"]:
+                    not_inlined.add(name)
+    assert {"brent", "locate", "restart", "record_events", "log_event"} <= takes_ws  # the scan finds them
+    assert not_inlined == called_per_run
+
+
 def _python_calls_of_compiled_functions():
     """Every call of a compiled function from Python code (not from a compiled function) in the
     package, tests, benchmarks and studies: ``(where, dispatcher)``, names resolved through each

@@ -208,7 +208,7 @@ def _set_options(ws, options, t_end, max_step, save_kind):
     ints[I_MAX_EVENTS] = options[OPT_MAX_EVENTS]
 
 
-@kernel
+@kernel(forceinline=True)
 def _room(ws, ev, smp, times):
     """Whether the logs hold what one more pass of the loop may add: an event per column and the
     restart's, two samples (steps) or every output time left (times)."""
@@ -334,7 +334,7 @@ def _loop(code, ws, ev, smp, times):
 _RETRY = -2  # _look_at_step: the step is to be retried smaller
 
 
-@kernel
+@kernel(forceinline=True)
 def _take_steps(code, ws, times):
     """Steps of the current phase while nothing happens (:func:`advance`); returns its result."""
     ints, u = ws[W_INT], ws[W_U][U_U]
@@ -431,7 +431,7 @@ def _after_step(code, ws, ev, smp, times, restart_col, s_restart, s_horizon, sto
     return False
 
 
-@kernel
+@kernel(forceinline=True)
 def _extremes(ws, force, y):
     """The running extremes (``W_STATS``) after a state the run stands at."""
     stats = ws[W_STATS]

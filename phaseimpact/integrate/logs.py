@@ -66,7 +66,7 @@ def _write_event(ev, n, t, kind, mode, y, force):
     row[EV_FORCE] = force
 
 
-@kernel
+@kernel(forceinline=True)
 def log_event(ws, ev, t, kind, mode, y, force):
     """An event of the run: counted, written into the log ``ev`` when the run keeps one (it has a
     free row: :func:`_room`), and followed by the summary (the first contact's duration and
@@ -96,7 +96,7 @@ def log_event(ws, ev, t, kind, mode, y, force):
         close_sticks(ws, t)
 
 
-@kernel
+@kernel(forceinline=True)
 def close_sticks(ws, end):
     """The stick phases still waiting for their end (a slip, the run's end) end at ``end``."""
     ints, sticks = ws[W_INT], ws[W_STICKS]
@@ -105,7 +105,7 @@ def close_sticks(ws, end):
     ints[I_OPEN_STICK] = ints[I_N_STICK]
 
 
-@kernel
+@kernel(forceinline=True)
 def add_sample(ws, smp, t, y, mode, force):
     """Append a sample to ``smp`` (columns ``SMP_*``; it has a free row: :func:`_room`)."""
     n = ws[W_INT][I_N_S]
