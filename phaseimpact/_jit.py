@@ -38,10 +38,10 @@ A kernel that takes a run's workspace and runs once per step or event (the root 
 event handling: :mod:`.integrate.step`, :mod:`.integrate.rootfind`, the driver's step kernels)
 says ``forceinline=True`` too, and so do the event function, the interpolant and the physical
 state the root finders call. The workspace is a tuple of 22 arrays passed by value: the LLVM
-functions that took it had 174 to 202 parameters. Numba gives its functions ``linkonce_odr`` linkage, so LLVM may not
-drop the arguments a callee never reads, and each call copied them all. What runs a few times
-per run stays a call: the entries, the loop (``_loop``), its start and end, and
-:func:`.integrate.step.advance` (which keeps its steps in a loop of its own);
+functions that took it had 174 to 202 parameters. Numba gives its functions ``linkonce_odr``
+linkage, so LLVM may not drop the arguments a callee never reads, and each call copied them all.
+What runs a few times per run stays a call: the entries, the loop (``_loop``), its start and end,
+and :func:`.integrate.step.advance` (which keeps its steps in a loop of its own);
 ``tests/test_integrate.py`` holds the list.
 
 Numba is imported only when something is compiled. Until then (``phaseimpact cases``, ``params``,
