@@ -94,9 +94,13 @@ def us(seconds: float) -> str:
 
 
 def commit_of(tree) -> str:
-    """The short commit of a checkout (``--against`` reports)."""
+    """The short commit of a checkout (``--against`` reports), and whether its package or benchmark
+    scripts have changes not committed (what was timed is then not that commit)."""
     done = subprocess.run(["git", "-C", str(tree), "rev-parse", "--short", "HEAD"], capture_output=True, text=True)
-    return done.stdout.strip() or "no git"
+    changed = subprocess.run(["git", "-C", str(tree), "status", "--porcelain", "--", "phaseimpact",
+                              ":(glob)benchmarks/*.py"], capture_output=True, text=True).stdout.strip()
+    commit = done.stdout.strip() or "no git"
+    return f"{commit} with changes not committed" if changed and done.stdout.strip() else commit
 
 
 def save_section(name: str, text: str) -> None:

@@ -231,8 +231,8 @@ def main(argv=None) -> int:
             + "\n\nBy compiler pass (numba's `numba:run_pass` events; a pass's own time, without the compiles "
               "and the LLVM calls nested in it; shares of numba's own work):\n\n"
             + table(("pass", "own [s]", "share"), pass_rows)
-            + "\n\nBy module (numba's own work; the stiff solver, `integrate.radau5`, is compiled by every first "
-              "command, whether its runs turn stiff or not):\n\n"
+            + "\n\nBy module (numba's own work; the stiff solver's steps, `integrate.radau5`, are compiled only once "
+              "a run turns stiff, `integrate.api.radau_marker`: this call's never does):\n\n"
             + table(("module", "own [s]", "compiles"),
                     [(f"`{name}`", f"{own:.2f}", n) for name, (own, n) in by_module]))
     emit(f"\n{start_load} at the start, {end_load} at the end.\n")

@@ -71,16 +71,17 @@ def driver_args(params, law, t_end, rtol, stop_on):
     s = api.scales(params)
     stop_kind, stop_count = api._stop_on(stop_on)
     horizon = s.horizon if t_end is None else t_end
+    stiff_after = api._stiff_after(True)
     return (law.code, pack(params, law), api._initial(params, None), api._atol(params, rtol, None), horizon,
-            s.max_step, (rtol, True, stop_kind, stop_count, api.MAX_STEPS, api.MAX_EVENTS, api._stiff_after(True)),
-            d.SAVE_SUMMARY, np.empty(0))
+            s.max_step, (rtol, True, stop_kind, stop_count, api.MAX_STEPS, api.MAX_EVENTS, stiff_after),
+            d.SAVE_SUMMARY, np.empty(0), api.radau_marker(stiff_after))
 
 
 @numba.njit
-def _loop(n, code, c, y0, atol, t_end, max_step, options, save_kind, times):
+def _loop(n, code, c, y0, atol, t_end, max_step, options, save_kind, times, radau):
     total = 0.0
     for _ in range(n):
-        out = d.run(code, c, y0, atol, t_end, max_step, options, save_kind, times)
+        out = d.run(code, c, y0, atol, t_end, max_step, options, save_kind, times, radau)
         total += out[0][d.S_MAX_FORCE]
     return total
 

@@ -139,8 +139,9 @@ def _version() -> str:
 
 
 # A module "compiles" when it imports one of these: its functions are machine code in the cache.
-# numba's ``overload`` and ``register_jitable`` are left out: the package uses them only for the
-# CUDA target (cuda.py), whose code is not cached here (``tests/test_cache.py`` checks that).
+# numba's ``overload`` and ``register_jitable`` are left out: the package uses them for the CUDA
+# target (cuda.py), whose code is not cached here, and in integrate/record.py, which compiles
+# kernels and is in the digest anyway (``tests/test_cache.py`` checks both).
 _OUR_COMPILERS = frozenset({"kernel", "allocating"})
 _NUMBA_COMPILERS = frozenset({"njit", "jit", "cfunc", "intrinsic", "generated_jit", "vectorize", "guvectorize"})
 # The imports are read from the text, not with ``ast``: parsing the candidate files took 0.34 s on

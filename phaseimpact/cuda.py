@@ -126,7 +126,7 @@ def _kernel():
     def points(code, batch, options, outputs, work):
         i = cuda.grid(1)
         if i < batch[0].shape[0]:
-            ws = carve(work[i], batch[0].shape[1], outputs[1].shape[1])
+            ws = carve(work[i], batch[0].shape[1], outputs[1].shape[1], True)  # with Radau
             run_point_into(code, ws, batch, options, i, outputs)
 
     return points

@@ -143,7 +143,9 @@ def test_the_workspace_members_tile_one_buffer():
             yield from (members(member) if isinstance(member, tuple) else [member])
 
     for n_coef, capacity in ((12, 0), (12, 3), (25, 32)):
-        views = sorted(members(record.workspace(n_coef, capacity)), key=lambda a: a.__array_interface__["data"][0])
+        ws = record.workspace(n_coef, capacity, None)  # W_RADAU None: W_STIFF holds Radau's views once
+        assert ws[record.W_RADAU] is None
+        views = sorted(members(ws[:record.W_RADAU]), key=lambda a: a.__array_interface__["data"][0])
         starts = [a.__array_interface__["data"][0] for a in views]
         ends = [start + a.nbytes for start, a in zip(starts, views, strict=True)]
         assert all(end <= start for end, start in zip(ends, starts[1:], strict=False))  # no overlap
@@ -152,6 +154,6 @@ def test_the_workspace_members_tile_one_buffer():
         assert all(start % 16 == 0 for start, a in zip(starts, views, strict=True) if a.dtype == np.complex128)
         assert all(not a.any() for a in views)
         assert len(views) == 22 and {a.dtype for a in views} == {np.dtype(t) for t in (float, np.int64, bool, complex)}
-        ws = record.workspace(n_coef, capacity)  # the y rows where a host reads a run's state (record.Y_AT)
+        ws = record.workspace(n_coef, capacity, True)  # the y rows where a host reads a run's state (record.Y_AT)
         base = min(a.__array_interface__["data"][0] for a in members(ws))
         assert ws[record.W_Y].__array_interface__["data"][0] - base == 8 * record.Y_AT

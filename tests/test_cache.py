@@ -114,15 +114,17 @@ def test_every_module_with_a_compiled_function_is_in_the_digest():
     assert "integrate/_dop853_codegen.py" not in _jit.engine_sources()
 
 
-def test_numba_overloads_are_only_for_the_gpu():
-    """The digest leaves numba's ``overload`` out of what compiles: the package's are all for the
-    CUDA target, which is not cached. A CPU overload would change the engine's code from where it
-    is registered and must join the digest first."""
+def test_numba_overloads_are_for_the_gpu_or_in_the_digest():
+    """The digest leaves numba's ``overload`` out of what compiles: the package's are for the CUDA
+    target, which is not cached, or in a module of the digest. A CPU overload changes the engine's
+    code from where it is registered (record.py's chooses the workspace's ``W_RADAU``)."""
     package = ROOT / "phaseimpact"
     overloads = {path.relative_to(package).as_posix(): re.findall(r"@overload\((.*)\)", path.read_text())
                  for path in package.rglob("*.py") if "@overload(" in path.read_text()}
-    assert list(overloads) == ["cuda.py"]
+    assert sorted(overloads) == ["cuda.py", "integrate/record.py"]
     assert all('target="cuda"' in call for call in overloads["cuda.py"])
+    cpu = {name for name, calls in overloads.items() if any('target="cuda"' not in call for call in calls)}
+    assert cpu == {"integrate/record.py"} and cpu <= set(_jit.engine_sources())
 
 
 def test_the_import_reader_finds_what_ast_finds_in_every_file():

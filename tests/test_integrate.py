@@ -280,6 +280,82 @@ def test_the_stiff_switch_keeps_the_columns():
         np.testing.assert_allclose(stiff.values[name], explicit.values[name], rtol=1e-7, equal_nan=True)
 
 
+@pytest.fixture
+def radau_not_met(monkeypatch):
+    """This process as at its start: no run has turned stiff, the engine runs without Radau."""
+    from phaseimpact.integrate import api
+
+    monkeypatch.setattr(api._Radau, "met", False)
+    return api._Radau
+
+
+def test_radaus_steps_are_called_only_through_the_member_an_engine_without_them_has_as_none():
+    """Radau's steps (the functions that hold its Newton iterations and factorisations) take the
+    workspace's ``W_RADAU``, None in an engine without them: a call with ``W_STIFF`` (the tuple every
+    run carries for the stiffness watch) would compile them into every first command again, with
+    nothing failing. Read from the source (ast): each call's ``stiff`` argument is ``ws[W_RADAU]``."""
+    import ast
+    import inspect
+    from pathlib import Path
+
+    from phaseimpact.integrate import radau5
+
+    steps = ("enter", "attempt", "fixed_step", "dense_coefficients")
+    position = {name: list(inspect.signature(getattr(radau5, name).py_func).parameters).index("stiff")
+                for name in steps}
+    calls = []
+    for path in sorted((Path(radau5.__file__).parent).glob("*.py")):
+        for node in ast.walk(ast.parse(path.read_text())):
+            if isinstance(node, ast.Call) and isinstance(node.func, ast.Attribute) and node.func.attr in steps \
+                    and isinstance(node.func.value, ast.Name) and node.func.value.id == "radau5":
+                calls.append((path.name, node.func.attr, ast.unparse(node.args[position[node.func.attr]])))
+    assert {name for _, name, _ in calls} == set(steps)  # the scan finds every one
+    assert all(stiff == "ws[W_RADAU]" for _, _, stiff in calls), calls
+
+
+def test_an_engine_without_radau_stops_where_the_run_turns_stiff(radau_not_met):
+    """driver.run with ``radau`` None (the engine compiled without its stiff solver) stops with
+    NEEDS_RADAU where the creep turns stiff, before the run with Radau ends; simulate then runs it
+    again with Radau, and from then on this process runs with it (api.radau_marker)."""
+    from phaseimpact.integrate import api
+    from phaseimpact.integrate import driver as d
+    from phaseimpact.model.laws import as_law
+    from phaseimpact.model.rhs import pack
+
+    law = as_law("paper")
+    s = scales(STIFF_CREEP)
+    args = (law.code, pack(STIFF_CREEP, law), api._initial(STIFF_CREEP, None), api._atol(STIFF_CREEP, 1e-10, None),
+            s.horizon, s.max_step, (1e-10, True, -1, 0, api.MAX_STEPS, api.MAX_EVENTS, api._stiff_after(True)),
+            d.SAVE_SUMMARY, np.empty(0))
+    without, with_radau = d.run(*args, None)[0], d.run(*args, True)[0]
+    assert without[d.S_STATUS] == d.NEEDS_RADAU and with_radau[d.S_STATUS] == d.SUCCESS
+    assert 0 < without[d.S_T_STOP] < with_radau[d.S_T_STOP]
+    assert api.radau_marker(api._stiff_after(True)) is None
+    tr = simulate(STIFF_CREEP, "paper")
+    assert tr.status == "success" and tr.nsteps == with_radau[d.S_NSTEPS] and tr.t_stop == with_radau[d.S_T_STOP]
+    assert radau_not_met.met is True and api.radau_marker(api._stiff_after(True)) is True
+    assert api.radau_marker(api._stiff_after(False)) is None  # DOP853 throughout never needs it
+
+
+@pytest.mark.parametrize("n_threads", [1, 2])
+def test_runs_without_radau_give_the_bits_of_runs_with_it(radau_not_met, n_threads):
+    """A batch whose runs partly turn stiff, run first without Radau (its stiff runs again with it)
+    and then with Radau from the start: the same columns, bit for bit; a non-stiff trajectory alike."""
+    points = [SEED.replace(kappa=float(k), v=float(v)) for k in np.geomspace(1e10, 1e15, 6) for v in (0.4, 9.0)]
+    first = simulate_many(points, "paper", n_threads=n_threads)
+    assert radau_not_met.met is True  # some of them turned stiff
+    again = simulate_many(points, "paper", n_threads=n_threads)
+    assert set(first.values) == set(again.values)
+    for name, column in first.values.items():
+        np.testing.assert_array_equal(np.asarray(column), np.asarray(again.values[name]), err_msg=name)
+    np.testing.assert_array_equal(first.stick_delta, again.stick_delta)
+    with_radau = simulate(SEED.replace(kappa=3e9), "hunt-crossley", 2e-3, save="steps")
+    radau_not_met.met = False
+    without = simulate(SEED.replace(kappa=3e9), "hunt-crossley", 2e-3, save="steps")
+    np.testing.assert_array_equal(without.y, with_radau.y)
+    np.testing.assert_array_equal(without.summary, with_radau.summary)
+
+
 def test_stiff_must_be_a_bool():
     with pytest.raises(ValueError, match="stiff"):
         simulate(SEED, "paper", stiff="yes")

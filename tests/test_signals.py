@@ -41,7 +41,7 @@ def _run_args(params, law, t_end):
     s = api.scales(params)
     return (law.code, pack(params, law), api._initial(params, None), api._atol(params, 1e-10, None), t_end,
             s.max_step, (1e-10, True, -1, 0, api.MAX_STEPS, api.MAX_EVENTS, api._stiff_after(True)), d.SAVE_SUMMARY,
-            np.empty(0))
+            np.empty(0), True)
 
 
 @pytest.fixture
@@ -105,7 +105,7 @@ def _interrupted_block(pipe, start: int, step: int) -> np.ndarray:
     os.write(pipe, b"\x02")
     d.run_block(batch.law.code, (batch.C, batch.Y0, batch.t_end, batch.atol, batch.max_step),
                 (1e-10, True, -1, 0, api.MAX_STEPS, api.MAX_EVENTS, api._stiff_after(True)), start, n, step,
-                (summary, *st, count), np.zeros(workspace_size(batch.C.shape[1], 32)))
+                (summary, *st, count), np.zeros(workspace_size(batch.C.shape[1], 32)), True)
     return summary[:, d.S_STATUS]
 
 
@@ -140,7 +140,7 @@ def test_threads_start_no_task_after_one_was_interrupted(pipe):
     batches._run_in_threads((batch.law.code, (batch.C, batch.Y0, batch.t_end, batch.atol, batch.max_step),
                              (1e-10, True, -1, 0, api.MAX_STEPS, api.MAX_EVENTS, api._stiff_after(True))),
                             (summary, *st, np.empty(n, np.int64)),
-                            np.zeros((threads, workspace_size(batch.C.shape[1], 32))), n)
+                            np.zeros((threads, workspace_size(batch.C.shape[1], 32))), n, True)
     status = summary[:, d.S_STATUS]
     ran = status == d.SUCCESS
     assert np.all(ran | (status == d.INTERRUPTED))  # every run accounted for, none left untouched

@@ -276,6 +276,36 @@ def _save(save, horizon: float, t_end):
 _STIFF_ON = np.int64(radau5.STIFF_STEPS)
 
 
+class _Radau:
+    """Whether a run of this process has turned stiff (:func:`radau_marker`)."""
+
+    met = False
+
+
+def radau_marker(stiff_after) -> bool | None:
+    """The driver entries' ``radau`` argument (:func:`.record.carve`): None, the engine compiled and
+    run without its stiff solver, until a run of this process turns stiff; True from then on.
+
+    A first command compiles about a fifth less when its runs never turn stiff. A run that does
+    stops there with the status ``NEEDS_RADAU`` and its caller runs it again with True: the same
+    kernels up to the switch, so the same numbers (:func:`again_with_radau`)."""
+    return True if _Radau.met and stiff_after else None
+
+
+def radau_needed() -> None:
+    """A run of this process turned stiff: :func:`radau_marker` gives True from now on."""
+    _Radau.met = True
+
+
+def again_with_radau(status) -> bool:
+    """Whether a run with ``radau`` None stopped where it turned stiff (its caller runs it again with
+    :func:`radau_marker`, which now gives True)."""
+    if status == d.NEEDS_RADAU:
+        radau_needed()
+        return True
+    return False
+
+
 def _stiff_after(stiff) -> np.int64:
     """The driver's switch: DOP853 steps at the stability limit before Radau takes over (0: never)."""
     if stiff is True:  # the common case, without the isinstance of a union
@@ -411,8 +441,10 @@ def simulate(params: Parameters, law: ContactLaw | str = "paper", t_end: float |
         else:
             out = d.run(law.code, c, y0, default_atol if atol is None else _atol(params, rtol, atol), horizon,
                         s.max_step, (rtol, settle, stop_kind, stop_count, int(max_steps), MAX_EVENTS, stiff_after),
-                        save_kind, times)
+                        save_kind, times, radau_marker(stiff_after))
         codes = out[0].tolist()  # the summary's numbers: cheaper than reading entries of the array one by one
+        if again_with_radau(codes[d.S_STATUS]):
+            continue
         woken = _woken(codes[d.S_STATUS], native)
         if not (woken or _signals.deferred):
             break
@@ -445,7 +477,18 @@ def _integrator_name(rk4_step: float, rtol: float, stiff: bool) -> str:
     return f"exact[{'DOP853+Radau5' if stiff else 'DOP853'}, rtol={rtol:g}]"
 
 
-_held = threading.local()  # each thread's workspace for summary_run: made once, reused run after run
+_held = threading.local()  # each thread's workspaces for summary_run: made once, reused run after run
+
+
+def _held_workspace(radau):
+    """This thread's workspace for :func:`summary_run`, one for each ``radau`` (:func:`radau_marker`)."""
+    held = getattr(_held, "workspaces", None)
+    if held is None:
+        held = _held.workspaces = {}
+    ws = held.get(radau)
+    if ws is None:
+        ws = held[radau] = workspace(N_COEF, 0, radau)  # no stick points kept: their count is in the summary
+    return ws
 
 
 def summary_run(params: Parameters, law: ContactLaw | str = "paper", t_end: float | None = None, *,
@@ -468,17 +511,18 @@ def summary_run(params: Parameters, law: ContactLaw | str = "paper", t_end: floa
     horizon = s.horizon if t_end is None else check_t_end(t_end, s.contact_time)
     y0 = seed_state if initial is None else _initial(params, initial)
     batch = (c[None], y0[None], np.array([horizon]), default_atol[None], np.array([s.max_step]))
-    options = (rtol, settle, stop_kind, stop_count, MAX_STEPS, MAX_EVENTS, _stiff_after(True))
-    ws = getattr(_held, "workspace", None)
-    if ws is None:
-        ws = _held.workspace = workspace(N_COEF, 0)  # no stick points kept: their count is in the summary
+    stiff_after = _stiff_after(True)
+    options = (rtol, settle, stop_kind, stop_count, MAX_STEPS, MAX_EVENTS, stiff_after)
     if not _signals.installed:
         _signals.install()
     native = law.entry.native
     while True:
         if native is not None:
             native.reset()
+        ws = _held_workspace(radau_marker(stiff_after))
         d.run_held(law.code, ws, batch, options, 0)
+        if again_with_radau(ws[W_SUMMARY][d.S_STATUS]):
+            continue
         woken = _woken(ws[W_SUMMARY][d.S_STATUS], native)
         if not (woken or _signals.deferred):
             break

@@ -38,12 +38,15 @@ from .api import (
     _stiff_after,
     _stop_on,
     _woken,
+    again_with_radau,
     check_bool,
     check_params,
     check_real,
     check_rtol,
     check_t_end,
     hertz_contact_time,
+    radau_marker,
+    radau_needed,
     state_tolerances,
 )
 from .record import workspace_size
@@ -178,10 +181,11 @@ def run_batch(batch: Batch, *, rtol: float, settle: bool = True, stop_on=None, n
             from .. import cuda
 
             cuda.run_batch_cuda(*args, outputs)
-        elif threads == 1:
-            d.run_block(*args, 0, n, 1, outputs, work[0])
         else:
-            _run_in_threads(args, outputs, work, n)
+            radau = radau_marker(stiff_after)
+            _run_block(args, outputs, work, radau)
+            if radau is None:
+                _again_with_radau(args, outputs, work, stiff_after)
         woken = bool(np.any(summary[:, d.S_STATUS] == d.INTERRUPTED)) or _woken(d.SUCCESS, native)
         if not (woken or _signals.deferred):
             break
@@ -202,6 +206,32 @@ def run_batch(batch: Batch, *, rtol: float, settle: bool = True, stop_on=None, n
         offset = int(np.minimum(count[:i], capacity).sum())
         points = [np.concatenate([p[:offset], full[j], p[offset + capacity:]]) for j, p in enumerate(points)]
     return Columns.from_summary(summary, count, *points)
+
+
+def _run_block(args: tuple, outputs: tuple, work: np.ndarray, radau) -> None:
+    """Every run of the batch in ``args`` (:func:`~.driver.run_block`'s arguments) in ``len(work)``
+    threads; ``radau``: :func:`~.api.radau_marker`."""
+    n = len(outputs[d.O_SUMMARY])
+    if len(work) == 1:
+        d.run_block(*args, 0, n, 1, outputs, work[0], radau)
+    else:
+        _run_in_threads(args, outputs, work, n, radau)
+
+
+def _again_with_radau(args: tuple, outputs: tuple, work: np.ndarray, stiff_after) -> None:
+    """The runs that stopped where they turned stiff (an engine without Radau: :func:`.api.radau_marker`)
+    run again with it, their rows of ``outputs`` replaced."""
+    status = outputs[d.O_SUMMARY][:, d.S_STATUS]
+    again = np.flatnonzero(status == d.NEEDS_RADAU)
+    if again.size == 0:
+        return
+    radau_needed()
+    code, batch, options = args
+    rows = tuple(column[again] for column in outputs)
+    _run_block((code, tuple(column[again] for column in batch), options), rows, work[:again.size],
+               radau_marker(stiff_after))
+    for column, row in zip(outputs, rows, strict=True):
+        column[again] = row
 
 
 #: Tasks a threaded chunk is cut into, per thread. Task j runs the runs j, j + tasks, ... (the cost
@@ -233,7 +263,7 @@ def thread_tasks(n: int, threads: int) -> list[tuple[int, int, int]]:
     return [(j, head, tasks) for j in range(tasks)] + [(head + j, n, tail_tasks) for j in range(tail_tasks)]
 
 
-def _run_in_threads(args: tuple, outputs: tuple, work: np.ndarray, n: int) -> None:
+def _run_in_threads(args: tuple, outputs: tuple, work: np.ndarray, n: int, radau) -> None:
     """:func:`~.driver.run_block` over ``len(work)`` threads (the driver releases the GIL), in
     interleaved tasks (:func:`thread_tasks`) taken as threads come free, each in a workspace no
     running task holds."""
@@ -251,7 +281,7 @@ def _run_in_threads(args: tuple, outputs: tuple, work: np.ndarray, n: int) -> No
             return
         ws = free.get()
         try:
-            d.run_block(*args, start, stop, step, outputs, ws)
+            d.run_block(*args, start, stop, step, outputs, ws, radau)
         finally:
             free.put(ws)
         if np.any(status[start:stop:step] == d.INTERRUPTED):
@@ -268,8 +298,10 @@ def _run_one(batch: Batch, i: int, rtol, settle, stop_kind, stop_count, stiff_af
             native.reset()
         out = d.run(batch.law.code, batch.C[i], batch.Y0[i], batch.atol[i], batch.t_end[i], batch.max_step[i],
                     (rtol, settle, stop_kind, stop_count, MAX_STEPS, MAX_EVENTS, stiff_after), d.SAVE_SUMMARY,
-                    _NO_TIMES)
+                    _NO_TIMES, radau_marker(stiff_after))
         codes = out[0].tolist()  # the summary's numbers: cheaper than reading entries of the array one by one
+        if again_with_radau(codes[d.S_STATUS]):
+            continue
         woken = _woken(codes[d.S_STATUS], native)
         if not (woken or _signals.deferred):
             return out

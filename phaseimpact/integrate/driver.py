@@ -147,6 +147,7 @@ from .step import (
     ADV_COLLAPSE,
     ADV_END,
     ADV_LIMIT,
+    ADV_NEEDS_RADAU,
     advance,
     locate_events,
     phase_step,
@@ -159,6 +160,10 @@ from .step import (
 # Run status (numerical health) and why the run stopped.
 SUCCESS, STEP_SIZE_COLLAPSE, TOO_MANY_STEPS, NON_FINITE, INTERRUPTED = range(5)
 STATUSES = ("success", "step-size-collapse", "too-many-steps", "non-finite", "interrupted")
+#: A run of an engine compiled without its stiff solver (``radau`` None, :func:`.record.carve`) that
+#: turned stiff: it stopped there, and its caller runs it again with Radau (:func:`.api.radau_marker`).
+#: Never a result: no name in ``STATUSES``.
+NEEDS_RADAU = len(STATUSES)
 #: Steps between two looks for Ctrl-C or SIGTERM (``_signals.interrupted``, a system call):
 #: milliseconds of work, so a run stops well within a second at no measurable cost.
 POLL_STEPS = 4096
@@ -313,6 +318,9 @@ def _loop(code, ws, ev, smp, times):
             break
         if result == ADV_COLLAPSE:
             ints[I_STATUS], ints[I_REASON] = STEP_SIZE_COLLAPSE, FAILED_STOP
+            break
+        if result == ADV_NEEDS_RADAU:
+            ints[I_STATUS], ints[I_REASON] = NEEDS_RADAU, FAILED_STOP
             break
         if result == ADV_LIMIT:
             if ints[I_NSTEPS] < ints[I_MAX_STEPS]:
@@ -546,16 +554,17 @@ def new_logs(save_kind, times):
 
 
 @allocating(python=True, nogil=True)  # runs side by side in threads (phaseimpact.train's orbit diagrams)
-def run(code, c, y0, atol, t_end, max_step, options, save_kind, times):
+def run(code, c, y0, atol, t_end, max_step, options, save_kind, times, radau):
     """Integrate one trajectory. See :func:`phaseimpact.integrate.simulate` for the meaning;
-    ``options`` is the tuple ``OPT_*``.
+    ``options`` is the tuple ``OPT_*``; ``radau`` None compiles and runs the engine without its stiff
+    solver (:func:`.record.carve`: a run that turns stiff stops with the status ``NEEDS_RADAU``).
 
     Returns ``(summary, events, samples, y_final)``: the event log (columns ``EV_*``) and the
     samples (columns ``SMP_*``) trimmed to their lengths. The per-point kernels of
     :func:`run_block` in a workspace of its own, with logs that grow (by doubling) whenever
     :func:`_loop` says they may not hold one more pass. The seed's RK4 is :func:`.rk4.run_rk4`.
     """
-    ws = workspace(c.shape[0], 0)
+    ws = workspace(c.shape[0], 0, radau)
     copy_values(c, ws[W_C])
     copy_values(y0, ws[W_Y][Y_START])
     copy_values(atol, ws[W_ATOL])
@@ -602,7 +611,7 @@ def run_point_into(code, ws, batch, options, i, outputs):
 
 
 @kernel(python=True, nogil=True)
-def run_block(code, batch, options, start, stop, step, outputs, work):
+def run_block(code, batch, options, start, stop, step, outputs, work, radau):
     """Runs ``start, start + step, ...`` (below ``stop``) of a batch, without the GIL (callers run
     blocks in threads; each run's numbers depend on nothing else). Fills ``outputs`` (the tuple
     ``O_*``): the summaries (n, N_SUMMARY), the first ``capacity`` stick points of each run and its
@@ -615,11 +624,12 @@ def run_block(code, batch, options, start, stop, step, outputs, work):
     ``interrupted``.
 
     ``work`` is the block's workspace, a buffer of :func:`.record.workspace_size` numbers the caller
-    made (one per thread); each run goes through :func:`run_point` in it, without an event log.
+    made (one per thread); each run goes through :func:`run_point` in it, without an event log;
+    ``radau`` as for :func:`run`.
     Allocates nothing, and being a kernel (no reference counting) takes its arguments from Python
     without numba's runtime either: a chunk of runs makes no numba allocation at all."""
     summary = outputs[O_SUMMARY]
-    ws = carve(work, batch[B_C].shape[1], outputs[O_STICK_T].shape[1])
+    ws = carve(work, batch[B_C].shape[1], outputs[O_STICK_T].shape[1], radau)
     done = 0
     for i in range(start, stop, step):
         done += 1

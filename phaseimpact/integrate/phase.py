@@ -29,6 +29,7 @@ from .record import (
     U_U,
     W_C,
     W_INT,
+    W_RADAU,
     W_REAL,
     W_STIFF,
     W_U,
@@ -172,6 +173,6 @@ def fresh_step(code, ws, h, u_new, fu_new):
         rhs_integration(code, c, u_new, mode, side, fu_new)
         return 0
     if radau5.active(stiff):
-        return radau5.fixed_step(code, c, mode, side, s, h, stiff, (u, fu, u_new, fu_new))
+        return radau5.fixed_step(code, c, mode, side, s, h, ws[W_RADAU], (u, fu, u_new, fu_new))
     dop853.step(code, c, mode, side, u, fu, h, K, u_new, fu_new)
     return 12

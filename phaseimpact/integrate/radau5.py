@@ -188,6 +188,8 @@ def due(stiff):
 @kernel(python=True)
 def enter(code, c, mode, side, u, fu, rtol, atol, stiff):
     """Switch the phase to Radau at ``(u, fu)``; returns the evaluations spent (the Jacobian)."""
+    if stiff is None:  # an engine compiled without the stiff solver (record.carve): pruned, never run
+        return 0
     ws, ctl = stiff[WS], stiff[CTL]
     inner = INNER_SCALE * rtol ** (2.0 / 3.0)
     ctl[ON] = 1.0
@@ -438,6 +440,8 @@ def attempt(code, c, mode, side, s, s_bound, h_abs, stiff, rows):
     Returns ``(ok, s_new, h_next, force_new, evaluations)``; ``ok`` False when the step size
     collapsed. The step's stages stay in the workspace for :func:`dense_coefficients`.
     """
+    if stiff is None:  # an engine compiled without the stiff solver (record.carve): pruned, never run
+        return False, s, h_abs, 0.0, 0
     ws, ctl = stiff[WS], stiff[CTL]
     u, fu, u_new, fu_new = rows
     rtol = ctl[RTOL]
@@ -501,6 +505,8 @@ def fixed_step(code, c, mode, side, s, h, stiff, rows):
     """A step of exactly ``h`` (to an event's root) from ``u`` into ``u_new``, ``fu_new`` (``rows =
     (u, fu, u_new, fu_new)``) without error control, split into equal sub-steps until Newton
     converges. Returns the evaluations spent."""
+    if stiff is None:  # an engine compiled without the stiff solver (record.carve): pruned, never run
+        return 0
     u, fu, u_new, fu_new = rows
     evaluations = 0
     start, f_start = stiff[START], stiff[F_START]
@@ -535,6 +541,8 @@ def fixed_step(code, c, mode, side, s, h, stiff, rows):
 def dense_coefficients(stiff, F):
     """The step's collocation polynomial in the driver's interpolant form (:func:`.dop853.dense_eval`:
     ``F0 x + F1 x(1-x) + F2 x^2(1-x)`` with the higher rows zero)."""
+    if stiff is None:  # an engine compiled without the stiff solver (record.carve): pruned, never run
+        return
     ws = stiff[WS]
     for j in range(N_STATE):
         q1, q2, q3 = ws[Q_, j], ws[Q_ + 1, j], ws[Q_ + 2, j]

@@ -14,6 +14,8 @@ costs about 30 ns, a row nothing).
 from __future__ import annotations
 
 import numpy as np
+from numba import types
+from numba.extending import overload
 
 from .._jit import allocating, kernel
 from . import radau5
@@ -44,8 +46,12 @@ N_U_ROWS = U_DENSE + N_DENSE
 STAT_MAX_FORCE, STAT_MAX_INDENTATION = 0, 1
 N_STATS = 2
 
-# Members of the workspace tuple (numba indexes a tuple's members of different types by constants):
-(W_REAL, W_INT, W_C, W_ATOL, W_Y, W_G, W_FIRED, W_U, W_STATS, W_COUNTS, W_SUMMARY, W_STICKS, W_STIFF) = range(13)
+# Members of the workspace tuple (numba indexes a tuple's members of different types by constants).
+# W_STIFF: Radau's tuple (radau5.carve), whose controller watches for stiffness in every run;
+# W_RADAU: the same tuple where the engine is compiled with its stiff solver, None where it is not
+# (:func:`carve`).
+(W_REAL, W_INT, W_C, W_ATOL, W_Y, W_G, W_FIRED, W_U, W_STATS, W_COUNTS, W_SUMMARY, W_STICKS, W_STIFF,
+ W_RADAU) = range(14)
 # The run's record: its scalars (W_REAL) ...
 (R_S, R_H, R_H_ABS, R_H_NEXT, R_FORCE, R_FORCE_NEW, R_T_END, R_RTOL, R_MAX_STEP, R_STIFF_AFTER, R_FLIGHT_STEP,
  R_W_FLOOR, R_ENERGY_LIMIT, R_PAIR_ENERGY, R_T_STOP, R_CONTACT_T, R_CONTACT_SPEED, R_CONTACT_DURATION, R_RESTITUTION,
@@ -83,9 +89,15 @@ def workspace_size(n_coef, capacity):
 
 
 @kernel(inline="always")  # typed in each caller: its views are the caller's own (counted where it counts)
-def carve(buf, n_coef, capacity):
+def carve(buf, n_coef, capacity, radau):
     """The workspace (members ``W_*``) as views of ``buf`` (:func:`workspace_size` numbers, zeros
-    or a previous run's: every run sets what it reads); allocates nothing."""
+    or a previous run's: every run sets what it reads); allocates nothing.
+
+    ``radau`` None leaves the stiff solver out of the engine compiled for this workspace: its
+    ``W_RADAU`` is None (:func:`radau_member`), numba prunes the branches on it and never compiles
+    :mod:`.radau5`'s steps. A run that turns stiff then stops with the status ``NEEDS_RADAU``, and
+    its caller runs it again in a workspace whose ``W_RADAU`` is Radau's tuple (``radau`` True;
+    :func:`.api.radau_marker`): the same kernels up to the switch, so the same numbers."""
     o = radau5.WORKSPACE_SIZE
     stiff = radau5.carve(buf[:o])
     real = buf[o:o + N_REAL]
@@ -111,11 +123,25 @@ def carve(buf, n_coef, capacity):
     c = buf[o:o + n_coef]
     o += n_coef
     sticks = buf[o:o + 3 * capacity].reshape((3, capacity))
-    return real, ints, c, atol, y, g, fired, u, stats, counts, summary, sticks, stiff
+    return real, ints, c, atol, y, g, fired, u, stats, counts, summary, sticks, stiff, radau_member(radau, stiff)
+
+
+def radau_member(radau, stiff):
+    """The workspace's ``W_RADAU``: None where ``radau`` is None, else Radau's tuple ``stiff``."""
+    return None if radau is None else stiff
+
+
+@overload(radau_member, inline="always", target="generic")  # the CPU and the GPU (phaseimpact.cuda)
+def _radau_member(radau, stiff):
+    # chosen on radau's type as numba types the caller: a branch on radau would be pruned only for
+    # None, and for True would unify None and the tuple into an Optional the kernels cannot index
+    if isinstance(radau, types.NoneType):
+        return lambda radau, stiff: None
+    return lambda radau, stiff: stiff
 
 
 @allocating(python=True)
-def workspace(n_coef, capacity):
+def workspace(n_coef, capacity, radau):
     """A workspace of its own (members ``W_*``; one allocation), reused run after run; ``capacity``
-    stick points."""
-    return carve(np.zeros(workspace_size(n_coef, capacity)), n_coef, capacity)
+    stick points; ``radau`` as for :func:`carve`."""
+    return carve(np.zeros(workspace_size(n_coef, capacity)), n_coef, capacity, radau)

@@ -87,7 +87,7 @@ def run_rk4(code, c, y0, t_end, save_kind, times, max_steps, rk4_step, rk4_every
     linearly); with ``save_kind`` steps, every ``rk4_every``-th step is kept. Returns what
     :func:`run` does. An entry of its own, not a branch of :func:`run`: the first compile of a run
     that does not ask for it leaves it out."""
-    ws = workspace(c.shape[0], 0)  # the run's record, logs and summary (driver.run's)
+    ws = workspace(c.shape[0], 0, None)  # the run's record, logs and summary (driver.run's); no Radau
     ints, stats, y = ws[W_INT], ws[W_STATS], ws[W_Y][Y_STATE]
     copy_values(c, ws[W_C])
     copy_values(y0, ws[W_Y][Y_START])

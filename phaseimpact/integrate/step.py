@@ -109,6 +109,7 @@ from .record import (
     W_FIRED,
     W_G,
     W_INT,
+    W_RADAU,
     W_REAL,
     W_STATS,
     W_STIFF,
@@ -130,7 +131,7 @@ from .spacing import ulp_above
 OBSERVED_MIN_FACTOR = 0.01
 _TINY = np.finfo(np.float64).tiny
 
-ADV_END, ADV_STEP, ADV_COLLAPSE, ADV_LIMIT = range(4)
+ADV_END, ADV_STEP, ADV_COLLAPSE, ADV_LIMIT, ADV_NEEDS_RADAU = range(5)
 
 
 @kernel
@@ -228,10 +229,13 @@ def advance(code, ws, next_sample, steps_left):
             # a regularised phase advances the time by w ds: its cap on the time step is one on s
             h_abs = min(h_abs, max_step if not regularised(side) else max_step / max(abs(u[0]), w_floor))
             if radau5.due(stiff):  # entered from an accepted state, so that every step has one method
-                evaluations += radau5.enter(code, c, mode, side, u, fu, real[R_RTOL], ur[U_ATOL], stiff)
+                if ws[W_RADAU] is None:  # an engine compiled without Radau: the caller runs this again with it
+                    _advanced(real, s, h, h_abs, h_next, force, force_new)
+                    return ADV_NEEDS_RADAU, steps, evaluations
+                evaluations += radau5.enter(code, c, mode, side, u, fu, real[R_RTOL], ur[U_ATOL], ws[W_RADAU])
             if radau5.active(stiff):
-                ok, s_new, h_next, force_new, spent = radau5.attempt(code, c, mode, side, s, s_bound, h_abs, stiff,
-                                                                     (u, fu, u_new, fu_new))
+                ok, s_new, h_next, force_new, spent = radau5.attempt(code, c, mode, side, s, s_bound, h_abs,
+                                                                     ws[W_RADAU], (u, fu, u_new, fu_new))
             else:
                 ok, s_new, h_next, force_new, spent = _dop853_attempt(code, ws, s, s_bound, h_abs)
         evaluations += spent
@@ -469,7 +473,7 @@ def step_interpolant(code, ws):
         copy_values(K[0], F[0])  # the flight's invariants
         return 0
     if radau5.active(stiff):
-        radau5.dense_coefficients(stiff, F)
+        radau5.dense_coefficients(ws[W_RADAU], F)
         return 0
     dop853.dense_coefficients(code, ws[W_C], ints[I_MODE], side, ur[U_U], ur[U_FU], ur[U_NEW], ur[U_FU_NEW],
                               ws[W_REAL][R_H], K, F, ur[U_TMP])
