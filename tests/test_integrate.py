@@ -337,6 +337,29 @@ def test_an_engine_without_radau_stops_where_the_run_turns_stiff(radau_not_met):
     assert api.radau_marker(api._stiff_after(False)) is None  # DOP853 throughout never needs it
 
 
+def test_a_stiff_run_is_remembered_by_the_processes_that_share_the_cache(tmp_path, monkeypatch):
+    """After a run turned stiff, a new process with the same cache starts with the engine with Radau
+    (the file api.RADAU_MET_FILE in the cache): the driver is not compiled twice on one machine.
+    Without a cache, only the process itself remembers."""
+    from types import SimpleNamespace
+
+    from phaseimpact.integrate import api
+
+    on = api._stiff_after(True)
+    monkeypatch.setattr(api, "cache_info", lambda: SimpleNamespace(path=tmp_path))
+    monkeypatch.setattr(api._Radau, "met", None)  # a process that has not looked yet
+    assert api.radau_marker(on) is None and not (tmp_path / api.RADAU_MET_FILE).exists()
+    api.radau_needed()
+    assert api.radau_marker(on) is True and (tmp_path / api.RADAU_MET_FILE).exists()
+    monkeypatch.setattr(api._Radau, "met", None)  # the next process
+    assert api.radau_marker(on) is True and api.radau_marker(api._stiff_after(False)) is None
+    monkeypatch.setattr(api, "cache_info", lambda: SimpleNamespace(path=None))
+    monkeypatch.setattr(api._Radau, "met", None)
+    assert api.radau_marker(on) is None
+    api.radau_needed()
+    assert api.radau_marker(on) is True
+
+
 @pytest.mark.parametrize("n_threads", [1, 2])
 def test_runs_without_radau_give_the_bits_of_runs_with_it(radau_not_met, n_threads):
     """A batch whose runs partly turn stiff, run first without Radau (its stiff runs again with it)

@@ -14,6 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .. import _signals
+from .._jit import cache_info
 from ..model.laws import ContactLaw, as_law
 from ..model.rhs import N_COEF, initial_state, pack
 from ..parameters import Parameters, is_number
@@ -276,25 +277,46 @@ def _save(save, horizon: float, t_end):
 _STIFF_ON = np.int64(radau5.STIFF_STEPS)
 
 
-class _Radau:
-    """Whether a run of this process has turned stiff (:func:`radau_marker`)."""
+#: In the engine's cache directory (:func:`phaseimpact._jit.cache_info`): a run on this machine has
+#: turned stiff, so the engine with Radau is (being) compiled there (:func:`radau_marker`).
+RADAU_MET_FILE = "radau-met"
 
-    met = False
+
+class _Radau:
+    """Whether a run has turned stiff, in this process or (its cache's ``RADAU_MET_FILE``) on this
+    machine; None until :func:`radau_marker` first looks."""
+
+    met = None
 
 
 def radau_marker(stiff_after) -> bool | None:
     """The driver entries' ``radau`` argument (:func:`.record.carve`): None, the engine compiled and
-    run without its stiff solver, until a run of this process turns stiff; True from then on.
+    run without its stiff solver, until a run turns stiff (in this process, or on this machine with
+    the same cache); True from then on.
 
-    A first command compiles about a fifth less when its runs never turn stiff. A run that does
-    stops there with the status ``NEEDS_RADAU`` and its caller runs it again with True: the same
-    kernels up to the switch, so the same numbers (:func:`again_with_radau`)."""
-    return True if _Radau.met and stiff_after else None
+    A first command whose runs never turn stiff compiles about a quarter less. A run that does stops
+    there with the status ``NEEDS_RADAU`` and its caller runs it again with True: the same kernels up
+    to the switch, so the same numbers (:func:`again_with_radau`). That first stiff run compiles the
+    driver a second time, with Radau (about two thirds of a first compile): once per machine, since
+    from then on every process that shares the cache compiles and runs only the engine with Radau."""
+    if not stiff_after:
+        return None
+    if _Radau.met is None:
+        path = cache_info().path
+        _Radau.met = path is not None and (path / RADAU_MET_FILE).exists()
+    return True if _Radau.met else None
 
 
 def radau_needed() -> None:
-    """A run of this process turned stiff: :func:`radau_marker` gives True from now on."""
+    """A run turned stiff: :func:`radau_marker` gives True from now on, here and (where the cache can
+    be written) in every later process that shares this cache."""
     _Radau.met = True
+    path = cache_info().path
+    if path is not None:
+        try:
+            (path / RADAU_MET_FILE).touch()  # an empty file: nothing to leave half-written
+        except OSError:
+            pass  # a cache no longer writable: this process alone knows
 
 
 def again_with_radau(status) -> bool:

@@ -41,19 +41,17 @@ def warmup() -> dict:
     before = [entry.stats.cache_misses.copy() for entry in entries]
     p = seed_parameters(v=1.0, kappa=3e9, limiting_pressure=2e9)  # p_y: read by the plastic law only
     stiff = p.replace(kappa=1e14, v=5.0)  # the stiff (Radau) path
-    met = api._Radau.met
-    for radau in (False, True):  # the engine without its stiff solver, then with it (api.radau_marker)
-        api._Radau.met = radau
-        for law in law_variants():
-            simulate(p, law, 2e-3)
-            simulate_many([p, stiff] if radau else [p], law, 2e-3)
-            summary_run(p, law, 2e-3)  # critical searches, impact maps
-        simulate(p, "paper", None, stop_on="slip")
-        simulate(p, "hunt-crossley", 2e-3, save="steps")
-        simulate_many([p, p.replace(kappa=1e12)], "paper", n_threads=2)
+    # the engine with Radau, which every later process that shares the cache then runs (api.radau_marker)
+    api.radau_needed()
+    for law in law_variants():
+        simulate(p, law, 2e-3)
+        simulate_many([p, stiff], law, 2e-3)
+        summary_run(p, law, 2e-3)  # critical searches, impact maps
+    simulate(p, "paper", None, stop_on="slip")
     simulate(stiff, "paper", 2e-3)
     simulate(p, "paper", 2e-4, integrator="rk4")
-    api._Radau.met = met or api._Radau.met
+    simulate(p, "hunt-crossley", 2e-3, save="steps")
+    simulate_many([p, p.replace(kappa=1e12)], "paper", n_threads=2)
     compiled = [entry.stats.cache_misses for entry in entries] != before
     files, size = _cache_files(info.path)
     return {"cache": None if info.path is None else str(info.path), "writable": info.path is not None,
