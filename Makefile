@@ -38,7 +38,7 @@ docs: $(STAMP)
 # beyond the tolerance README.md states, so a clean checkout stays clean on any machine;
 # QUICK=1 previews go to figures/preview/ (git-ignored), never over figures/.
 reproduce: $(STAMP)
-	$(BIN)/phaseimpact warmup
+	$(BIN)/python -m phaseimpact warmup
 	$(BIN)/python studies/run_all.py $(if $(QUICK),--quick) --jobs $(JOBS)
 
 # The engine's tests on the oldest and the newest numba pyproject.toml allows (numba>=0.59,<0.69),

@@ -294,11 +294,12 @@ def radau_marker(stiff_after) -> bool | None:
     run without its stiff solver, until a run turns stiff (in this process, or on this machine with
     the same cache); True from then on.
 
-    A first command whose runs never turn stiff compiles about a quarter less. A run that does stops
-    there with the status ``NEEDS_RADAU`` and its caller runs it again with True: the same kernels up
-    to the switch, so the same numbers (:func:`again_with_radau`). That first stiff run compiles the
-    driver a second time, with Radau (about two thirds of a first compile): once per machine, since
-    from then on every process that shares the cache compiles and runs only the engine with Radau."""
+    A first command whose runs never turn stiff compiles in about 0.8 of the time. A run that does
+    stops there with the status ``NEEDS_RADAU`` and its caller runs it again with True: the same
+    kernels up to the switch, so the same numbers (:func:`again_with_radau`). That first stiff run
+    compiles the driver a second time, with Radau (about 45 s more on 2 cores): once per machine,
+    since from then on every process that shares the cache runs only the engine with Radau
+    (``benchmarks/compile_profile.py --against``)."""
     if not stiff_after:
         return None
     if _Radau.met is None:
