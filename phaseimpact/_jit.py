@@ -37,9 +37,11 @@ the two kernels that return views: typed in each caller, their views are the cal
 A kernel that takes a run's workspace and runs once per step or event (the root finders, the
 event handling: :mod:`.integrate.step`, :mod:`.integrate.rootfind`, the driver's step kernels)
 says ``forceinline=True`` too, and so do the event function, the interpolant and the physical
-state the root finders call. The workspace is a tuple of 22 arrays passed by value: the LLVM
-functions that took it had 174 to 202 parameters. Numba gives its functions ``linkonce_odr``
-linkage, so LLVM may not drop the arguments a callee never reads, and each call copied them all.
+state the root finders call. The workspace is a tuple of arrays passed by value (13, and the stiff
+solver's ten where the engine has that solver: :func:`.integrate.record.carve`), some seven LLVM
+parameters an array: with 22 arrays, the functions that took it had 174 to 202 parameters. Numba
+gives its functions ``linkonce_odr`` linkage, so LLVM may not drop the arguments a callee never
+reads, and each call copied them all.
 What runs a few times per run stays a call: the entries, the loop (``_loop``), its start and end,
 and :func:`.integrate.step.advance` (which keeps its steps in a loop of its own);
 ``tests/test_integrate.py`` holds the list.
@@ -378,13 +380,31 @@ def cache_info() -> CacheInfo:
 # The first compile says so
 # ------------------------------------------------------------------------------------------------
 
-def announce() -> str:
-    """The line a first compile writes on stderr (it depends on where the cache is)."""
+def announce(stiff: bool = False) -> str:
+    """The line a compile of the engine writes on stderr (it depends on where the cache is); ``stiff``:
+    the compile of the engine with its stiff solver, after a run turned stiff (:func:`stiff_run_met`)."""
     info = cache_info()
+    what = ("a run turned stiff: compiling the engine again with its stiff solver (Radau IIA)," if stiff
+            else "compiling the engine")
     if info.path is None:
-        return (f"phaseimpact: compiling the engine for this process, {FIRST_COMPILE} on 2 cores (nothing is "
-                f"cached: {info.reason}; set NUMBA_CACHE_DIR to a writable directory to compile once)")
-    return f"phaseimpact: compiling the engine once for this machine, {FIRST_COMPILE} on 2 cores (cache: {info.path})"
+        return (f"phaseimpact: {what} for this process, {FIRST_COMPILE} on 2 cores (nothing is cached: "
+                f"{info.reason}; set NUMBA_CACHE_DIR to a writable directory to compile once)")
+    return f"phaseimpact: {what} once for this machine, {FIRST_COMPILE} on 2 cores (cache: {info.path})"
+
+
+class _Announced:
+    """What this process has said on stderr: the first compile of the engine; and whether a run has
+    turned stiff here (the engine's next compile is then the one with Radau, said once more: it
+    takes about as long, and without a line the command would seem to hang)."""
+
+    stiff_run = False
+    lines: set[bool] = set()
+
+
+def stiff_run_met() -> None:
+    """A run turned stiff in this process (:func:`phaseimpact.integrate.api.turned_stiff`): a compile
+    of an entry from now on is the engine with its stiff solver, and says so."""
+    _Announced.stiff_run = True
 
 
 #: The modules of the run loops called from Python, whose compile is the engine's (a kernel called
@@ -392,26 +412,31 @@ def announce() -> str:
 _ENTRIES_MODULES = ("phaseimpact.integrate.driver", "phaseimpact.integrate.rk4")
 
 
+def _on_compile(dispatcher) -> None:
+    """Print :func:`announce` when numba compiles an entry (once; once more for the engine with its
+    stiff solver after a run turned stiff)."""
+    if (getattr(dispatcher.py_func, "__module__", "") in _ENTRIES_MODULES
+            and not dispatcher.targetoptions.get("no_cpython_wrapper", False)):
+        stiff = _Announced.stiff_run
+        if stiff not in _Announced.lines:
+            _Announced.lines.add(stiff)
+            print(announce(stiff), file=sys.stderr, flush=True)
+
+
 @functools.cache
 def _listen_for_first_compile() -> None:
-    """Print :func:`announce` once per process, when numba compiles an entry (a cache miss: numba's
+    """Call :func:`_on_compile` when numba compiles a function (a cache miss: numba's
     ``numba:compile`` event fires on nothing else)."""
     from numba.core import event
 
-    class FirstCompile(event.Listener):
-        announced = False
-
+    class Compile(event.Listener):
         def on_start(self, ev):
-            dispatcher = ev.data["dispatcher"]
-            if (not self.announced and getattr(dispatcher.py_func, "__module__", "") in _ENTRIES_MODULES
-                    and not dispatcher.targetoptions.get("no_cpython_wrapper", False)):
-                self.announced = True
-                print(announce(), file=sys.stderr, flush=True)
+            _on_compile(ev.data["dispatcher"])
 
         def on_end(self, ev):
             pass
 
-    event.register("numba:compile", FirstCompile())
+    event.register("numba:compile", Compile())
 
 
 # ------------------------------------------------------------------------------------------------

@@ -133,19 +133,25 @@ def test_summary_run_gives_simulate_numbers():
 
 
 def test_the_workspace_members_tile_one_buffer():
-    """record.carve's views (every member, Radau's too) lie in one buffer of workspace_size numbers
-    without overlapping, Radau's complex members 16-byte aligned as an array of their own is; the
-    buffer comes zeroed (radau5.clear's state, empty counters)."""
-    from phaseimpact.integrate import record
+    """record.carve's views (every member, Radau's too; the controller ``W_STIFF`` is Radau's own) lie
+    in one buffer of workspace_size numbers without overlapping, Radau's complex members 16-byte
+    aligned as an array of their own is; the buffer comes zeroed (radau5.clear's state, empty
+    counters)."""
+    from phaseimpact.integrate import radau5, record
 
     def members(ws):
         for member in ws:
             yield from (members(member) if isinstance(member, tuple) else [member])
 
+    def address(a):
+        return a.__array_interface__["data"][0]
+
     for n_coef, capacity in ((12, 0), (12, 3), (25, 32)):
-        ws = record.workspace(n_coef, capacity, None)  # W_RADAU None: W_STIFF holds Radau's views once
-        assert ws[record.W_RADAU] is None
-        views = sorted(members(ws[:record.W_RADAU]), key=lambda a: a.__array_interface__["data"][0])
+        without = record.workspace(n_coef, capacity, None)  # W_RADAU None: only its controller, W_STIFF
+        assert without[record.W_RADAU] is None and without[record.W_STIFF].shape == (radau5.N_CTL,)
+        ws = record.workspace(n_coef, capacity, True)  # W_STIFF is then the controller of W_RADAU's tuple
+        assert address(ws[record.W_STIFF]) == address(ws[record.W_RADAU][radau5.CTL])
+        views = sorted(members(ws[:record.W_STIFF] + ws[record.W_RADAU:]), key=address)
         starts = [a.__array_interface__["data"][0] for a in views]
         ends = [start + a.nbytes for start, a in zip(starts, views, strict=True)]
         assert all(end <= start for end, start in zip(ends, starts[1:], strict=False))  # no overlap
@@ -154,6 +160,6 @@ def test_the_workspace_members_tile_one_buffer():
         assert all(start % 16 == 0 for start, a in zip(starts, views, strict=True) if a.dtype == np.complex128)
         assert all(not a.any() for a in views)
         assert len(views) == 22 and {a.dtype for a in views} == {np.dtype(t) for t in (float, np.int64, bool, complex)}
-        ws = record.workspace(n_coef, capacity, True)  # the y rows where a host reads a run's state (record.Y_AT)
+        # the y rows where a host reads a run's state (record.Y_AT)
         base = min(a.__array_interface__["data"][0] for a in members(ws))
         assert ws[record.W_Y].__array_interface__["data"][0] - base == 8 * record.Y_AT

@@ -340,7 +340,7 @@ def test_an_engine_without_radau_stops_where_the_run_turns_stiff(radau_not_met):
 def test_a_stiff_run_is_remembered_by_the_processes_that_share_the_cache(tmp_path, monkeypatch):
     """After a run turned stiff, a new process with the same cache starts with the engine with Radau
     (the file api.RADAU_MET_FILE in the cache): the driver is not compiled twice on one machine.
-    Without a cache, only the process itself remembers."""
+    Without a cache, or with one no longer writable, only the process itself remembers."""
     from types import SimpleNamespace
 
     from phaseimpact.integrate import api
@@ -358,6 +358,12 @@ def test_a_stiff_run_is_remembered_by_the_processes_that_share_the_cache(tmp_pat
     assert api.radau_marker(on) is None
     api.radau_needed()
     assert api.radau_marker(on) is True
+    # a cache that can no longer be written (here: removed): this process alone remembers, no error
+    monkeypatch.setattr(api, "cache_info", lambda: SimpleNamespace(path=tmp_path / "removed"))
+    monkeypatch.setattr(api._Radau, "met", None)
+    assert api.radau_marker(on) is None
+    api.radau_needed()
+    assert api.radau_marker(on) is True and not (tmp_path / "removed").exists()
 
 
 @pytest.mark.parametrize("n_threads", [1, 2])
@@ -403,11 +409,11 @@ def test_a_step_to_a_root_that_cannot_converge_is_a_failure_not_a_state():
     radau5.enter(law.code, c, 1, 1, u, fu, 1e-10, atol, stiff)
     good, f_good = np.empty(6), np.empty(6)
     radau5.fixed_step(law.code, c, 1, 1, 0.0, 1e-4, stiff, (u, fu, good, f_good))
-    assert not radau5.failed(stiff) and np.all(np.isfinite(good)) and good[5] > 0
+    assert not radau5.failed(stiff[radau5.CTL]) and np.all(np.isfinite(good)) and good[5] > 0
     broken = u.copy()
     broken[2] = np.nan
     radau5.fixed_step(law.code, c, 1, 1, 0.0, 1e-4, stiff, (broken, fu, good, f_good))
-    assert radau5.failed(stiff)
+    assert radau5.failed(stiff[radau5.CTL])
 
 
 def test_engine_kernels_are_compiled_without_reference_counting():

@@ -94,7 +94,7 @@ def test_radau_iia_is_of_order_5():
         for i in range(n):
             radau5.fixed_step(code, c, mode, side, i * h, h, stiff, (u, fu, u_new, fu_new))
             u, fu = u_new.copy(), fu_new.copy()
-        assert not radau5.failed(stiff)
+        assert not radau5.failed(stiff[radau5.CTL])
         steps.append(h)
         errors.append(_error(u, A, u0, T, omega))
     assert errors[-1] > 1e-13

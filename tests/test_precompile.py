@@ -99,3 +99,46 @@ def test_the_announcement_says_when_nothing_is_cached(monkeypatch):
     assert _jit.announce() == (f"phaseimpact: compiling the engine for this process, {_jit.FIRST_COMPILE} on 2 cores "
                                "(nothing is cached: NUMBA_DISABLE_JIT is set; set NUMBA_CACHE_DIR to a writable "
                                "directory to compile once)")
+
+
+def test_the_compile_after_a_stiff_run_says_what_it_compiles(monkeypatch, capsys):
+    """An entry's compile is announced once; after a run turned stiff in this process, the engine's
+    next compile (the one with Radau, about as long again) says so once more, instead of a long
+    silence or the first compile's words again. Other functions' compiles say nothing."""
+    from types import SimpleNamespace
+
+    monkeypatch.setattr(_jit._Announced, "lines", set())
+    monkeypatch.setattr(_jit._Announced, "stiff_run", False)
+    monkeypatch.setattr(_jit, "cache_info", lambda: _jit.CacheInfo(None, "", "a test", ()))
+
+    def compile_of(module, wrapper=True):
+        _jit._on_compile(SimpleNamespace(py_func=SimpleNamespace(__module__=module),
+                                         targetoptions={} if wrapper else {"no_cpython_wrapper": True}))
+        return capsys.readouterr().err.splitlines()
+
+    assert compile_of("phaseimpact.model.rhs") == []
+    assert compile_of("phaseimpact.integrate.driver", wrapper=False) == []  # a kernel the driver calls
+    assert compile_of("phaseimpact.integrate.driver") == [_jit.announce()]
+    assert compile_of("phaseimpact.integrate.rk4") == []
+    _jit.stiff_run_met()
+    assert compile_of("phaseimpact.integrate.driver") == [_jit.announce(stiff=True)]
+    assert compile_of("phaseimpact.integrate.driver") == []
+    assert "a run turned stiff: compiling the engine again" in _jit.announce(stiff=True)
+    assert "a run turned stiff" not in _jit.announce()
+
+
+def test_a_stiff_run_in_a_process_whose_first_compile_it_causes_says_so(monkeypatch, capsys):
+    """A process that loaded the engine without Radau from the cache and meets a stiff run compiles
+    only the engine with Radau: its one line is the stiff one (through api.again_with_radau)."""
+    from types import SimpleNamespace
+
+    from phaseimpact.integrate import api
+    from phaseimpact.integrate import driver as d
+
+    monkeypatch.setattr(_jit._Announced, "lines", set())
+    monkeypatch.setattr(_jit._Announced, "stiff_run", False)
+    monkeypatch.setattr(api, "cache_info", lambda: SimpleNamespace(path=None))
+    monkeypatch.setattr(api._Radau, "met", False)
+    assert api.again_with_radau(d.NEEDS_RADAU) and api._Radau.met is True
+    _jit._on_compile(SimpleNamespace(py_func=d.run.py_func, targetoptions={}))
+    assert capsys.readouterr().err.splitlines() == [_jit.announce(stiff=True)]

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .. import _signals
-from .._jit import cache_info
+from .._jit import cache_info, stiff_run_met
 from ..model.laws import ContactLaw, as_law
 from ..model.rhs import N_COEF, initial_state, pack
 from ..parameters import Parameters, is_number
@@ -320,11 +320,18 @@ def radau_needed() -> None:
             pass  # a cache no longer writable: this process alone knows
 
 
+def turned_stiff() -> None:
+    """A run with ``radau`` None stopped where it turned stiff: :func:`radau_needed`, and the compile
+    of the engine with Radau that follows says so on stderr (:func:`.._jit.stiff_run_met`)."""
+    stiff_run_met()
+    radau_needed()
+
+
 def again_with_radau(status) -> bool:
     """Whether a run with ``radau`` None stopped where it turned stiff (its caller runs it again with
     :func:`radau_marker`, which now gives True)."""
     if status == d.NEEDS_RADAU:
-        radau_needed()
+        turned_stiff()
         return True
     return False
 

@@ -46,8 +46,8 @@ from .api import (
     check_t_end,
     hertz_contact_time,
     radau_marker,
-    radau_needed,
     state_tolerances,
+    turned_stiff,
 )
 from .record import workspace_size
 from .result import Columns
@@ -185,7 +185,7 @@ def run_batch(batch: Batch, *, rtol: float, settle: bool = True, stop_on=None, n
             radau = radau_marker(stiff_after)
             _run_block(args, outputs, work, radau)
             if radau is None:
-                _again_with_radau(args, outputs, work, stiff_after)
+                _again_with_radau(args, outputs, work)
         woken = bool(np.any(summary[:, d.S_STATUS] == d.INTERRUPTED)) or _woken(d.SUCCESS, native)
         if not (woken or _signals.deferred):
             break
@@ -218,18 +218,17 @@ def _run_block(args: tuple, outputs: tuple, work: np.ndarray, radau) -> None:
         _run_in_threads(args, outputs, work, n, radau)
 
 
-def _again_with_radau(args: tuple, outputs: tuple, work: np.ndarray, stiff_after) -> None:
+def _again_with_radau(args: tuple, outputs: tuple, work: np.ndarray) -> None:
     """The runs that stopped where they turned stiff (an engine without Radau: :func:`.api.radau_marker`)
     run again with it, their rows of ``outputs`` replaced."""
     status = outputs[d.O_SUMMARY][:, d.S_STATUS]
     again = np.flatnonzero(status == d.NEEDS_RADAU)
     if again.size == 0:
         return
-    radau_needed()
+    turned_stiff()
     code, batch, options = args
     rows = tuple(column[again] for column in outputs)
-    _run_block((code, tuple(column[again] for column in batch), options), rows, work[:again.size],
-               radau_marker(stiff_after))
+    _run_block((code, tuple(column[again] for column in batch), options), rows, work[:again.size], True)
     for column, row in zip(outputs, rows, strict=True):
         column[again] = row
 

@@ -124,6 +124,7 @@ from .record import (
     W_FIRED,
     W_G,
     W_INT,
+    W_RADAU,
     W_REAL,
     W_STATS,
     W_STICKS,
@@ -287,6 +288,7 @@ def _start(code, ws, ev, smp, times):
     if side == FLIGHT:
         flight.coefficients(c, u, 0.0, ur[U_STAGES:U_DENSE])  # kept for the whole flight (it has no stages)
     radau5.clear(ws[W_STIFF], real[R_STIFF_AFTER])
+    radau5.clear_arrays(ws[W_RADAU])
     ints[I_NFEV], ints[I_NEXT_POLL] = 3, POLL_STEPS
     real[R_S], real[R_H_ABS], real[R_FORCE] = 0.0, h_abs, force
     real[R_ENERGY_LIMIT], real[R_PAIR_ENERGY] = energy_limit, stuck_pair_energy(c, y)  # the pair's: read while stuck

@@ -127,9 +127,22 @@ def workspace(switch_after):
 
 
 @kernel
-def clear(stiff, switch_after):
-    """The workspace as :func:`workspace` makes it (zeros, and the switch), for the next run in it
-    (nothing allocated)."""
+def clear(ctl, switch_after):
+    """The controller ``ctl`` (``stiff[CTL]``, the workspace's ``W_STIFF``) as :func:`workspace` makes
+    it, for the next run in it: zeros, and the switch (nothing allocated)."""
+    for k in range(N_CTL):
+        ctl[k] = 0.0
+    ctl[SWITCH_AFTER] = switch_after  # 0: never (DOP853 throughout)
+
+
+@kernel
+def clear_arrays(stiff):
+    """Zeros in the arrays of the ``stiff`` tuple (``W_RADAU``) but its controller (:func:`clear`),
+    for the next run in it: the Newton iterations start from what a fresh workspace holds, so a run's
+    numbers do not depend on the runs before it in the same thread. Nothing where the engine has no
+    stiff solver (``stiff`` None)."""
+    if stiff is None:
+        return
     ws, lu_real, lu_complex, zc, piv = stiff[WS], stiff[LU_REAL], stiff[LU_COMPLEX], stiff[ZC], stiff[PIV]
     for i in range(ws.shape[0]):
         for j in range(ws.shape[1]):
@@ -146,42 +159,37 @@ def clear(stiff, switch_after):
         stiff[FTMP][j] = 0.0
         stiff[START][j] = 0.0
         stiff[F_START][j] = 0.0
-    ctl = stiff[CTL]
-    for k in range(N_CTL):
-        ctl[k] = 0.0
-    ctl[SWITCH_AFTER] = switch_after  # 0: never (DOP853 throughout)
 
 
+# The light controller below takes ``ctl`` alone (the workspace's ``W_STIFF``): the stiffness watch
+# runs in every run, also in an engine compiled without the stiff solver's arrays.
 @kernel
-def reset(stiff):
+def reset(ctl):
     """A new phase starts explicit."""
-    ctl = stiff[CTL]
     ctl[ON] = 0.0
     ctl[COUNT] = 0.0
 
 
 @kernel
-def active(stiff):
-    return stiff[CTL][ON] != 0.0
+def active(ctl):
+    return ctl[ON] != 0.0
 
 
 @kernel(python=True)
-def failed(stiff):
+def failed(ctl):
     """True once a step to a root could not be taken (the run must end with a failure status)."""
-    return stiff[CTL][FAILED] != 0.0
+    return ctl[FAILED] != 0.0
 
 
 @kernel
-def watch(stiff, h_lambda):
+def watch(ctl, h_lambda):
     """Count accepted explicit steps with a large ``h lambda``."""
-    ctl = stiff[CTL]
     ctl[COUNT] = ctl[COUNT] + 1.0 if h_lambda > STIFF_H_LAMBDA else 0.0
 
 
 @kernel
-def due(stiff):
+def due(ctl):
     """True when the phase has turned stiff and the next step should be Radau's."""
-    ctl = stiff[CTL]
     return ctl[ON] == 0.0 and ctl[SWITCH_AFTER] > 0.0 and ctl[COUNT] >= ctl[SWITCH_AFTER]
 
 

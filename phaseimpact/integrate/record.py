@@ -47,9 +47,11 @@ STAT_MAX_FORCE, STAT_MAX_INDENTATION = 0, 1
 N_STATS = 2
 
 # Members of the workspace tuple (numba indexes a tuple's members of different types by constants).
-# W_STIFF: Radau's tuple (radau5.carve), whose controller watches for stiffness in every run;
-# W_RADAU: the same tuple where the engine is compiled with its stiff solver, None where it is not
-# (:func:`carve`).
+# W_STIFF: the controller of Radau's tuple (radau5.carve's member CTL), which watches for
+# stiffness in every run; W_RADAU: the whole tuple where the engine is compiled with its stiff
+# solver, None where it is not (:func:`carve`). Apart, so that an engine without the solver carries
+# none of its arrays, and one with it carries them once (a tuple goes by value: each array costs
+# the calls that take the workspace some seven LLVM parameters).
 (W_REAL, W_INT, W_C, W_ATOL, W_Y, W_G, W_FIRED, W_U, W_STATS, W_COUNTS, W_SUMMARY, W_STICKS, W_STIFF,
  W_RADAU) = range(14)
 # The run's record: its scalars (W_REAL) ...
@@ -123,7 +125,8 @@ def carve(buf, n_coef, capacity, radau):
     c = buf[o:o + n_coef]
     o += n_coef
     sticks = buf[o:o + 3 * capacity].reshape((3, capacity))
-    return real, ints, c, atol, y, g, fired, u, stats, counts, summary, sticks, stiff, radau_member(radau, stiff)
+    return (real, ints, c, atol, y, g, fired, u, stats, counts, summary, sticks, stiff[radau5.CTL],
+            radau_member(radau, stiff))
 
 
 def radau_member(radau, stiff):
