@@ -48,6 +48,7 @@ def load(name):
 
 
 def main() -> int:
+    _cli.on_numpy_baseline()
     args = _cli.parser(__doc__.splitlines()[0], default_jobs=2).parse_args()
     _cli.set_source_date_epoch()
     folder = _cli.output_folder(args.quick)

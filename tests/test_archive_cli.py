@@ -461,6 +461,24 @@ def test_quick_previews_go_to_the_preview_folder(monkeypatch):
     assert ignored.returncode == 0  # previews never show up in git status
 
 
+def test_study_processes_make_the_committed_grids_on_any_cpu(tmp_path):
+    """numpy's SIMD power and log give grids whose last bits depend on the CPU (with AVX-512, 5 of
+    the 70 kappa of atlas_paper's ``np.geomspace(1e10, 1e15, 70)`` were one ulp off): a study process
+    runs on numpy's baseline code (studies/_cli.py's on_numpy_baseline re-executes it once), where
+    that axis is the committed archive's bit for bit."""
+    studies = os.path.join(os.path.dirname(__file__), "..", "studies")
+    out = tmp_path / "kappa.npy"
+    script = tmp_path / "grid.py"
+    script.write_text(f"import sys\nsys.path.insert(0, {studies!r})\nimport _cli\n_cli.on_numpy_baseline()\n"
+                      f"import numpy as np\nnp.save({str(out)!r}, np.geomspace(1e10, 1e15, 70))\n")
+    unset = ("NPY_DISABLE_CPU_FEATURES", "PHASEIMPACT_STUDIES_NUMPY_BASELINE")
+    env = {k: v for k, v in os.environ.items() if k not in unset}
+    subprocess.run([sys.executable, str(script)], env=env, check=True, timeout=300)
+    with h5py.File(os.path.join(studies, "..", "figures", "data", "atlas_paper_printed.h5")) as f:
+        committed = np.unique(f["kappa"][()])
+    np.testing.assert_array_equal(np.load(out), committed)
+
+
 def test_a_resume_of_other_work_names_what_differs_with_the_asked_value(tmp_path):
     """The audit's "holds other work (t_end nan)": the held and the asked value both show, in
     words, and axis ends differing in the 11th digit are visible."""
