@@ -123,9 +123,9 @@ def on_numpy_baseline() -> None:
         found = np.show_config(mode="dicts")["SIMD Extensions"]["found"]
     except (TypeError, KeyError):  # a numpy without the report (before 1.25): run as it is
         return
-    env = dict(os.environ, **{BASELINE_VARIABLE: "1"})
-    if found:
-        env["NPY_DISABLE_CPU_FEATURES"] = " ".join(found)
+    if not found:  # the baseline code already
+        return
+    env = dict(os.environ, **{BASELINE_VARIABLE: "1", "NPY_DISABLE_CPU_FEATURES": " ".join(found)})
     sys.stdout.flush()
     os.execve(sys.executable, [sys.executable, *sys.argv], env)
 

@@ -297,7 +297,7 @@ def radau_marker(stiff_after) -> bool | None:
     A first command whose runs never turn stiff compiles in about 0.8 of the time. A run that does
     stops there with the status ``NEEDS_RADAU`` and its caller runs it again with True: the same
     kernels up to the switch, so the same numbers (:func:`again_with_radau`). That first stiff run
-    compiles the driver a second time, with Radau (about 45 s more on 2 cores): once per machine,
+    compiles the driver a second time, with Radau (nearly as long again): once per machine,
     since from then on every process that shares the cache runs only the engine with Radau
     (``benchmarks/compile_profile.py --against``)."""
     if not stiff_after:
