@@ -7,7 +7,7 @@ QUICK ?=
 JOBS ?= 2
 TEST_JOBS ?= 2
 
-.PHONY: test test-sdist test-ptx test-numba-range docs reproduce lint benchmarks stress peers clean
+.PHONY: test test-sdist test-numba-range docs reproduce lint benchmarks stress peers clean
 
 $(BIN)/python:
 	$(PYTHON) -m venv $(VENV)
@@ -63,16 +63,13 @@ NUMBA_RANGE_TESTS ?= tests/test_integrate.py tests/test_laws.py tests/test_cache
 test-sdist: $(STAMP)
 	PHASEIMPACT_SDIST_ALL=1 $(BIN)/python -m pytest -q tests/test_packaging.py -k sdist_has_every
 
-# The GPU kernel compiled for an H100 (sm_90) by the real CUDA target, without a GPU (needs the CUDA
-# toolkit's NVVM; about 10 minutes on 2 cores). make test runs the kernel on numba's CUDA simulator.
-test-ptx: $(STAMP)
-	PHASEIMPACT_PTX=1 $(BIN)/python -m pytest -q tests/test_cuda.py -k ptx
-
 test-numba-range: .venv-numba-oldest/.installed .venv-numba-newest/.installed
 	@for end in oldest newest; do \
 		echo "== numba $$(.venv-numba-$$end/bin/python -c 'import numba, numpy; print(numba.__version__, "with numpy", numpy.__version__)') ($$end allowed)"; \
 		NUMBA_CACHE_DIR=$$PWD/.venv-numba-$$end/numba-cache .venv-numba-$$end/bin/python -m pytest -q \
 			-o cache_dir=.venv-numba-$$end/pytest-cache -m "not slow" $(NUMBA_RANGE_TESTS) || exit 1; \
+		NUMBA_CACHE_DIR=$$PWD/.venv-numba-$$end/numba-cache .venv-numba-$$end/bin/python -m pytest -q \
+			-o cache_dir=.venv-numba-$$end/pytest-cache tests/test_cuda.py -k "ptx or call_policy" || exit 1; \
 	done
 
 lint: $(STAMP)

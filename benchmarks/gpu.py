@@ -19,7 +19,8 @@ nothing and it writes ``--results`` (default ``benchmarks/results/gpu_simulator.
 
 The GPU's rows come first (a run cut short still prints them), then the CPU's. The kernel's first
 compile is timed apart: on an H200 machine (2026-11-28) it had not finished after 559 s
-(results/gpu.md), so give the script more than ten minutes there.
+(results/gpu.md), before the engine's calls were kept as calls (results/gpu_compile.md: the PTX
+then took about half a minute without a GPU; the driver's assembly of it is not timed yet).
 
     python benchmarks/gpu.py [--side 1000] [--check 10000] [--threads 1,2,4,8,16]   # a GPU machine
     python benchmarks/gpu.py --simulator [--results FILE.md]     # anywhere, seconds

@@ -5,9 +5,10 @@
 # machine's own python3 (numpy, scipy, numba, numba-cuda, h5py, joblib and tqdm are installed
 # there); the package runs from the tree (PYTHONPATH) and compiles on first use.
 #
-# The CUDA kernel's compile (minutes, one core) runs beside the CPU engine's (phaseimpact warmup)
-# and then beside scale.py, which times 1 to 16 threads on the other 15 cores; gpu.py's CPU rows
-# come after its GPU rows, when scale.py is done. Results land in benchmarks/results/ and are
+# The CUDA kernel's compile (one core; it had not finished after 559 s in the first lease, before
+# the engine's calls were kept as calls: benchmarks/results/gpu.md) runs beside the CPU engine's
+# (phaseimpact warmup) and then beside scale.py, which times 1 to 16 threads on the other 15
+# cores; gpu.py's CPU rows come after its GPU rows. Results land in benchmarks/results/ and are
 # copied to $OUT (default ./gpu-machine-out) with the logs.
 #
 # The image's numba-cuda (0.30.4, seen 2026-11-28) fails with its numpy 2.5 (numpy removed

@@ -30,8 +30,9 @@ SCRIPTS = ("startup", "compile_profile", "trajectory", "throughput", "critical",
            "scene_savings", "stress", "stiff", "atlas", "train", "scale")
 SECTIONS = ("trajectory", "trajectory_against", "throughput", "critical", "startup", "compile_profile",
             "compile_against", "work_precision", "peers", "stiff", "atlas", "scene_savings", "stress", "train",
-            "scale", "scale_gpu_machine", "gpu")
+            "scale", "scale_gpu_machine", "gpu_compile", "gpu_compile_numba_cuda", "gpu")
 #: gpu.py is not in SCRIPTS: it is run on a GPU machine (its section says where it was, or that it was not);
+#: gpu_compile.py neither (it needs NVVM, and numba's own inlining takes it five minutes);
 #: trajectory_against and compile_against come from ``trajectory.py --against TREE`` and
 #: ``compile_profile.py --against TREE`` (another checkout), run by hand.
 

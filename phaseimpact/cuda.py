@@ -10,6 +10,23 @@ device once, the outputs come back once; the workspaces stay there.
 This module is host code and the CUDA kernel (not cached on disk): no CPU kernel module imports it,
 so it is not part of the CPU engine's cache digest (:func:`._jit.engine_sources`).
 
+**The engine's calls stay calls on the GPU.** numba hands NVVM one module per compiled function and
+a copy of it for every function that calls it (3172 modules, 62.6 MB of IR, for the kernel's 156
+functions), and numba's own CUDA target marks every device function ``alwaysinline`` (its
+``inline="never"`` read as true; numba-cuda fixed that, but leaves the inlining to NVVM): NVVM put
+the whole engine into the kernel, 461 000 lines of PTX, in most of a five-minute compile for sm_90
+on this project's 2-core machine (``benchmarks/results/gpu_compile.md``); on an H200 machine the
+first launch had not finished after 559 s (``benchmarks/results/gpu.md``). So
+before NVVM, :func:`_install_call_policy` passes each module once and marks ``noinline`` the
+functions the CPU engine compiles as calls (those without ``forceinline``: the entries, the run
+loop, the step, the event and stiff-solver kernels), leaving NVVM to inline the small kernels of
+the hot path as the CPU does (``benchmarks/gpu_compile.py`` times both). The arithmetic is the
+same, up to where NVVM fuses a multiply and an add (``fma``, on by default), which it can do across
+an inlined call and not across a kept one: last bits. What the calls cost on a GPU has not been
+timed. This hooks numba's private
+``nvvm.compile_ir`` (``llvm_to_ptx`` in numba 0.59; the same in numba-cuda); ``PHASEIMPACT_GPU_CALLS=0``
+leaves numba as it is, and a numba without either gets one warning and numba's own compile.
+
 Without a usable GPU, :func:`unavailable` says what is missing (one line) and the callers refuse
 before any work. numba's CUDA simulator (``NUMBA_ENABLE_CUDASIM=1``) runs the kernel in Python
 threads; it calls the engine as Python, so it needs ``NUMBA_DISABLE_JIT=1`` too (the compiled
@@ -19,6 +36,10 @@ kernels have no entry from Python): the tests run it so, on small grids.
 from __future__ import annotations
 
 import functools
+import os
+import re
+import sys
+import warnings
 
 import numba
 import numpy as np
@@ -30,11 +51,17 @@ try:  # a module global: the simulator swaps it for its own in the kernel's glob
 except ImportError as missing:  # a numba built without its CUDA target
     cuda, _MISSING = None, missing
 
-__all__ = ["unavailable", "check", "run_batch_cuda", "THREADS_PER_BLOCK"]
+__all__ = ["unavailable", "check", "run_batch_cuda", "THREADS_PER_BLOCK", "CALLS_VARIABLE", "NVVM_ENTRIES"]
 
 #: Threads of a block. The per-point kernel is long and holds many registers: small blocks keep
 #: the multiprocessors' register files from limiting the blocks resident at once.
 THREADS_PER_BLOCK = 64
+#: ``PHASEIMPACT_GPU_CALLS``: ``1`` or unset (the default) keeps the engine's calls calls on the GPU;
+#: ``0`` leaves NVVM's inlining as numba sets it up.
+CALLS_VARIABLE = "PHASEIMPACT_GPU_CALLS"
+#: numba's function that hands the IR to NVVM: ``compile_ir`` from numba 0.60 (and in numba-cuda),
+#: ``llvm_to_ptx`` in numba 0.59 (the same arguments: the modules' IR and NVVM's options).
+NVVM_ENTRIES = ("compile_ir", "llvm_to_ptx")
 
 
 def unavailable() -> str | None:
@@ -113,6 +140,97 @@ def _device_min_max() -> None:
     define(min, register_jitable(inline="always")(lambda x, y: x < y))
 
 
+def calls_kept() -> bool:
+    """``PHASEIMPACT_GPU_CALLS`` (module docstring): True unless it is ``0``; ValueError out of range."""
+    value = os.environ.get(CALLS_VARIABLE, "")
+    if value not in ("", "0", "1"):
+        raise ValueError(f"{CALLS_VARIABLE} = {value!r} is out of range; allowed: 0 or 1")
+    return value != "0"
+
+
+def engine_calls() -> frozenset:
+    """The dotted names (``module.qualname``) of the engine's compiled functions that the CPU keeps
+    as calls: every numba dispatcher a ``phaseimpact`` module defines without ``forceinline``."""
+    names = set()
+    for module_name, module in list(sys.modules.items()):
+        if module_name.split(".")[0] != __name__.split(".")[0] or module is None:
+            continue
+        for value in list(vars(module).values()):
+            options, py_func = getattr(value, "targetoptions", None), getattr(value, "py_func", None)
+            if isinstance(options, dict) and py_func is not None and py_func.__module__ == module_name \
+                    and not options.get("forceinline"):
+                names.add(f"{module_name}.{py_func.__qualname__}")
+    return frozenset(names)
+
+
+def _demangled(symbol: str) -> str:
+    """The dotted name in numba's Itanium-style symbol ``_ZN<len><part>...``, up to its ABI tags."""
+    parts, i = [], 3
+    while i < len(symbol) and symbol[i].isdigit():
+        j = i
+        while symbol[j].isdigit():
+            j += 1
+        length = int(symbol[i:j])
+        parts.append(symbol[j:j + length])
+        i = j + length
+    return ".".join(parts)
+
+
+_SYMBOL = re.compile(r'@"?(_ZN[0-9A-Za-z_$]+)')
+
+
+def keep_calls(module_ir: str, calls: frozenset) -> str:
+    """``module_ir`` (one module's LLVM IR, as numba prints it) with the functions named in ``calls``
+    (:func:`engine_calls`) defined ``noinline`` and declared without ``alwaysinline``; every other
+    line as it was."""
+    lines = module_ir.split("\n")
+    for k, line in enumerate(lines):
+        is_definition = line.startswith("define ")
+        if not (is_definition or line.startswith("declare ")):
+            continue
+        symbol = _SYMBOL.search(line)
+        if symbol is None or _demangled(symbol.group(1)) not in calls:
+            continue
+        head = line.rstrip()
+        opens_body = head.endswith("{")
+        if opens_body:
+            head = head[:-1].rstrip()
+        head = head.replace(" alwaysinline", "")
+        if is_definition and not head.endswith(" noinline"):
+            head += " noinline"
+        lines[k] = head + (" {" if opens_body else "")
+    return "\n".join(lines)
+
+
+def nvvm_entry(nvvm) -> str | None:
+    """The name of numba's function that hands the IR to NVVM (:data:`NVVM_ENTRIES`), or None."""
+    return next((name for name in NVVM_ENTRIES if callable(getattr(nvvm, name, None))), None)
+
+
+@functools.cache
+def _install_call_policy() -> None:
+    """Wrap numba's NVVM entry (module docstring): each module once, the engine's calls
+    ``noinline``. Once per process; nothing where ``PHASEIMPACT_GPU_CALLS=0``."""
+    if not calls_kept() or numba.config.ENABLE_CUDASIM:
+        return
+    from numba.cuda.cudadrv import nvvm
+
+    name = nvvm_entry(nvvm)
+    if name is None:
+        warnings.warn(f"phaseimpact: numba {numba.__version__}'s CUDA target has none of "
+                      f"nvvm.{', nvvm.'.join(NVVM_ENTRIES)}; the GPU kernel is compiled numba's own way, every call "
+                      f"inlined (set {CALLS_VARIABLE}=0 to choose this without the warning)", RuntimeWarning,
+                      stacklevel=3)
+        return
+    original, calls = getattr(nvvm, name), engine_calls()
+
+    def to_nvvm(llvmir, **options):
+        modules = [llvmir] if isinstance(llvmir, str) else llvmir
+        return original([keep_calls(m, calls) for m in dict.fromkeys(modules)], **options)
+
+    setattr(nvvm, name, to_nvvm)
+
+
 @functools.cache
 def _kernel():
     """The CUDA kernel (compiled on first launch): thread ``i`` runs point ``i`` in row ``i`` of
@@ -121,6 +239,7 @@ def _kernel():
     from .integrate.record import carve
 
     _device_min_max()
+    _install_call_policy()
 
     @cuda.jit
     def points(code, batch, options, outputs, work):

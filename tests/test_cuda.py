@@ -325,7 +325,9 @@ def _nvvm_available() -> bool:
 
 
 PTX = textwrap.dedent("""
+    import re
     import sys
+    import time
     import types
 
     import numba
@@ -347,21 +349,43 @@ PTX = textwrap.dedent("""
     options = (1e-10, True, np.int64(-1), np.int64(0), api.MAX_STEPS, api.MAX_EVENTS, api._stiff_after(True))
     args = (np.int64(batch.law.code), (batch.C, batch.Y0, batch.t_end, batch.atol, batch.max_step), options,
             outputs, work)
-    ptx, _ = cuda.compile_ptx(gpu._kernel().py_func, tuple(numba.typeof(a) for a in args), cc=(9, 0))
-    print(len(ptx), ".entry" in ptx, ".target sm_90" in ptx, "phaseimpact_poll" in ptx)
+    kernel = gpu._kernel()  # installs the call policy (PHASEIMPACT_GPU_CALLS) around NVVM
+    from numba.cuda.cudadrv import nvvm
+
+    entry = gpu.nvvm_entry(nvvm)
+    nvvm_s, handed, policy_entry = [], [], getattr(nvvm, entry)
+
+    def timed_entry(llvmir, **options):
+        handed.extend([llvmir] if isinstance(llvmir, str) else llvmir)  # numba's modules, before the policy
+        start = time.perf_counter()
+        try:
+            return policy_entry(llvmir, **options)
+        finally:
+            nvvm_s.append(time.perf_counter() - start)
+
+    setattr(nvvm, entry, timed_entry)
+    start = time.perf_counter()
+    ptx, _ = cuda.compile_ptx(kernel.py_func, tuple(numba.typeof(a) for a in args), cc=(9, 0))
+    total = time.perf_counter() - start
+    functions = len(re.findall(r"(?m)^[.](?:visible |weak )*[.]func", ptx))
+    print(len(ptx), ".entry" in ptx, ".target sm_90" in ptx, "phaseimpact_poll" in ptx, functions, ptx.count("\\n"),
+          f"{sum(nvvm_s):.1f}", f"{total:.1f}", len(handed), len(set(handed)), sum(map(len, handed)))
 """)
 
 
 @pytest.mark.slow
-@pytest.mark.skipif(os.environ.get("PHASEIMPACT_PTX") != "1",
-                    reason="the PTX compile takes ~10 min on 2 cores: make test-ptx (PHASEIMPACT_PTX=1) runs it")
 @pytest.mark.skipif(not _nvvm_available(), reason="no NVVM (CUDA toolkit) to compile PTX with")
 def test_the_device_kernel_compiles_to_ptx_for_an_h100(request):
     """The real CUDA target (not the simulator) accepts the whole per-point path: law, right-hand
-    sides, DOP853, Radau, events, root finders, the flight's elliptic functions, for sm_90 (about 8
-    minutes on 2 loaded cores: kept per engine digest in pytest's cache, as the cold sessions of
-    tests/test_precompile.py)."""
-    key = f"phaseimpact/cuda-ptx/{_jit.engine_digest()}/{hashlib.sha256(PTX.encode()).hexdigest()[:16]}"
+    sides, DOP853, Radau, events, root finders, the flight's elliptic functions, for sm_90 (about
+    half a minute with the engine's calls kept, ``phaseimpact.cuda``'s call policy; kept per engine
+    digest in pytest's cache, as the cold sessions of tests/test_precompile.py). The calls are
+    there: with every function inlined (``PHASEIMPACT_GPU_CALLS=0``) the PTX has no function
+    besides the kernel, and NVVM took 277 s of a 298 s compile (benchmarks/results/gpu_compile.md)."""
+    from phaseimpact.cuda import CALLS_VARIABLE
+
+    policy = hashlib.sha256((PTX + (ROOT / "phaseimpact" / "cuda.py").read_text()).encode()).hexdigest()[:16]
+    key = f"phaseimpact/cuda-ptx/{_jit.engine_digest()}/{policy}/{os.environ.get(CALLS_VARIABLE, '')}"
     kept = request.config.cache.get(key, None)
     if kept is None:
         out = subprocess.run([sys.executable, "-c", PTX], capture_output=True, text=True, timeout=1500, cwd=ROOT,
@@ -369,8 +393,9 @@ def test_the_device_kernel_compiles_to_ptx_for_an_h100(request):
         assert out.returncode == 0, out.stderr[-3000:]
         kept = out.stdout.split()
         request.config.cache.set(key, kept)
-    size, entry, target, polls = kept
+    size, entry, target, polls, functions = kept[:5]
     assert int(size) > 100_000 and (entry, target, polls) == ("True", "True", "False")
+    assert int(functions) > 50, f"{functions} PTX functions: the engine's calls were inlined"
 
 
 def test_the_gpu_benchmark_runs_under_the_simulator(tmp_path):
@@ -479,3 +504,58 @@ def test_gpu_summaries_refuse_a_non_finite_arrival_before_any_launch(monkeypatch
     with pytest.raises(ValueError, match=r"initial = .* is out of range; allowed: 4 finite numbers"):
         summary_runs(as_law("paper"), cases, [None, None], rtol=1e-10, arrivals=arrivals)
     assert len(launched) == 1
+
+
+LOOP = "_ZN11phaseimpact9integrate6driver5_loopB4v162B12cw51cXTLSUwvE5ArrayIdLi1E"
+FORCED = "_ZN11phaseimpact5model5forms8force_ofB3v25B12cw51cXTLSUwvEdd"
+KERNEL = "_ZN6cudapy11phaseimpact4cuda7_kernel12_3clocals_3e6pointsB2v1E5Tuple"
+
+
+def test_the_call_policy_marks_the_engine_calls_noinline_and_nothing_else():
+    """keep_calls: a named function's definition loses ``alwaysinline`` and gains ``noinline`` (its
+    body's brace kept, on the line or the next), its declaration elsewhere loses ``alwaysinline``;
+    a function not named, and the kernel, are left as they were."""
+    from phaseimpact.cuda import keep_calls
+
+    module = "\n".join([
+        f'define linkonce_odr i32 @"{LOOP}"(i8* %".1", double %".2") alwaysinline {{',
+        "entry:", "  ret i32 0", "}",
+        f'declare i32 @"{LOOP}"(i8*, double) alwaysinline',
+        f'define linkonce_odr i32 @"{FORCED}"(double %".1") alwaysinline',
+        "{", "  ret i32 0", "}",
+        f'define void @"{KERNEL}"(i8* %".1")', "{", "  ret void", "}"])
+    calls = frozenset({"phaseimpact.integrate.driver._loop"})
+    lines = keep_calls(module, calls).split("\n")
+    assert lines[0] == f'define linkonce_odr i32 @"{LOOP}"(i8* %".1", double %".2") noinline {{'
+    assert lines[4] == f'declare i32 @"{LOOP}"(i8*, double)'
+    assert lines[1:4] + lines[5:] == module.split("\n")[1:4] + module.split("\n")[5:]
+    everything = frozenset({"phaseimpact.integrate.driver._loop", "phaseimpact.model.forms.force_of"})
+    marked = keep_calls(module, everything).split("\n")
+    assert marked[5] == f'define linkonce_odr i32 @"{FORCED}"(double %".1") noinline' and marked[6] == "{"
+    assert marked[-4:] == module.split("\n")[-4:]  # the kernel: never noinline (NVVM refuses that)
+
+
+def test_the_call_policy_names_the_cpu_engines_calls():
+    """engine_calls: the functions the CPU compiles as calls (the run loop, the step), not those it
+    inlines (forceinline: the DOP853 stages, the law's force); the symbols demangle to those names."""
+    import phaseimpact.integrate.driver  # noqa: F401 (the engine's modules, as the kernel imports them)
+    from phaseimpact.cuda import _demangled, engine_calls
+
+    calls = engine_calls()
+    assert {"phaseimpact.integrate.driver._loop", "phaseimpact.integrate.step.advance",
+            "phaseimpact.integrate.driver.run_point"} <= calls
+    assert not {"phaseimpact.integrate._dop853_stages.step", "phaseimpact.model.forms.force_of",
+                "phaseimpact.integrate.step.phase_step"} & calls
+    assert _demangled(LOOP) == "phaseimpact.integrate.driver._loop"
+    assert _demangled(KERNEL) == "cudapy.phaseimpact.cuda._kernel._3clocals_3e.points"
+
+
+@pytest.mark.parametrize("value", ["2", "yes", " 1"])
+def test_the_call_policy_switch_refuses_other_values(monkeypatch, value):
+    from phaseimpact.cuda import CALLS_VARIABLE, calls_kept
+
+    monkeypatch.setenv(CALLS_VARIABLE, value)
+    with pytest.raises(ValueError, match=rf"PHASEIMPACT_GPU_CALLS = '{value}' is out of range; allowed: 0 or 1"):
+        calls_kept()
+    monkeypatch.setenv(CALLS_VARIABLE, "0")
+    assert calls_kept() is False
