@@ -3,10 +3,10 @@
 target from the same source (numba compiles the engine's ``@njit`` functions a CUDA kernel calls
 as device functions; no second copy of any kernel).
 
-A launch allocates every thread's workspace at once: one row per point of a float64 array, each
-row the buffer a CPU thread's block runs in (:func:`.integrate.record.workspace_size` numbers), and
-a thread runs in the views :func:`.integrate.record.carve` makes of its row. The inputs go to the
-device once, the outputs come back once; the workspaces stay there.
+A launch allocates every thread's workspace at once, on the device: one row per point of a float64
+array, each row the buffer a CPU thread's block runs in (:func:`.integrate.record.workspace_size`
+numbers), and a thread runs in the views :func:`.integrate.record.carve` makes of its row. The
+inputs go to the device once, the outputs come back once; the workspaces stay there.
 This module is host code and the CUDA kernel (not cached on disk): no CPU kernel module imports it,
 so it is not part of the CPU engine's cache digest (:func:`._jit.engine_sources`).
 
@@ -251,11 +251,6 @@ def _kernel():
     return points
 
 
-def workspaces(n: int, n_coef: int, capacity: int) -> np.ndarray:
-    """One workspace row per point (a host array, zeros), as a CPU thread's block gets one."""
-    return np.zeros((n, workspace_size(n_coef, capacity)))
-
-
 def run_batch_cuda(code: int, batch: tuple, options: tuple, outputs: tuple, final_states=None) -> None:
     """Run every point of ``batch`` (the tuple ``integrate.driver.B_*``) on the GPU, one thread each, and fill
     ``outputs`` (the tuple ``integrate.driver.O_*``) as :func:`.integrate.driver.run_block` does; and
@@ -265,9 +260,12 @@ def run_batch_cuda(code: int, batch: tuple, options: tuple, outputs: tuple, fina
     from numba import cuda
 
     n = batch[0].shape[0]
-    work = cuda.to_device(workspaces(n, batch[0].shape[1], outputs[1].shape[1]))
+    # made on the device, never sent: a run sets every number of its workspace it reads, and every
+    # output number its caller reads (tests/test_allocations.py runs the CPU in poisoned buffers);
+    # a launch of 262144 points would otherwise send 1.5 GB of zeros and 0.24 GB of outputs
+    work = cuda.device_array((n, workspace_size(batch[0].shape[1], outputs[1].shape[1])))
     device_batch = tuple(cuda.to_device(np.ascontiguousarray(a)) for a in batch)
-    device_outputs = tuple(cuda.to_device(a) for a in outputs)
+    device_outputs = tuple(cuda.device_array_like(a) for a in outputs)
     blocks = (n + THREADS_PER_BLOCK - 1) // THREADS_PER_BLOCK
     _kernel()[blocks, THREADS_PER_BLOCK](np.int64(code), device_batch, options, device_outputs, work)
     cuda.synchronize()

@@ -163,3 +163,43 @@ def test_the_workspace_members_tile_one_buffer():
         # the y rows where a host reads a run's state (record.Y_AT)
         base = min(a.__array_interface__["data"][0] for a in members(ws))
         assert ws[record.W_Y].__array_interface__["data"][0] - base == 8 * record.Y_AT
+
+
+
+def _run_in_buffers(batch, capacity: int, fill: float):
+    """run_block over the whole batch (the engine with the stiff solver) in a workspace and outputs
+    full of ``fill``: (summaries, counts, each run's first stick points)."""
+    from phaseimpact.integrate import driver as d
+    from phaseimpact.integrate.batch import MAX_EVENTS, MAX_STEPS, _stiff_after
+    from phaseimpact.integrate.record import workspace_size
+
+    n = len(batch)
+    summary, st = np.full((n, d.N_SUMMARY), fill), np.full((3, n, capacity), fill)
+    count = np.full(n, -7, np.int64)
+    work = np.full(workspace_size(batch.C.shape[1], capacity), fill)
+    d.run_block(batch.law.code, (batch.C, batch.Y0, batch.t_end, batch.atol, batch.max_step),
+                (1e-10, True, np.int64(-1), np.int64(0), MAX_STEPS, MAX_EVENTS, _stiff_after(True)), 0, n, 1,
+                (summary, st[0], st[1], st[2], count), work, True)
+    kept = np.arange(capacity) < np.minimum(count, capacity)[:, None]
+    return summary, count, [st[j][kept] for j in range(3)]
+
+
+def test_a_run_reads_nothing_its_workspace_or_outputs_held_before():
+    """The per-point path sets every number of its workspace that it reads, and every output number
+    its callers read (the summaries, the counts, the first stick points): run_block in buffers
+    poisoned with NaN, 1e300 or -3 gives the results of zeroed ones, for a law of each kind, with
+    the stiff solver in the workspace. The GPU's workspaces and outputs are made on the device
+    uninitialised (phaseimpact.cuda.run_batch_cuda) because of this."""
+    laws = {"paper": {}, "hunt-crossley": {}, "abrate": {}, "thornton": {"limiting_pressure": 2e9}}
+    for law, extra in laws.items():
+        base = seed_parameters(**extra)
+        batch = pack_batch([base.replace(kappa=k, v=v) for k in np.geomspace(1e8, 1e15, 6) for v in (0.3, 6.35, 13.0)],
+                           law, None, 1e-10)
+        zeroed = _run_in_buffers(batch, 1, 0.0)  # room for one stick point: paper's second ones overflow
+        assert np.all(zeroed[1] >= 0) and (law != "paper" or zeroed[1].max() == 2)
+        for fill in (np.nan, 1e300, -3.0):
+            summary, count, points = _run_in_buffers(batch, 1, fill)
+            np.testing.assert_array_equal(summary, zeroed[0], err_msg=f"{law}, buffers full of {fill}")
+            np.testing.assert_array_equal(count, zeroed[1])
+            for ours, reference in zip(points, zeroed[2], strict=True):
+                np.testing.assert_array_equal(ours, reference)

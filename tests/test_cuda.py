@@ -338,12 +338,13 @@ PTX = textwrap.dedent("""
     from phaseimpact import cuda as gpu, seed_parameters
     from phaseimpact.integrate import api, driver as d
     from phaseimpact.integrate.batch import pack_batch
+    from phaseimpact.integrate.record import workspace_size
 
     # The engine's @njit functions become device functions when the kernel calls them; numba asks the
     # current device for its compute capability there, and there is none: the H100's (9.0) instead.
     numba.cuda.dispatcher.get_current_device = lambda: types.SimpleNamespace(compute_capability=(9, 0))
     batch = pack_batch([seed_parameters()], "paper", None, 1e-10)
-    work = gpu.workspaces(1, batch.C.shape[1], 32)
+    work = np.zeros((1, workspace_size(batch.C.shape[1], 32)))
     outputs = (np.empty((1, d.N_SUMMARY)), np.empty((1, 32)), np.empty((1, 32)), np.empty((1, 32)),
                np.empty(1, np.int64))
     options = (1e-10, True, np.int64(-1), np.int64(0), api.MAX_STEPS, api.MAX_EVENTS, api._stiff_after(True))
