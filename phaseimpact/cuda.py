@@ -231,10 +231,14 @@ def _install_call_policy() -> None:
     setattr(nvvm, name, to_nvvm)
 
 
+#: Where a run's final state ``(x1, x2, x1dot, x2dot, W)`` is in its workspace (row ``Y_STATE``).
+FINAL_AT = Y_AT + 5 * Y_STATE
+
+
 @functools.cache
 def _kernel():
     """The CUDA kernel (compiled on first launch): thread ``i`` runs point ``i`` in row ``i`` of
-    ``work`` (:func:`workspaces`)."""
+    ``work``, and copies its final state to row ``i`` of ``final`` where ``final`` has one."""
     from .integrate.driver import run_point_into
     from .integrate.record import carve
 
@@ -242,11 +246,14 @@ def _kernel():
     _install_call_policy()
 
     @cuda.jit
-    def points(code, batch, options, outputs, work):
+    def points(code, batch, options, outputs, work, final):
         i = cuda.grid(1)
         if i < batch[0].shape[0]:
             ws = carve(work[i], batch[0].shape[1], outputs[1].shape[1], True)  # with Radau
             run_point_into(code, ws, batch, options, i, outputs)
+            if i < final.shape[0]:
+                for k in range(5):
+                    final[i, k] = work[i, FINAL_AT + k]
 
     return points
 
@@ -266,11 +273,11 @@ def run_batch_cuda(code: int, batch: tuple, options: tuple, outputs: tuple, fina
     work = cuda.device_array((n, workspace_size(batch[0].shape[1], outputs[1].shape[1])))
     device_batch = tuple(cuda.to_device(np.ascontiguousarray(a)) for a in batch)
     device_outputs = tuple(cuda.device_array_like(a) for a in outputs)
+    final = cuda.device_array((0 if final_states is None else n, 5))  # 5 numbers a run back, not its workspace
     blocks = (n + THREADS_PER_BLOCK - 1) // THREADS_PER_BLOCK
-    _kernel()[blocks, THREADS_PER_BLOCK](np.int64(code), device_batch, options, device_outputs, work)
+    _kernel()[blocks, THREADS_PER_BLOCK](np.int64(code), device_batch, options, device_outputs, work, final)
     cuda.synchronize()
     for host, device in zip(outputs, device_outputs, strict=True):
         device.copy_to_host(host)
     if final_states is not None:
-        at = Y_AT + 5 * Y_STATE
-        final_states[...] = work.copy_to_host()[:, at:at + 5]
+        final_states[...] = final.copy_to_host()

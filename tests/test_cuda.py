@@ -349,7 +349,7 @@ PTX = textwrap.dedent("""
                np.empty(1, np.int64))
     options = (1e-10, True, np.int64(-1), np.int64(0), api.MAX_STEPS, api.MAX_EVENTS, api._stiff_after(True))
     args = (np.int64(batch.law.code), (batch.C, batch.Y0, batch.t_end, batch.atol, batch.max_step), options,
-            outputs, work)
+            outputs, work, np.empty((0, 5)))
     kernel = gpu._kernel()  # installs the call policy (PHASEIMPACT_GPU_CALLS) around NVVM
     from numba.cuda.cudadrv import nvvm
 
