@@ -560,3 +560,24 @@ def test_the_call_policy_switch_refuses_other_values(monkeypatch, value):
         calls_kept()
     monkeypatch.setenv(CALLS_VARIABLE, "0")
     assert calls_kept() is False
+
+
+def test_the_call_policy_finds_numbas_nvvm_entry_or_warns(monkeypatch):
+    """nvvm_entry: compile_ir (numba >= 0.60, numba-cuda), else llvm_to_ptx (numba 0.59), else None;
+    with none, installing the policy warns once and leaves numba as it is."""
+    import types
+
+    from numba.cuda.cudadrv import nvvm
+
+    from phaseimpact import cuda as gpu
+
+    assert gpu.nvvm_entry(types.SimpleNamespace(compile_ir=print, llvm_to_ptx=print)) == "compile_ir"
+    assert gpu.nvvm_entry(types.SimpleNamespace(llvm_to_ptx=print)) == "llvm_to_ptx"
+    assert gpu.nvvm_entry(types.SimpleNamespace(compile_ir=None)) is None
+    for name in gpu.NVVM_ENTRIES:
+        monkeypatch.delattr(nvvm, name, raising=False)
+    monkeypatch.delenv(gpu.CALLS_VARIABLE, raising=False)
+    with pytest.warns(RuntimeWarning, match=r"has none of nvvm.compile_ir, nvvm.llvm_to_ptx; the GPU kernel is "
+                                            r"compiled numba's own way"):
+        gpu._install_call_policy.__wrapped__()
+    assert gpu.nvvm_entry(nvvm) is None  # nothing put in their place
