@@ -11,6 +11,10 @@ check refuses it with a message: the command line at once, an archive when it is
 ``NUMBA_NUM_THREADS`` is read by numba: 0 fails deep inside its first parallel call and a
 non-integer is replaced by a warning with a traceback in it; the command line refuses both
 (:func:`numba_num_threads`), and an empty one is unset too.
+
+``PHASEIMPACT_GPU_CALLS`` (0 or 1) is read when the GPU kernel is first built
+(:mod:`phaseimpact.cuda`'s call policy): :func:`gpu_calls_kept` checks it, the command line before
+any work and ``backend="cuda"`` before any run.
 """
 
 from __future__ import annotations
@@ -19,10 +23,13 @@ import os
 import re
 
 __all__ = ["EPOCH_MAX", "source_date_epoch", "hide_bad_source_date_epoch", "restore_source_date_epoch",
-           "numba_num_threads", "unset_empty"]
+           "numba_num_threads", "unset_empty", "gpu_calls_kept", "GPU_CALLS_VARIABLE"]
 
 VARIABLE = "SOURCE_DATE_EPOCH"
 THREADS_VARIABLE = "NUMBA_NUM_THREADS"
+#: ``1`` or unset (the default) keeps the engine's calls calls on the GPU; ``0`` leaves NVVM's
+#: inlining as numba sets it up (:mod:`phaseimpact.cuda`).
+GPU_CALLS_VARIABLE = "PHASEIMPACT_GPU_CALLS"
 #: The last second a timestamp can hold (9999-12-31T23:59:59 UTC), s since 1970.
 EPOCH_MAX = 253_402_300_799
 
@@ -84,3 +91,17 @@ def numba_num_threads() -> int | None:
         raise ValueError(f"{THREADS_VARIABLE} = {text!r} is out of range; allowed: an integer >= 1 (threads of "
                          f"numba's pool; this machine has {cores} cores), or unset")
     return int(text)
+
+
+def gpu_calls_kept() -> bool:
+    """``PHASEIMPACT_GPU_CALLS``: True unless it is ``0``.
+
+    Raises
+    ------
+    ValueError
+        Naming the variable, its value and the allowed range (0 or 1).
+    """
+    value = os.environ.get(GPU_CALLS_VARIABLE, "")
+    if value not in ("", "0", "1"):
+        raise ValueError(f"{GPU_CALLS_VARIABLE} = {value!r} is out of range; allowed: 0 or 1")
+    return value != "0"

@@ -36,7 +36,6 @@ kernels have no entry from Python): the tests run it so, on small grids.
 from __future__ import annotations
 
 import functools
-import os
 import re
 import sys
 import warnings
@@ -44,6 +43,7 @@ import warnings
 import numba
 import numpy as np
 
+from ._environment import GPU_CALLS_VARIABLE, gpu_calls_kept
 from .integrate.record import Y_AT, Y_STATE, workspace_size
 
 try:  # a module global: the simulator swaps it for its own in the kernel's globals
@@ -51,14 +51,11 @@ try:  # a module global: the simulator swaps it for its own in the kernel's glob
 except ImportError as missing:  # a numba built without its CUDA target
     cuda, _MISSING = None, missing
 
-__all__ = ["unavailable", "check", "run_batch_cuda", "THREADS_PER_BLOCK", "CALLS_VARIABLE", "NVVM_ENTRIES"]
+__all__ = ["unavailable", "check", "run_batch_cuda", "THREADS_PER_BLOCK", "NVVM_ENTRIES"]
 
 #: Threads of a block. The per-point kernel is long and holds many registers: small blocks keep
 #: the multiprocessors' register files from limiting the blocks resident at once.
 THREADS_PER_BLOCK = 64
-#: ``PHASEIMPACT_GPU_CALLS``: ``1`` or unset (the default) keeps the engine's calls calls on the GPU;
-#: ``0`` leaves NVVM's inlining as numba sets it up.
-CALLS_VARIABLE = "PHASEIMPACT_GPU_CALLS"
 #: numba's function that hands the IR to NVVM: ``compile_ir`` from numba 0.60 (and in numba-cuda),
 #: ``llvm_to_ptx`` in numba 0.59 (the same arguments: the modules' IR and NVVM's options).
 NVVM_ENTRIES = ("compile_ir", "llvm_to_ptx")
@@ -90,7 +87,9 @@ def unavailable() -> str | None:
 
 def check(law) -> None:
     """Refuse the CUDA backend before any work: a user law (a Python function, which a GPU
-    cannot call), or no usable GPU (:func:`unavailable`). ValueError, one line."""
+    cannot call), ``PHASEIMPACT_GPU_CALLS`` out of range, or no usable GPU (:func:`unavailable`).
+    ValueError, one line."""
+    gpu_calls_kept()
     if law.entry.native is not None:
         raise ValueError(f"backend = 'cuda' cannot run the user law {law.name!r}: its Python function cannot run "
                          "on a GPU; allowed: a built-in law (phaseimpact laws), or backend 'threads'")
@@ -138,14 +137,6 @@ def _device_min_max() -> None:
 
     define(max, register_jitable(inline="always")(lambda x, y: x > y))
     define(min, register_jitable(inline="always")(lambda x, y: x < y))
-
-
-def calls_kept() -> bool:
-    """``PHASEIMPACT_GPU_CALLS`` (module docstring): True unless it is ``0``; ValueError out of range."""
-    value = os.environ.get(CALLS_VARIABLE, "")
-    if value not in ("", "0", "1"):
-        raise ValueError(f"{CALLS_VARIABLE} = {value!r} is out of range; allowed: 0 or 1")
-    return value != "0"
 
 
 def engine_calls() -> frozenset:
@@ -211,7 +202,7 @@ def nvvm_entry(nvvm) -> str | None:
 def _install_call_policy() -> None:
     """Wrap numba's NVVM entry (module docstring): each module once, the engine's calls
     ``noinline``. Once per process; nothing where ``PHASEIMPACT_GPU_CALLS=0``."""
-    if not calls_kept() or numba.config.ENABLE_CUDASIM:
+    if not gpu_calls_kept() or numba.config.ENABLE_CUDASIM:
         return
     from numba.cuda.cudadrv import nvvm
 
@@ -219,7 +210,7 @@ def _install_call_policy() -> None:
     if name is None:
         warnings.warn(f"phaseimpact: numba {numba.__version__}'s CUDA target has none of "
                       f"nvvm.{', nvvm.'.join(NVVM_ENTRIES)}; the GPU kernel is compiled numba's own way, every call "
-                      f"inlined (set {CALLS_VARIABLE}=0 to choose this without the warning)", RuntimeWarning,
+                      f"inlined (set {GPU_CALLS_VARIABLE}=0 to choose this without the warning)", RuntimeWarning,
                       stacklevel=3)
         return
     original, calls = getattr(nvvm, name), engine_calls()

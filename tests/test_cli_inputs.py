@@ -453,6 +453,12 @@ def test_bad_linked_only_switch_refused(monkeypatch, no_work):
     assert code == 2 and "PHASEIMPACT_LINKED_ONLY = 'abc' is out of range; allowed: 0 or 1" in err
 
 
+def test_bad_gpu_calls_switch_refused(monkeypatch, no_work):
+    monkeypatch.setenv("PHASEIMPACT_GPU_CALLS", "2")
+    code, _, err = run(["simulate"])
+    assert code == 2 and "PHASEIMPACT_GPU_CALLS = '2' is out of range; allowed: 0 or 1" in err
+
+
 def test_closed_stdout_is_an_error(tmp_path):
     result = subprocess.run(["sh", "-c", f"exec {shlex.join(CLI)} cases >&-"], capture_output=False, cwd=tmp_path,
                             stderr=subprocess.PIPE, text=True, timeout=120)

@@ -383,10 +383,10 @@ def test_the_device_kernel_compiles_to_ptx_for_an_h100(request):
     digest in pytest's cache, as the cold sessions of tests/test_precompile.py). The calls are
     there: with every function inlined (``PHASEIMPACT_GPU_CALLS=0``) the PTX has no function
     besides the kernel, and NVVM took 277 s of a 298 s compile (benchmarks/results/gpu_compile.md)."""
-    from phaseimpact.cuda import CALLS_VARIABLE
+    from phaseimpact._environment import GPU_CALLS_VARIABLE
 
     policy = hashlib.sha256((PTX + (ROOT / "phaseimpact" / "cuda.py").read_text()).encode()).hexdigest()[:16]
-    key = f"phaseimpact/cuda-ptx/{_jit.engine_digest()}/{policy}/{os.environ.get(CALLS_VARIABLE, '')}"
+    key = f"phaseimpact/cuda-ptx/{_jit.engine_digest()}/{policy}/{os.environ.get(GPU_CALLS_VARIABLE, '')}"
     kept = request.config.cache.get(key, None)
     if kept is None:
         out = subprocess.run([sys.executable, "-c", PTX], capture_output=True, text=True, timeout=1500, cwd=ROOT,
@@ -553,13 +553,17 @@ def test_the_call_policy_names_the_cpu_engines_calls():
 
 @pytest.mark.parametrize("value", ["2", "yes", " 1"])
 def test_the_call_policy_switch_refuses_other_values(monkeypatch, value):
-    from phaseimpact.cuda import CALLS_VARIABLE, calls_kept
+    """Before any work: the check, and backend="cuda" (refused for the switch before the GPU is looked at)."""
+    from phaseimpact._environment import GPU_CALLS_VARIABLE, gpu_calls_kept
 
-    monkeypatch.setenv(CALLS_VARIABLE, value)
-    with pytest.raises(ValueError, match=rf"PHASEIMPACT_GPU_CALLS = '{value}' is out of range; allowed: 0 or 1"):
-        calls_kept()
-    monkeypatch.setenv(CALLS_VARIABLE, "0")
-    assert calls_kept() is False
+    monkeypatch.setenv(GPU_CALLS_VARIABLE, value)
+    message = rf"PHASEIMPACT_GPU_CALLS = '{value}' is out of range; allowed: 0 or 1"
+    with pytest.raises(ValueError, match=message):
+        gpu_calls_kept()
+    with pytest.raises(ValueError, match=message):
+        atlas(seed_parameters(), "paper", {"kappa": [1e9, 1e10]}, backend="cuda")
+    monkeypatch.setenv(GPU_CALLS_VARIABLE, "0")
+    assert gpu_calls_kept() is False
 
 
 def test_the_call_policy_finds_numbas_nvvm_entry_or_warns(monkeypatch):
@@ -576,7 +580,7 @@ def test_the_call_policy_finds_numbas_nvvm_entry_or_warns(monkeypatch):
     assert gpu.nvvm_entry(types.SimpleNamespace(compile_ir=None)) is None
     for name in gpu.NVVM_ENTRIES:
         monkeypatch.delattr(nvvm, name, raising=False)
-    monkeypatch.delenv(gpu.CALLS_VARIABLE, raising=False)
+    monkeypatch.delenv("PHASEIMPACT_GPU_CALLS", raising=False)
     with pytest.warns(RuntimeWarning, match=r"has none of nvvm.compile_ir, nvvm.llvm_to_ptx; the GPU kernel is "
                                             r"compiled numba's own way"):
         gpu._install_call_policy.__wrapped__()

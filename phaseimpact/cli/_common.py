@@ -66,7 +66,7 @@ _NEGATIVE_NUMBER = re.compile(r"^-(\d+\.?\d*|\.\d+)(e[-+]?\d+)?$|^-(inf|infinity
 
 def _check_environment() -> None:
     """The environment this process runs in, checked before any work (``ValueError`` names it)."""
-    from .._environment import numba_num_threads, source_date_epoch
+    from .._environment import gpu_calls_kept, numba_num_threads, source_date_epoch
     from .._jit import linked_only_requested
 
     if sys.stdout is None:  # started with stdout closed (cmd >&-): nothing could be reported
@@ -74,6 +74,7 @@ def _check_environment() -> None:
     source_date_epoch()
     numba_num_threads()
     linked_only_requested()  # PHASEIMPACT_LINKED_ONLY: read only by a first compile, checked every time
+    gpu_calls_kept()  # PHASEIMPACT_GPU_CALLS: read only by the GPU kernel's first compile, checked every time
 
 
 class _Parser(argparse.ArgumentParser):
