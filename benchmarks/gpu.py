@@ -79,7 +79,7 @@ def kernel_resources() -> str:
         registers = list(kernel.get_regs_per_thread().values())
         local = list(kernel.get_local_mem_per_thread().values())
         most = list(kernel.get_max_threads_per_block().values())
-    except Exception as why:  # a numba-cuda without these queries: say so, the times still stand
+    except AttributeError as why:  # a numba-cuda without these queries: say so, the times still stand
         return f"kernel resources not read ({type(why).__name__}: {why})"
     return (f"The kernel: {registers} registers and {local} bytes of local memory per thread, at most {most} "
             f"threads a block (blocks of {cuda.THREADS_PER_BLOCK})")
@@ -102,17 +102,18 @@ def run(side: int, check: int, threads: list[int]) -> tuple[list[list], list[dic
     print(f"compiling the CUDA kernel ({time.strftime('%H:%M:%S')})", flush=True)
     compile_s, _ = timed(lambda: atlas(base, "paper", grid(2), backend="cuda"))
     gpu_s, gpu = timed(lambda: atlas(base, "paper", axes, backend="cuda"))
-    rows = [["(a) paper atlas", n, "GPU (cuda)", gpu_s, f"kernel compile and first launch {compile_s:.3g} s"]]
-    print(rows[-1], flush=True)  # the GPU's rows first: a run cut short by the lease still says them
+    atlas_rows = [["(a) paper atlas", n, "GPU (cuda)", gpu_s, f"kernel compile and first launch {compile_s:.3g} s"]]
+    print(atlas_rows[-1], flush=True)  # the GPU's rows first: a run cut short by the lease still says them
     hc_s, _ = timed(lambda: atlas(base, "hunt-crossley", axes, t_end=2e-3, backend="cuda"))
-    rows.append(["(b) hunt-crossley, t_end 2e-3", n, "GPU (cuda)", hc_s,
-                 "diffrax: not compared (diffrax, jax, equinox not installed; no wheels carried)"])
-    print(rows[-1], flush=True)
+    hunt_crossley_row = ["(b) hunt-crossley, t_end 2e-3", n, "GPU (cuda)", hc_s,
+                         "diffrax: not compared (diffrax, jax, equinox not installed; no wheels carried)"]
+    print(hunt_crossley_row, flush=True)
     cpu = None
     for k in threads:
         cpu_s, cpu = timed(lambda k=k: atlas(base, "paper", axes, n_jobs=k))
-        rows.insert(len(rows) - 1, ["(a) paper atlas", n, f"CPU, {k} threads", cpu_s, ""])
-        print(rows[-2], flush=True)
+        atlas_rows.append(["(a) paper atlas", n, f"CPU, {k} threads", cpu_s, ""])
+        print(atlas_rows[-1], flush=True)
+    rows = [*atlas_rows, hunt_crossley_row]
     subset = min(check, n)
     same, worst = compare(gpu, cpu, subset)
     rows.append(["(c) GPU vs CPU", subset, "codes and counts equal" if same else "**codes or counts differ**",

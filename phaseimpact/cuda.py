@@ -159,7 +159,7 @@ def _demangled(symbol: str) -> str:
     parts, i = [], 3
     while i < len(symbol) and symbol[i].isdigit():
         j = i
-        while symbol[j].isdigit():
+        while j < len(symbol) and symbol[j].isdigit():
             j += 1
         length = int(symbol[i:j])
         parts.append(symbol[j:j + length])
