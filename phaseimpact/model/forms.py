@@ -75,8 +75,16 @@ def make_code(form: int, flags: int, address: int = 0) -> int:
 @kernel(python=True, forceinline=True)
 def hertz_power(ad, alpha):
     """``ad**alpha`` for ``ad >= 0``; Hertz's 3/2 as the cheaper ``ad*sqrt(ad)``."""
+    return _hertz_power(ad, alpha, -1.0)
+
+
+@kernel(forceinline=True)
+def _hertz_power(ad, alpha, root):
+    """:func:`hertz_power` with ``root``, ``sqrt(ad)`` where the caller has it (a regularised phase:
+    ``|w|``, the same number: ``sqrt(w*w) == |w|`` in binary floating point), else -1: the square
+    root is on the critical path of every stage of a step."""
     if alpha == 1.5:
-        return ad * math.sqrt(ad)
+        return ad * (root if root >= 0 else math.sqrt(ad))
     return ad**alpha
 
 
@@ -162,16 +170,23 @@ def contact_force(code, delta, deltadot, mode, K, damping, alpha):
     ``mode`` is ignored except by ``paper`` (sign factor); the stuck force of ``paper`` is not a
     function of ``(delta, deltadot)`` and comes from :func:`phaseimpact.model.rhs.stick_force`.
     """
+    return _contact_force(code, delta, -1.0, deltadot, mode, K, damping, alpha)
+
+
+@kernel(forceinline=True)
+def _contact_force(code, delta, root, deltadot, mode, K, damping, alpha):
+    """:func:`contact_force` with ``root``, ``sqrt(|delta|)`` where the caller has it, else -1
+    (:func:`_hertz_power`)."""
     unilateral = (code & UNILATERAL) != 0
     if unilateral and delta <= 0:
         return 0.0
     form = (code >> FORM_SHIFT) & FORM_MASK
     if form == ELASTIC:
         if unilateral:
-            return K * hertz_power(delta, alpha)
-        return K * hertz_power(abs(delta), alpha) * _sign(delta)
+            return K * _hertz_power(delta, alpha, root)
+        return K * _hertz_power(abs(delta), alpha, root) * _sign(delta)
     if form == HUNT_CROSSLEY:
-        force = (K + damping * deltadot) * hertz_power(delta, alpha)
+        force = (K + damping * deltadot) * _hertz_power(delta, alpha, root)
         return max(force, 0.0) if (code & CLAMP) != 0 else force
     if form == KUWABARA_KONO:
         return _kuwabara_kono_force(code, delta, deltadot, K, damping, alpha)
@@ -179,7 +194,7 @@ def contact_force(code, delta, deltadot, mode, K, damping, alpha):
         return _native(code >> ADDRESS_SHIFT, int(FORCE), delta, deltadot, mode, K, damping, alpha)
     if form == PAPER:  # eq. 8
         sign = _sign(deltadot) if mode == PLAIN else float(mode)
-        return (K + damping * deltadot) * hertz_power(abs(delta), alpha) * sign
+        return (K + damping * deltadot) * _hertz_power(abs(delta), alpha, root) * sign
     return math.nan  # a form without a branch here (register refuses it): never another law's force
 
 
@@ -330,11 +345,18 @@ def force_of(code, c, delta, deltadot, mode):
     """The contact force of a run with packed coefficients ``c`` (what the engine calls): the
     law's :func:`contact_force`, or a law with memory read from ``c`` (its form's memory branch;
     NaN for a form without one)."""
+    return force_of_root(code, c, delta, -1.0, deltadot, mode)
+
+
+@kernel(forceinline=True)
+def force_of_root(code, c, delta, root, deltadot, mode):
+    """:func:`force_of` given ``root = sqrt(|delta|)`` (-1 where the caller does not have it): a
+    regularised phase's ``|w|`` saves the Hertz term its square root."""
     if has_memory(code):
         if (code >> FORM_SHIFT) & FORM_MASK == THORNTON:
             return _thornton(c, delta)[0] if delta > 0 else 0.0
         return math.nan
-    return contact_force(code, delta, deltadot, mode, c[K_], c[DAMP_], c[ALPHA_])
+    return _contact_force(code, delta, root, deltadot, mode, c[K_], c[DAMP_], c[ALPHA_])
 
 
 @kernel(python=True, forceinline=True)

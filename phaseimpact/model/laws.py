@@ -48,14 +48,16 @@ package:
    :data:`HUNT_CROSSLEY`). :func:`register` refuses a form missing from :data:`FORMS`, and the
    kernels give NaN for a form without a branch: a law is never computed with another law's
    force.
-2. Write the form's branch (in :mod:`phaseimpact.model.forms`) in :func:`contact_force`,
+2. Write the form's branch (in :mod:`phaseimpact.model.forms`) in :func:`contact_force` (its
+   body ``_contact_force``, which also takes the ``sqrt(|delta|)`` a regularised phase has),
    :func:`force_partials` (exact partial derivatives, zero where ``P`` is 0) and, if its elastic
    term has a potential, :func:`contact_potential` (a Filippov law has none; a Filippov form
    also gives its force at rest in :func:`stick_bound`: the stick holds while the required force
    stays within it). A branch reads the flags from ``code``: :data:`UNILATERAL` (the kernels
    already return 0 for ``delta <= 0``), :data:`CLAMP` (``P >= 0``), and the sign factor of a
    :data:`FILIPPOV` law from ``mode``. A law with memory (:data:`MEMORY`, set from
-   :attr:`LawEntry.memory`) writes its branch in :func:`force_of`, :func:`partials_of` and
+   :attr:`LawEntry.memory`) writes its branch in :func:`force_of` (its body
+   :func:`force_of_root`), :func:`partials_of` and
    :func:`remember` instead, reading its state from the packed coefficients (its dent, if any,
    at ``DENT_``).
    **Inlining rule:** the branch calls an out-of-line kernel of the form's own

@@ -54,6 +54,7 @@ from .forms import (  # noqa: F401 (the packed layout, re-exported: the engine's
     STUCK,
     contact_gap,
     force_of,
+    force_of_root,
     is_filippov,
     partials_of,
     potential_of,
@@ -240,7 +241,7 @@ def rhs_values(code, c, u0, x2, v1, v2, mode, side):
         return v1, v2, 0.0, 0.0 if c[RIGID_] > 0 else -spring_force(c, x2) / c[M2_], 0.0, 1.0, 0.0
     w = u0
     delta = side * w * w
-    force = force_of(code, c, delta, deltadot, mode)
+    force = force_of_root(code, c, delta, abs(w), deltadot, mode)
     if w < 0:
         force = -force
     if c[IMPEDANCE_] > 0:
