@@ -163,9 +163,9 @@ def test_editing_a_kernel_in_a_copy_changes_the_next_run(tmp_path):
 
     forms = package / "model" / "forms.py"
     text = forms.read_text()
-    edited = re.sub(r"(def hertz_power\(ad, alpha\):\n(?:    .*\n)*?)(    )(if alpha == 1\.5:)",
+    edited = re.sub(r"(def _hertz_power\(ad, alpha, root\):\n(?:    .*\n)*?)(    )(if alpha == 1\.5:)",
                     r"\1\2return 2.0 * ad**alpha\n\2\3", text, count=1)
-    assert edited != text, "hertz_power's body was not found: update this test's edit"
+    assert edited != text, "_hertz_power's body was not found: update this test's edit"
     forms.write_text(edited)
     second = _run(RUN, package.parent, NUMBA_CACHE_DIR=str(root))
     assert second.returncode == 0, second.stderr[-3000:]
