@@ -46,6 +46,13 @@ What runs a few times per run stays a call: the entries, the loop (``_loop``), i
 and :func:`.integrate.step.advance` (which keeps its steps in a loop of its own);
 ``tests/test_integrate.py`` holds the list.
 
+Every function is compiled with numba's ``error_model="numpy"``: a float division by zero gives
+IEEE's inf or NaN, as on the GPU (numba's CUDA target has no other model), and the run reports it
+with a status (``non-finite``), not a traceback. numba's default (``"python"``) tests every divisor
+and raises ZeroDivisionError, and every call of a function that can raise is followed by a test
+of its exception status (the same bits without them, and a Hunt-Crossley trajectory's time the
+same within the machine's spread: ``benchmarks/results/trajectory_against.md``).
+
 Numba is imported only when something is compiled. Until then (``phaseimpact cases``, ``params``,
 building a case: they import the laws but integrate nothing) a decorated function is a
 :class:`_Deferred` placeholder; the first use of one, or the first decoration once numba is
@@ -636,7 +643,7 @@ def _compiler(reference_counted: bool):
     def decorate(function=None, *, python: bool = False, forceinline: bool = False, inline: str = "never",
                  nogil: bool = False):
         options = dict(_nrt=reference_counted, forceinline=forceinline, inline=inline, nogil=nogil,
-                       no_cpython_wrapper=not python, no_cfunc_wrapper=True)
+                       no_cpython_wrapper=not python, no_cfunc_wrapper=True, error_model="numpy")
 
         def compile_(f):
             if "numba" in sys.modules:  # numba's import is paid: compile-ready functions, placeholders too

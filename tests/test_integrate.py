@@ -562,6 +562,22 @@ def test_compiled_functions_called_from_python_have_a_python_entry():
                 assert not obj.targetoptions.get("no_cpython_wrapper"), f"{name}.{exported}"
 
 
+def test_a_division_by_zero_in_the_engine_gives_ieee_values_not_an_exception():
+    """The engine is compiled with numba's error_model "numpy" (phaseimpact._jit), the GPU's: a
+    float division by zero gives inf or NaN, which a run reports as a status, where numba's default
+    raises ZeroDivisionError out of the compiled code. Here the projectile's rate -w P / M1 with
+    M1 = 0 in a regularised contact (w > 0, P > 0)."""
+    from phaseimpact.model import pack
+    from phaseimpact.model.forms import M1_
+    from phaseimpact.model.rhs import rhs_values
+
+    law = ContactLaw("hunt-crossley")
+    c = pack(seed_parameters(v=1.0, kappa=3e9), law)
+    c[M1_] = 0.0
+    rates = rhs_values(law.code, c, 1e-3, 0.0, 0.3, 0.0, 1, 1)
+    assert rates[6] > 0 and rates[2] == -math.inf
+
+
 def test_no_kernel_returns_an_array():
     """A kernel (compiled without reference counting) that returned an array to a counting caller
     would have it freed under its owner (memory corruption): every compiled overload of every
