@@ -28,13 +28,14 @@ from _common import FIGURES, RESULTS, emit, load, machine  # noqa: E402
 #: In run order: peers (heyoka) before work_precision, which draws its points.
 SCRIPTS = ("startup", "compile_profile", "trajectory", "throughput", "critical", "peers", "work_precision",
            "scene_savings", "stress", "stiff", "atlas", "train", "scale")
-SECTIONS = ("trajectory", "trajectory_against", "throughput", "critical", "startup", "compile_profile",
-            "compile_against", "work_precision", "peers", "stiff", "atlas", "scene_savings", "stress", "train",
-            "scale", "scale_gpu_machine", "gpu_compile", "gpu_compile_numba_cuda", "gpu")
+SECTIONS = ("trajectory", "trajectory_against", "trajectory_against_self", "throughput", "critical", "startup",
+            "compile_profile", "compile_against", "work_precision", "peers", "stiff", "atlas", "scene_savings",
+            "stress", "train", "scale", "scale_gpu_machine", "gpu_compile", "gpu_compile_numba_cuda", "gpu")
 #: gpu.py is not in SCRIPTS: it is run on a GPU machine (its section says where it was, or that it was not);
 #: gpu_compile.py neither (it needs NVVM, and numba's own inlining takes it five minutes);
 #: trajectory_against and compile_against come from ``trajectory.py --against TREE`` and
-#: ``compile_profile.py --against TREE`` (another checkout), run by hand.
+#: ``compile_profile.py --against TREE`` (another checkout), run by hand; trajectory_against_self is
+#: ``trajectory.py --against`` a checkout of the same commit (the noise floor of a comparison), renamed.
 
 
 def _pick(name: str, suffix: str, quick_first: bool = False):
