@@ -139,6 +139,22 @@ def test_dataclasses_replace_revalidates(obj, name, bad):
             obj.replace(**{name: bad})
 
 
+@pytest.mark.parametrize("name", [f.name for f in dataclasses.fields(Parameters)])
+def test_replace_is_dataclasses_replace(name):
+    """Parameters.replace (a copy of the fields, validated by __post_init__) gives what
+    dataclasses.replace gives for a change of any field: every value and its type (ints and NumPy
+    floats stored as floats), and nothing more in the instance."""
+    p = seed_parameters()
+    value = {"target": "rigid", "alpha": 2, "kappa": np.float64(3e9), "v": 13, "R": 0.01,
+             "limiting_pressure": 3e8, "impedance": 1e3}.get(name)
+    value = getattr(p, name) * 2 if value is None else value
+    got, expected = p.replace(**{name: value}), dataclasses.replace(p, **{name: value})
+    assert type(got) is Parameters and got.__dict__.keys() == expected.__dict__.keys()
+    assert [(v, type(v)) for v in got.__dict__.values()] == [(expected.__dict__[k], type(expected.__dict__[k]))
+                                                              for k in got.__dict__]
+    assert getattr(got, name) == value
+
+
 def test_replace_with_valid_values_keeps_the_rest():
     p = seed_parameters()
     q = p.replace(kappa=3e9, v=13.0)
