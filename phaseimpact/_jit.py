@@ -47,8 +47,8 @@ and :func:`.integrate.step.advance` (which keeps its steps in a loop of its own)
 ``tests/test_integrate.py`` holds the list.
 
 Every function is compiled with numba's ``error_model="numpy"``: a float division by zero gives
-IEEE's inf or NaN, as on the GPU (numba's CUDA target has no other model), and the run reports it
-with a status (``non-finite``), not a traceback. numba's default (``"python"``) tests every divisor
+IEEE's inf or NaN, as on the GPU (numba's CUDA target has no other model), which the run's
+steps and checks turn into a status, not a traceback. numba's default (``"python"``) tests every divisor
 and raises ZeroDivisionError, and every call of a function that can raise is followed by a test
 of its exception status (the same bits without them, and a Hunt-Crossley trajectory's time the
 same within the machine's spread: ``benchmarks/results/trajectory_against.md``).

@@ -578,6 +578,32 @@ def test_a_division_by_zero_in_the_engine_gives_ieee_values_not_an_exception():
     assert rates[6] > 0 and rates[2] == -math.inf
 
 
+NAN_RATE_RUN = """
+from phaseimpact import seed_parameters
+from phaseimpact.integrate import api, driver as d
+from phaseimpact.model import as_law, pack
+from phaseimpact.model.forms import M2_
+p, law = seed_parameters(v=1.0, kappa=3e9), as_law("hunt-crossley")
+c = pack(p, law)
+c[M2_] = 0.0  # the target's rate (P - spring) / M2 is 0/0 at the contact's start: NaN
+out = d.run(law.code, c, api._initial(p, None), api._atol(p, 1e-10, None), 2e-3, api.scales(p).max_step,
+            (1e-10, True, -1, 0, 100_000, api.MAX_EVENTS, api._stiff_after(True)), d.SAVE_SUMMARY,
+            api._NO_TIMES, api.radau_marker(api._stiff_after(True)))
+print(d.STATUSES[int(out[0][d.S_STATUS])])
+"""
+
+
+def test_a_nan_rate_ends_the_run_with_a_status_not_a_hang():
+    """A NaN rate at a phase's start makes scipy's initial-step rule give a NaN step. The step loops
+    tested ``h < 10 ulp`` for a collapse, which is False for NaN, and spun forever without counting a
+    step (found with the target's mass zeroed: ZeroDivisionError under numba's default error model,
+    a hang under the engine's "numpy" one). Run in a process of its own, so that a hang fails the
+    test instead of stopping the suite."""
+    out = subprocess.run([sys.executable, "-c", NAN_RATE_RUN], capture_output=True, text=True, timeout=240)
+    assert out.returncode == 0, out.stderr[-3000:]
+    assert out.stdout.split()[-1] == "step-size-collapse"
+
+
 def test_no_kernel_returns_an_array():
     """A kernel (compiled without reference counting) that returned an array to a counting caller
     would have it freed under its owner (memory corruption): every compiled overload of every

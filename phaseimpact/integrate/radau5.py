@@ -461,7 +461,7 @@ def attempt(code, c, mode, side, s, s_bound, h_abs, stiff, rows):
     s_new = s
     h = 0.0
     while True:
-        if h_abs < 10.0 * ulp_above(s):
+        if not h_abs >= 10.0 * ulp_above(s):  # NaN too, as in DOP853's attempt
             return False, s, h_abs, 0.0, evaluations
         s_new = min(s + h_abs, s_bound)
         h = s_new - s

@@ -163,7 +163,7 @@ def _dop853_attempt(code, ws, s, s_bound, h_abs):
     rejected = False
     h_rejected = err_rejected = 0.0
     while True:
-        if h_abs < 10.0 * ulp_above(s):
+        if not h_abs >= 10.0 * ulp_above(s):  # a NaN step (from a NaN rate) collapses too: never a loop without end
             return False, s, h_abs, 0.0, evaluations
         s_new = min(s + h_abs, s_bound)
         h = s_new - s
