@@ -581,14 +581,15 @@ def test_a_division_by_zero_in_the_engine_gives_ieee_values_not_an_exception():
 NAN_RATE_RUN = """
 from phaseimpact import seed_parameters
 from phaseimpact.integrate import api, driver as d
-from phaseimpact.model import as_law, pack
+from phaseimpact.model import as_law
 from phaseimpact.model.forms import M2_
-p, law = seed_parameters(v=1.0, kappa=3e9), as_law("hunt-crossley")
-c = pack(p, law)
+law = as_law("hunt-crossley")
+c, atol, y0, scales = api._packed(seed_parameters(v=1.0, kappa=3e9), law, 1e-10)  # simulate's inputs
+c = c.copy()
 c[M2_] = 0.0  # the target's rate (P - spring) / M2 is 0/0 at the contact's start: NaN
-out = d.run(law.code, c, api._initial(p, None), api._atol(p, 1e-10, None), 2e-3, api.scales(p).max_step,
-            (1e-10, True, -1, 0, 100_000, api.MAX_EVENTS, api._stiff_after(True)), d.SAVE_SUMMARY,
-            api._NO_TIMES, api.radau_marker(api._stiff_after(True)))
+stiff = api._stiff_after(True)
+out = d.run(law.code, c, y0, atol, 2e-3, scales.max_step, (1e-10, True, -1, 0, 100_000, api.MAX_EVENTS, stiff),
+            d.SAVE_SUMMARY, api._NO_TIMES, api.radau_marker(stiff))
 print(d.STATUSES[int(out[0][d.S_STATUS])])
 """
 
