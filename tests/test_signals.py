@@ -125,6 +125,18 @@ def test_an_interleaved_block_marks_only_its_own_runs_interrupted(pipe):
     assert np.all(status[mine[mine >= first_polled]] == d.INTERRUPTED)
 
 
+def _threaded_chunk(n: int, threads: int = 2):
+    """A chunk of ``n`` paper runs for _run_in_threads: its arguments, the outputs (summaries -7:
+    a run no thread touched) and the workspaces."""
+    seq = [seed_parameters(v=1.0, kappa=k) for k in np.geomspace(1e9, 1e11, n)]
+    batch = pack_batch(seq, as_law("paper"), None, 1e-10)
+    summary = np.full((n, d.N_SUMMARY), -7.0)
+    st = np.empty((3, n, 32))
+    args = (batch.law.code, (batch.C, batch.Y0, batch.t_end, batch.atol, batch.max_step),
+            (1e-10, True, -1, 0, api.MAX_STEPS, api.MAX_EVENTS, api._stiff_after(True)))
+    return args, (summary, *st, np.empty(n, np.int64)), np.zeros((threads, workspace_size(batch.C.shape[1], 32)))
+
+
 def test_threads_start_no_task_after_one_was_interrupted(pipe):
     """run_batch's threads take interleaved tasks as they come free; once a task has seen Ctrl-C,
     the tasks not yet started run nothing and mark their runs interrupted (a chunk stops within a
@@ -132,16 +144,10 @@ def test_threads_start_no_task_after_one_was_interrupted(pipe):
     threads = 2
     tasks = batches.TASKS_PER_THREAD * threads
     n = 2 * tasks * (d.POLL_RUNS + 6)  # each of the first tasks polls once, at its POLL_RUNS-th run
-    seq = [seed_parameters(v=1.0, kappa=k) for k in np.geomspace(1e9, 1e11, n)]
-    batch = pack_batch(seq, as_law("paper"), None, 1e-10)
-    summary = np.full((n, d.N_SUMMARY), -7.0)
-    st = np.empty((3, n, 32))
+    args, outputs, work = _threaded_chunk(n, threads)
     os.write(pipe, b"\x02")
-    batches._run_in_threads((batch.law.code, (batch.C, batch.Y0, batch.t_end, batch.atol, batch.max_step),
-                             (1e-10, True, -1, 0, api.MAX_STEPS, api.MAX_EVENTS, api._stiff_after(True))),
-                            (summary, *st, np.empty(n, np.int64)),
-                            np.zeros((threads, workspace_size(batch.C.shape[1], 32))), n, True)
-    status = summary[:, d.S_STATUS]
+    batches._run_in_threads(args, outputs, work, n, True)
+    status = outputs[0][:, d.S_STATUS]
     ran = status == d.SUCCESS
     assert np.all(ran | (status == d.INTERRUPTED))  # every run accounted for, none left untouched
     # only the tasks running when the first poll came (the first one, or the first two on two
@@ -150,6 +156,65 @@ def test_threads_start_no_task_after_one_was_interrupted(pipe):
     runs = np.flatnonzero(ran)
     assert runs.max() < head
     assert set(runs % tasks) in ({0}, {1}, {0, 1}) and ran.sum() in (d.POLL_RUNS - 1, 2 * (d.POLL_RUNS - 1))
+
+
+def _logged_run_block(monkeypatch, fail):
+    """run_block, patched to log each call (in the caller's thread or not, the task's first run) in
+    the order of the calls, and to raise ``fail(in_caller, calls_so_far)`` instead of running when
+    that gives an exception."""
+    real, calls = batches.d.run_block, []
+
+    def logged(*args):
+        in_caller = threading.current_thread() is threading.main_thread()
+        calls.append((in_caller, args[3]))
+        failure = fail(in_caller, calls)
+        if failure is not None:
+            raise failure
+        real(*args)
+
+    monkeypatch.setattr(batches.d, "run_block", logged)
+    return calls
+
+
+def _untouched_tasks_are_interrupted(outputs, calls, n):
+    """Every task no thread started is marked interrupted, in its every run."""
+    status = outputs[0][:, d.S_STATUS]
+    started = {start for _, start in calls}
+    for start, stop, step in batches.thread_tasks(n, 2):
+        if start not in started:
+            assert np.all(status[start:stop:step] == d.INTERRUPTED), (start, stop, step)
+
+
+def test_a_failure_in_a_helper_thread_is_raised_by_the_caller(monkeypatch):
+    """_run_in_threads runs tasks in the caller's thread and a helper: an exception in the helper
+    is raised in the caller, not lost with the thread, and the caller starts at most one more task
+    (the one it took as the failure came: a look, then a start)."""
+    calls = _logged_run_block(monkeypatch, lambda in_caller, _: None if in_caller else RuntimeError("a helper failed"))
+    n = 4 * batches.TASKS_PER_THREAD * 2
+    args, outputs, work = _threaded_chunk(n)
+    with pytest.raises(RuntimeError, match="a helper failed"):
+        batches._run_in_threads(args, outputs, work, n, True)
+    failed = next(k for k, (in_caller, _) in enumerate(calls) if not in_caller)
+    assert sum(in_caller for in_caller, _ in calls[failed + 1:]) <= 1
+    _untouched_tasks_are_interrupted(outputs, calls, n)
+
+
+def test_ctrl_c_in_the_caller_between_two_tasks_stops_the_helper(monkeypatch):
+    """Ctrl-C raised in the caller's thread between two of its tasks (where Python runs the signal's
+    handler): the helper starts at most one more task, and the caller raises it once the helper
+    has stopped."""
+    def second_call_in_caller(in_caller, calls):
+        return KeyboardInterrupt() if in_caller and sum(c for c, _ in calls) == 2 else None
+
+    calls = _logged_run_block(monkeypatch, second_call_in_caller)
+    n = 4 * batches.TASKS_PER_THREAD * 2
+    args, outputs, work = _threaded_chunk(n)
+    with pytest.raises(KeyboardInterrupt):
+        batches._run_in_threads(args, outputs, work, n, True)
+    raised = [k for k, (in_caller, _) in enumerate(calls) if in_caller][1]
+    assert sum(not in_caller for in_caller, _ in calls[raised + 1:]) <= 1
+    assert sum(in_caller for in_caller, _ in calls) == 2
+    _untouched_tasks_are_interrupted(outputs, calls, n)
 
 
 @pytest.mark.parametrize(("n", "threads"), [(1, 2), (7, 2), (100, 2), (600, 2), (4096, 2), (8000, 2), (2000, 16),
