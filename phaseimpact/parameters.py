@@ -400,8 +400,7 @@ class Parameters:
     def hertz_indentation(self) -> float:
         """Largest indentation of the undamped impact of the reduced mass, m (docs/physics.md §4):
         ``((alpha+1) m v^2 / (2K))^(1/(alpha+1))``, ``(5 m v^2/(4K))^(2/5)`` for Hertz."""
-        a = self.alpha
-        return ((a + 1) * self.reduced_mass * self.v**2 / (2 * self.K)) ** (1 / (a + 1))
+        return indentation_of(self.alpha, self.reduced_mass, self.v, self.K)
 
     def as_dict(self) -> dict:
         """The parameters as a plain dict (for JSON; ``None`` stays ``None``).
@@ -521,6 +520,12 @@ def derive_parameters(
     impedance = 8 * math.sqrt(rigidity * areal_density)  # Zener's point impedance (docs/physics.md §8)
     return Parameters(M1=M1, M2=M2, K=K, Kb=Kb, Km=Km, alpha=alpha, kappa=kappa, v=v, target=target, R=R,
                       limiting_pressure=p_y, impedance=impedance)
+
+
+def indentation_of(alpha: float, reduced_mass: float, v: float, K: float) -> float:
+    """:attr:`Parameters.hertz_indentation` of plain floats, m: one expression for a case and for the
+    cases of a batch packed on columns (Python's ``**``, whose bits numpy's power need not give)."""
+    return ((alpha + 1) * reduced_mass * v**2 / (2 * K)) ** (1 / (alpha + 1))
 
 
 def _bending_shear(laminate, a: float, R: float, K: float, reduced_mass: float, v: float) -> float:

@@ -15,11 +15,11 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..case import Case
-from ..integrate.api import check_rtol, hertz_contact_time, scales, state_tolerances
+from ..integrate.api import HORIZON_CAP_PERIODS, check_rtol, hertz_contact_time, scales, state_tolerances
 from ..integrate.batch import Batch, pack_batch
 from ..model.laws import ContactLaw
 from ..model.rhs import ALPHA_, DAMP_, K_, M1_, pack
-from ..parameters import KAPPA_MAX, PARAMETER_NAMES, V_RANGE, Parameters, is_number
+from ..parameters import KAPPA_MAX, PARAMETER_NAMES, V_RANGE, Parameters, indentation_of, is_number
 from ..settings import QUANTITIES, SETTABLE
 
 __all__ = ["Axis", "Grid", "parse_axis", "MAX_POINTS"]
@@ -455,15 +455,19 @@ class Grid:
             Y0[:, 2] = v
             s = scales(base)
             alpha = C[0, ALPHA_]
-            # the same expressions as Parameters.hertz_indentation and scales(), on arrays
-            indentation = ((alpha + 1) * base.reduced_mass * v**2 / (2 * C[0, K_])) ** (1 / (alpha + 1))
-            A = state_tolerances(rtol, indentation, v, C[:, M1_], hertz_contact_time(alpha, indentation, v))
+            # Parameters.hertz_indentation per point (Python's power: numpy's differs in the last bit for
+            # ~5 % of the values, and so would a point of the atlas from simulate's run of it); scales()'s
+            # other expressions on arrays
+            m, K = base.reduced_mass, float(C[0, K_])
+            indentation = np.array([indentation_of(float(alpha), m, x, K) for x in v.tolist()])
+            contact_time = hertz_contact_time(alpha, indentation, v)
+            A = state_tolerances(rtol, indentation, v, C[:, M1_], contact_time)
             if t_end is not None:
                 T = np.full(n, t_end)
             elif math.isfinite(s.plate_period):
                 T = np.full(n, s.horizon)
-            else:  # the horizon scales with the contact time, which scales with the indentation over v
-                T = s.horizon * (indentation / v) / (base.hertz_indentation / base.v)
+            else:  # scales()'s horizon of each point: a number of its contact times
+                T = HORIZON_CAP_PERIODS * contact_time
             return Batch(self.law, C, Y0, T, A, np.full(n, s.max_step))
         points = (self.parameters_at({k: v[i] for k, v in columns.items()}) for i in range(n))
         return pack_batch(points, self.law, t_end, rtol)

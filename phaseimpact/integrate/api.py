@@ -128,8 +128,9 @@ def hertz_contact_time(alpha, indentation, v):
     """Duration of the undamped impact, ``2 tau delta_max / v`` (s; scalars or arrays, ``alpha`` too)."""
     if type(alpha) is float or np.ndim(alpha) == 0:  # (the first test spares a case np.ndim's cost)
         tau = _hertz_tau(alpha)
-    else:
-        tau = np.array([_hertz_tau(a) for a in np.asarray(alpha).tolist()])
+    else:  # a batch has few distinct exponents
+        exponents, which = np.unique(alpha, return_inverse=True)
+        tau = np.array([_hertz_tau(a) for a in exponents.tolist()])[which]
     return 2 * tau * indentation / v
 
 
