@@ -13,6 +13,7 @@ from scipy.special import gamma
 
 from phaseimpact import ContactLaw, scales, seed_parameters, simulate, simulate_many
 from phaseimpact._oracle import oracle
+from phaseimpact.integrate import batch
 from phaseimpact.model import hunt_crossley_restitution
 
 SEED = seed_parameters(v=1.0)
@@ -139,6 +140,36 @@ def test_many_runs_equal_single_runs_and_do_not_depend_on_threads():
         np.testing.assert_array_equal(tr.stick_points()[1], one.sticks_of(i)[1])
     assert one.n_stick[1] == 42 and len(one.sticks_of(1)[0]) == 42  # more than the 32-point buffer
     assert one.n_stick[3] > 42 and len(one.stick_t) == one.n_stick.sum()
+
+
+def test_many_runs_in_chunks_of_growing_size_equal_one_chunk():
+    """simulate_many in threads packs its cases in chunks that start small and double (each packed
+    while the one before runs): 4000 cases in chunks of 1024, 2048 and 928 give the columns of one
+    thread's single chunk bit for bit, the stick points of runs past the 32-point buffer in the
+    first and the last chunk included."""
+    kappas = np.geomspace(1e9, 1e13, 4000)
+    kappas[[100, 3990]] = KAPPA_C * (1 + 1e-4)  # 42 stick phases each
+    params = [SEED.replace(kappa=float(k)) for k in kappas]
+    assert [len(range(4000)[part]) for part in batch.pack_chunks(4000, True)] == [1024, 2048, 928]
+    one, two = simulate_many(params, "paper", n_threads=1), simulate_many(params, "paper", n_threads=2)
+    for name in ("status", "outcome", "stop_reason", "stick_count", "stick_t", "stick_delta", "stick_dwell"):
+        np.testing.assert_array_equal(getattr(one, name), getattr(two, name))
+    for name, column in one.values.items():
+        np.testing.assert_array_equal(column, two.values[name])
+    assert one.n_stick[100] == one.n_stick[3990] == 42 and len(one.stick_t) == one.n_stick.sum()
+    np.testing.assert_array_equal(two.sticks_of(3990)[0], simulate(params[3990], "paper").stick_points()[0])
+
+
+@pytest.mark.parametrize("n", [1, 1023, 1024, 1025, 8000, 20_000])
+def test_pack_chunks_cover_every_case_once_in_order(n):
+    for threaded in (False, True):
+        parts = batch.pack_chunks(n, threaded)
+        sizes = [part.stop - part.start for part in parts]
+        assert parts[0].start == 0 and parts[-1].stop == n
+        assert all(a.stop == b.start for a, b in zip(parts[:-1], parts[1:], strict=True))
+        assert max(sizes) <= batch.PACK_CHUNK and min(sizes) >= 1
+        assert sizes[0] == min(n, batch.FIRST_PACK_CHUNK if threaded else batch.PACK_CHUNK)
+        assert all(b == min(2 * a, batch.PACK_CHUNK) for a, b in zip(sizes[:-2], sizes[1:-1], strict=True))
 
 
 def test_horizon_cut_is_reported():

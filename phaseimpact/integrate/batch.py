@@ -14,7 +14,7 @@ import math
 import numbers
 import operator
 import threading
-from concurrent.futures import ThreadPoolExecutor
+import time
 from dataclasses import dataclass
 
 import numpy as np
@@ -73,10 +73,26 @@ class Batch:
 
 #: Where :func:`simulate_many` runs: threads of this process, or a GPU (:mod:`phaseimpact.cuda`).
 SIMULATE_MANY_BACKENDS = ("threads", "cuda")
-#: Runs packed at a time by :func:`simulate_many` (any size gives the same numbers: runs are independent).
-#: Each chunk's end leaves threads idle (its last task, the hand-off from the packer), so chunks are
-#: large; a chunk's batch and columns take about 10 MB.
+#: Most runs packed at a time by :func:`simulate_many` (any size gives the same numbers: runs are
+#: independent). Each chunk's end leaves threads idle (its last task), so chunks are large; a
+#: chunk's batch and columns take about 10 MB.
 PACK_CHUNK = 8192
+#: Runs of :func:`simulate_many`'s first chunk in threads; each next one twice as many, up to
+#: :data:`PACK_CHUNK`. The first is packed before any run starts, each other one while the one
+#: before it runs (8000 cases in one chunk were packed before any run, 4 % of two threads' time).
+FIRST_PACK_CHUNK = 1024
+
+
+def pack_chunks(n: int, threaded: bool) -> list[slice]:
+    """How :func:`simulate_many` cuts ``n`` cases into chunks: :data:`PACK_CHUNK` at a time, or in
+    threads from :data:`FIRST_PACK_CHUNK` up, doubling (each packed while the one before runs)."""
+    size = FIRST_PACK_CHUNK if threaded else PACK_CHUNK
+    chunks, start = [], 0
+    while start < n:
+        chunks.append(slice(start, min(start + size, n)))
+        start += size
+        size = min(2 * size, PACK_CHUNK)
+    return chunks
 
 
 def pack_batch(params_seq, law: ContactLaw, t_end, rtol: float, initial=None) -> Batch:
@@ -168,10 +184,12 @@ def _horizons(t_end, default: np.ndarray, contact_time: np.ndarray) -> np.ndarra
 
 
 def run_batch(batch: Batch, *, rtol: float, settle: bool = True, stop_on=None, n_threads: int = 1,
-              capacity: int = 32, stiff: bool = True, backend: str = "threads") -> Columns:
+              capacity: int = 32, stiff: bool = True, backend: str = "threads", meanwhile=None) -> Columns:
     """Run a packed batch in ``n_threads`` threads, or one GPU thread per run (``backend="cuda"``,
     checked by :func:`phaseimpact.cuda.check` first); each run is independent of the others, so the columns
-    do not depend on the thread count or on how a sweep was cut into batches."""
+    do not depend on the thread count or on how a sweep was cut into batches. ``meanwhile``: a
+    function of no argument that this thread calls once while the other threads run (before the
+    runs on the GPU or in one thread)."""
     stop_kind, stop_count = _stop_on(stop_on)
     stiff_after = _stiff_after(stiff)
     n = len(batch)
@@ -193,12 +211,15 @@ def run_batch(batch: Batch, *, rtol: float, settle: bool = True, stop_on=None, n
         if backend == "cuda":
             from .. import cuda
 
+            if meanwhile is not None:
+                meanwhile()
             cuda.run_batch_cuda(*args, outputs)
         else:
             radau = radau_marker(stiff_after)
-            _run_block(args, outputs, work, radau)
+            _run_block(args, outputs, work, radau, meanwhile)
             if radau is None:
                 _again_with_radau(args, outputs, work)
+        meanwhile = None  # once, not again if the runs are repeated (an old signal's byte)
         woken = bool(np.any(summary[:, d.S_STATUS] == d.INTERRUPTED)) or _woken(d.SUCCESS, native)
         if not (woken or _signals.deferred):
             break
@@ -221,14 +242,44 @@ def run_batch(batch: Batch, *, rtol: float, settle: bool = True, stop_on=None, n
     return Columns.from_summary(summary, count, *points)
 
 
-def _run_block(args: tuple, outputs: tuple, work: np.ndarray, radau) -> None:
-    """Every run of the batch in ``args`` (:func:`~.driver.run_block`'s arguments) in ``len(work)``
-    threads; ``radau``: :func:`~.api.radau_marker`."""
-    n = len(outputs[d.O_SUMMARY])
-    if len(work) == 1:
-        d.run_block(*args, 0, n, 1, outputs, work[0], radau)
-    else:
-        _run_in_threads(args, outputs, work, n, radau)
+#: Seconds between two looks of :func:`_run_block` at the helpers' first claims (a thread starts in
+#: about 0.1 ms).
+_HAND_OVER = 2e-5
+
+
+def _run_block(args: tuple, outputs: tuple, work: np.ndarray, radau, meanwhile=None) -> None:
+    """Every run of the batch in ``args`` (:func:`~.driver.run_block`'s first arguments) in
+    ``len(work)`` threads at once (the driver releases the GIL): this one and ``len(work) - 1``
+    helpers, each in a workspace of its own, claiming the tasks of :func:`thread_tasks` from one
+    counter in compiled code; ``radau``: :func:`~.api.radau_marker`. No Python between two tasks: a
+    thread pool's hand-offs (a queue, a future, the caller woken) left each of two threads idle
+    3-5 % of a sweep's chunk. ``meanwhile``: Python this thread runs while the helpers run, before it
+    joins them (:func:`simulate_many` packs its next chunk); it starts once each helper has claimed a
+    task, inside compiled code, where the helpers need the GIL no more until their end."""
+    tasks = np.array(thread_tasks(len(outputs[d.O_SUMMARY]), len(work)), np.int64)
+    claimed = np.zeros(1, np.int64)
+    failures = []
+
+    def helper(ws: np.ndarray) -> None:
+        try:
+            d.run_block(*args, tasks, claimed, outputs, ws, radau)
+        except BaseException as failure:  # raised in the caller's thread once every helper has ended
+            failures.append(failure)
+
+    helpers = [threading.Thread(target=helper, args=(ws,), name="phaseimpact-run") for ws in work[1:]]
+    for thread in helpers:
+        thread.start()
+    try:
+        if meanwhile is not None:
+            while claimed[0] < len(helpers) and any(thread.is_alive() for thread in helpers):
+                time.sleep(_HAND_OVER)
+            meanwhile()
+        d.run_block(*args, tasks, claimed, outputs, work[0], radau)
+    finally:
+        for thread in helpers:
+            thread.join()
+    if failures:
+        raise failures[0]
 
 
 def _again_with_radau(args: tuple, outputs: tuple, work: np.ndarray) -> None:
@@ -261,7 +312,7 @@ MIN_TAIL_TASK_RUNS = 8
 
 
 def thread_tasks(n: int, threads: int) -> list[tuple[int, int, int]]:
-    """How :func:`_run_in_threads` cuts ``n`` runs: ``(start, stop, step)`` of each task, every
+    """How :func:`_run_block` cuts ``n`` runs: ``(start, stop, step)`` of each task, every
     ``step``-th run of ``[start, stop)``, in the order the threads take them. :data:`TASKS_PER_THREAD`
     interleaved tasks a thread over the first runs, then the last ``n // TAIL_SHARE`` runs in up to as
     many smaller ones (of at least :data:`MIN_TAIL_TASK_RUNS` runs); all runs in the first kind when
@@ -273,47 +324,6 @@ def thread_tasks(n: int, threads: int) -> list[tuple[int, int, int]]:
         return [(j, n, tasks) for j in range(tasks)]
     head = n - tail
     return [(j, head, tasks) for j in range(tasks)] + [(head + j, n, tail_tasks) for j in range(tail_tasks)]
-
-
-def _run_in_threads(args: tuple, outputs: tuple, work: np.ndarray, n: int, radau) -> None:
-    """:func:`~.driver.run_block` over ``len(work)`` threads (the driver releases the GIL): this one
-    and ``len(work) - 1`` helpers, each in a workspace of its own, take the interleaved tasks of
-    :func:`thread_tasks` as they come free. No executor: its hand-offs (a queue, a future and the
-    waiting caller woken per task) left each of two threads idle for 3-5 % of a sweep's chunk."""
-    status = outputs[d.O_SUMMARY][:, d.S_STATUS]
-    tasks = iter(thread_tasks(n, len(work)))  # shared: next() on a list iterator is atomic under the GIL
-    stopped = threading.Event()
-    failures = []
-
-    def take_tasks(ws: np.ndarray) -> None:
-        for start, stop, step in tasks:
-            if stopped.is_set():  # Ctrl-C or SIGTERM seen by an earlier task: the rest is not started
-                status[start:stop:step] = d.INTERRUPTED
-                continue
-            d.run_block(*args, start, stop, step, outputs, ws, radau)
-            if status[start + (stop - 1 - start) // step * step] == d.INTERRUPTED:  # its last run: marked if any was
-                stopped.set()
-
-    def helper(ws: np.ndarray) -> None:
-        try:
-            take_tasks(ws)
-        except BaseException as failure:  # raised in the caller's thread once every helper has stopped
-            stopped.set()
-            failures.append(failure)
-
-    helpers = [threading.Thread(target=helper, args=(ws,), name="phaseimpact-run") for ws in work[1:]]
-    for thread in helpers:
-        thread.start()
-    try:
-        take_tasks(work[0])
-    except BaseException:  # Ctrl-C between two tasks: the helpers start no other
-        stopped.set()
-        raise
-    finally:
-        for thread in helpers:
-            thread.join()
-    if failures:
-        raise failures[0]
 
 
 def _run_one(batch: Batch, i: int, rtol, settle, stop_kind, stop_count, stiff_after, native):
@@ -454,21 +464,24 @@ def simulate_many(params_seq, law: ContactLaw | str = "paper", t_end: float | No
     params_seq = _checked_sequence(params_seq)  # every case, before any run
     if t_end is not None:  # long enough for the case of the longest contact
         check_t_end(t_end, max(hertz_contact_time(p.alpha, p.hertz_indentation, p.v) for p in params_seq))
-    chunks = [params_seq[i:i + PACK_CHUNK] for i in range(0, len(params_seq), PACK_CHUNK)]
+    threaded = n_threads > 1 and backend == "threads"
+    chunks = [params_seq[part] for part in pack_chunks(len(params_seq), threaded)]
     options = {"rtol": rtol, "settle": stop_when_settled, "stop_on": stop_on, "n_threads": n_threads, "stiff": stiff,
                "backend": backend}
-    if n_threads == 1 or len(chunks) == 1 or backend == "cuda":
+    if not threaded:
         return _joined([run_batch(_pack(chunk, law, t_end, rtol, initial), **options) for chunk in chunks])
-    # Packing is Python and serial (on columns ~1.2 us a case, 4 % of a run): a second thread packs the
-    # next chunks while this one runs the last in the worker threads (whose compiled runs release the
-    # GIL), so the packing does not add to the run time. The runs stay in this thread, where signals arrive.
-    with ThreadPoolExecutor(1) as packer:
-        packed = [packer.submit(_pack, chunk, law, t_end, rtol, initial) for chunk in chunks]
-        try:
-            return _joined([run_batch(batch.result(), **options) for batch in packed])
-        except BaseException:  # Ctrl-C or SIGTERM: the chunks not yet packed are not packed
-            packer.shutdown(cancel_futures=True)
-            raise
+    # Packing is Python (~1.2 us a case on columns, 4 % of a run on two threads): this thread packs
+    # the next chunk while the other threads run the chunk before, in compiled code that needs no GIL,
+    # and then runs the rest of it beside them (run_batch's meanwhile). Only the first, small chunk is
+    # packed before any run starts.
+    packed = [_pack(chunks[0], law, t_end, rtol, initial)]
+    parts = []
+    for k in range(len(chunks)):
+        batch = packed.pop()
+        following = chunks[k + 1] if k + 1 < len(chunks) else None
+        parts.append(run_batch(batch, **options, meanwhile=None if following is None else lambda cases=following:
+                               packed.append(_pack(cases, law, t_end, rtol, initial))))
+    return _joined(parts)
 
 
 def _joined(parts: list[Columns]) -> Columns:

@@ -45,6 +45,7 @@ from ..model.rhs import (
     stuck_pair_energy,
 )
 from . import flight, radau5
+from .claims import claim
 from .events import CONTACT, DELTA, N_EVENTS, SILENT, STICK, STOP_RUNAWAY, STOP_SETTLED, energy_limit_of, initial_mode
 from .logs import N_EV_COLUMNS, N_SMP_COLUMNS, add_sample, close_sticks, grow, log_event
 from .phase import (
@@ -612,18 +613,32 @@ def run_point_into(code, ws, batch, options, i, outputs):
         st_t[i, j], st_delta[i, j], st_dwell[i, j] = sticks[ST_T, j], sticks[ST_DELTA, j], sticks[ST_DWELL, j]
 
 
+@kernel
+def _stop_block(summary, tasks, task, first, claimed):
+    """Ctrl-C or SIGTERM seen before run ``first`` of task ``task``: that run and the rest of the task,
+    and every task no thread has claimed yet (claimed here, so that no thread starts one), get the
+    status ``interrupted``."""
+    for i in range(first, tasks[task, 1], tasks[task, 2]):
+        summary[i, S_STATUS] = INTERRUPTED
+    n_tasks = tasks.shape[0]
+    for other in range(claim(claimed, n_tasks), n_tasks):
+        for i in range(tasks[other, 0], tasks[other, 1], tasks[other, 2]):
+            summary[i, S_STATUS] = INTERRUPTED
+
+
 @kernel(python=True, nogil=True)
-def run_block(code, batch, options, start, stop, step, outputs, work, radau):
-    """Runs ``start, start + step, ...`` (below ``stop``) of a batch, without the GIL (callers run
-    blocks in threads; each run's numbers depend on nothing else). Fills ``outputs`` (the tuple
+def run_block(code, batch, options, tasks, claimed, outputs, work, radau):
+    """Runs the tasks of a batch that this thread claims, without the GIL (callers run one block per
+    thread; each run's numbers depend on nothing else). A task is a row ``(start, stop, step)`` of
+    ``tasks``, the runs ``start, start + step, ...`` below ``stop``. The threads of a chunk share the
+    counter ``claimed`` (an int64 array of one number, 0 at first) and each takes its next task from
+    it as it comes free (:func:`.claims.claim`): no Python between two tasks, so no thread waits for
+    the GIL there, and a thread slowed by another process takes fewer. Fills ``outputs`` (the tuple
     ``O_*``): the summaries (n, N_SUMMARY), the first ``capacity`` stick points of each run and its
     full number of stick points (more than ``capacity``: the caller runs it again on the full path).
-    Threads over blocks, not a compiled parallel loop: that would compile the driver a second
-    time. A thread's block is every ``step``-th run, not a contiguous range: the cost of a run
-    changes smoothly over a sweep or an atlas (many times over near kappa_c), so interleaved blocks
-    cost the same to within one run, where contiguous ones left a thread idle while another finished
-    an expensive stretch. On Ctrl-C or SIGTERM the rest of the block is left with the status
-    ``interrupted``.
+    Threads over blocks, not a compiled parallel loop: that would compile the driver a second time.
+    On Ctrl-C or SIGTERM the rest of the thread's task and every task not yet claimed get the status
+    ``interrupted`` (:func:`_stop_block`); the other threads stop at their next look.
 
     ``work`` is the block's workspace, a buffer of :func:`.record.workspace_size` numbers the caller
     made (one per thread); each run goes through :func:`run_point` in it, without an event log;
@@ -633,17 +648,19 @@ def run_block(code, batch, options, start, stop, step, outputs, work, radau):
     summary = outputs[O_SUMMARY]
     ws = carve(work, batch[B_C].shape[1], outputs[O_STICK_T].shape[1], radau)
     done = 0
-    for i in range(start, stop, step):
-        done += 1
-        if done % POLL_RUNS == 0 and interrupted():
-            for j in range(i, stop, step):
-                summary[j, S_STATUS] = INTERRUPTED
-            break
-        run_point_into(code, ws, batch, options, i, outputs)
-        if summary[i, S_STATUS] == INTERRUPTED:
-            for j in range(i + step, stop, step):
-                summary[j, S_STATUS] = INTERRUPTED
-            break
+    task = claim(claimed, 1)
+    while task < tasks.shape[0]:
+        start, stop, step = tasks[task, 0], tasks[task, 1], tasks[task, 2]
+        for i in range(start, stop, step):
+            done += 1
+            if done % POLL_RUNS == 0 and interrupted():
+                _stop_block(summary, tasks, task, i, claimed)
+                return
+            run_point_into(code, ws, batch, options, i, outputs)
+            if summary[i, S_STATUS] == INTERRUPTED:  # the run itself looked
+                _stop_block(summary, tasks, task, i + step, claimed)
+                return
+        task = claim(claimed, 1)
 
 
 @kernel(python=True, nogil=True)
