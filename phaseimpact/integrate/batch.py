@@ -474,13 +474,15 @@ def simulate_many(params_seq, law: ContactLaw | str = "paper", t_end: float | No
     # the next chunk while the other threads run the chunk before, in compiled code that needs no GIL,
     # and then runs the rest of it beside them (run_batch's meanwhile). Only the first, small chunk is
     # packed before any run starts.
-    packed = [_pack(chunks[0], law, t_end, rtol, initial)]
-    parts = []
-    for k in range(len(chunks)):
-        batch = packed.pop()
-        following = chunks[k + 1] if k + 1 < len(chunks) else None
-        parts.append(run_batch(batch, **options, meanwhile=None if following is None else lambda cases=following:
-                               packed.append(_pack(cases, law, t_end, rtol, initial))))
+    batch, parts = _pack(chunks[0], law, t_end, rtol, initial), []
+    for following in [*chunks[1:], None]:
+        packed = []
+
+        def pack_following(cases=following, into=packed) -> None:
+            into.append(_pack(cases, law, t_end, rtol, initial))
+
+        parts.append(run_batch(batch, **options, meanwhile=None if following is None else pack_following))
+        batch = packed[0] if packed else None
     return _joined(parts)
 
 
