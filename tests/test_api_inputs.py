@@ -240,3 +240,17 @@ def test_none_and_misshapen_arguments_are_named(call, error, name):
     with pytest.raises(error) as raised:
         call()
     assert name in str(raised.value) and type(raised.value) is error
+
+
+def test_a_case_the_law_cannot_run_is_refused_before_any_chunk_runs(monkeypatch):
+    """simulate_many packs its chunks as they run (in threads the first has 1024 cases): a case
+    without what the law needs, past the first chunk, is refused before any run, named by its index."""
+    from phaseimpact.integrate import batch
+
+    def no_run(*args, **kwargs):
+        raise AssertionError("a chunk ran")
+
+    monkeypatch.setattr(batch, "run_batch", no_run)
+    cases = [SEED.replace(limiting_pressure=2e9)] * 1500 + [SEED]
+    with pytest.raises(ValueError, match=r"params_seq\[1500\]: law 'thornton' needs the limiting contact pressure"):
+        simulate_many(cases, "thornton", n_threads=2)

@@ -462,6 +462,12 @@ def simulate_many(params_seq, law: ContactLaw | str = "paper", t_end: float | No
 
         cuda.check(law)
     params_seq = _checked_sequence(params_seq)  # every case, before any run
+    if law.entry.coefficients is not None:  # what the law needs of each case (chunks are packed as they run)
+        for i, p in enumerate(params_seq):
+            try:
+                law.coefficients(p)
+            except ValueError as error:
+                raise ValueError(f"params_seq[{i}]: {error}") from None
     if t_end is not None:  # long enough for the case of the longest contact
         check_t_end(t_end, max(hertz_contact_time(p.alpha, p.hertz_indentation, p.v) for p in params_seq))
     threaded = n_threads > 1 and backend == "threads"
