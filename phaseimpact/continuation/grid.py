@@ -459,7 +459,8 @@ class Grid:
             # ~5 % of the values, and so would a point of the atlas from simulate's run of it); scales()'s
             # other expressions on arrays
             m, K = base.reduced_mass, float(C[0, K_])
-            indentation = np.array([indentation_of(float(alpha), m, x, K) for x in v.tolist()])
+            speeds, which = np.unique(v, return_inverse=True)  # one speed for a whole sweep over kappa
+            indentation = np.array([indentation_of(float(alpha), m, x, K) for x in speeds.tolist()])[which]
             contact_time = hertz_contact_time(alpha, indentation, v)
             A = state_tolerances(rtol, indentation, v, C[:, M1_], contact_time)
             if t_end is not None:
