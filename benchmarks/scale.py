@@ -151,7 +151,8 @@ def main(argv=None) -> int:
             "speed). CPU backends only: the GPU's "
             "(backend=\"cuda\") is timed by "
             "benchmarks/gpu.py on a machine with one; no GPU "
-            f"rows. simulate_many's packing (serial Python, one thread beside the workers): {pack_us:.2g} us a case "
+            "rows. simulate_many's packing (Python, in the caller while the other workers run the chunk before): "
+            f"{pack_us:.2g} us a case "
             f"(process CPU time, median of {3 * repeats}), its runs {run_us:.3g} us a case on one worker.\n\n"
             + table(header, rows))
     emit()

@@ -299,15 +299,17 @@ def _again_with_radau(args: tuple, outputs: tuple, work: np.ndarray) -> None:
 
 #: Tasks a threaded chunk is cut into, per thread. Task j runs the runs j, j + tasks, ... (the cost
 #: of a run changes smoothly over a sweep or an atlas, so interleaved tasks cost alike), and a thread
-#: that finishes one takes the next: a thread slowed by another (simulate_many's packer shares the
-#: cores) no longer leaves the others idle at the chunk's end for up to a third of the chunk.
+#: that finishes one claims the next: a thread slowed by something else (simulate_many's caller packs
+#: the next chunk first; another process shares the core) no longer leaves the others idle at the
+#: chunk's end for up to a third of the chunk.
 TASKS_PER_THREAD = 16
 #: The chunk's last ``1 / TAIL_SHARE`` of its runs go in tasks of their own, smaller, taken last: the
 #: task that finishes the chunk, running while the other threads are idle, is short. (One size for all
 #: left the threads idle for half a task each at the end of every chunk: 1.6 % of two threads'
 #: time, more on many.)
 TAIL_SHARE = 8
-#: Fewest runs in one of those small tasks: a task costs a few tens of µs of Python to start.
+#: Fewest runs in one of those small tasks (set when a task cost tens of µs of Python to start; a
+#: claim in compiled code costs nothing, and this only bounds how finely a small chunk's end is cut).
 MIN_TAIL_TASK_RUNS = 8
 
 
