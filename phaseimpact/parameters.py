@@ -49,6 +49,8 @@ __all__ = [
 ]
 
 TARGETS = ("plate", "rigid", "free", "infinite")
+#: Targets whose contact moves the projectile's mass alone (:attr:`Parameters.reduced_mass` is ``M1``).
+M1_ALONE_TARGETS = ("rigid", "infinite")
 MEMBRANE_FORMULAS = ("printed", "shivakumar")
 BODIES = ("projectile", "plate")
 MATERIAL_FIELDS = ("E", "nu", "rho", "yield_strength")
@@ -378,7 +380,7 @@ class Parameters:
     def reduced_mass(self) -> float:
         """Mass of the relative motion during contact, kg (``M1`` against a rigid target or the
         massless load point of the infinite plate)."""
-        if self.target in ("rigid", "infinite"):
+        if self.target in M1_ALONE_TARGETS:
             return self.M1
         return self.M1 * self.M2 / (self.M1 + self.M2)
 

@@ -128,7 +128,7 @@ def test_an_interleaved_block_marks_only_its_own_runs_interrupted(pipe):
 
 
 def _threaded_chunk(n: int, threads: int = 2):
-    """A chunk of ``n`` paper runs for _run_in_threads: its arguments, the outputs (summaries -7:
+    """A chunk of ``n`` paper runs for batch._run_block: its arguments, the outputs (summaries -7:
     a run no thread touched) and the workspaces."""
     seq = [seed_parameters(v=1.0, kappa=k) for k in np.geomspace(1e9, 1e11, n)]
     batch = pack_batch(seq, as_law("paper"), None, 1e-10)

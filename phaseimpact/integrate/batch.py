@@ -23,7 +23,7 @@ from .. import _signals
 from ..model.forms import ALPHA_, DAMP_, GUARD_, IMPEDANCE_, K_, KB_, KM_, LAW_, M1_, M2_, RIGID_, SPRINGS_
 from ..model.laws import ContactLaw, as_law
 from ..model.rhs import N_COEF, initial_state
-from ..parameters import Parameters, indentation_of
+from ..parameters import M1_ALONE_TARGETS, Parameters, indentation_of
 from . import driver as d
 from . import logs
 from .api import (
@@ -148,7 +148,7 @@ def _pack(params_seq: list, law: ContactLaw, t_end, rtol: float, initial) -> Bat
         C[:, IMPEDANCE_] = [p.impedance if t == "infinite" else 0.0 for p, t in zip(params_seq, targets, strict=True)]
     # Parameters.reduced_mass (IEEE operations, numpy's bits too) and .hertz_indentation (its power
     # Python's, per case: numpy's need not give the same bits)
-    reduced_mass = np.where(of_kind("rigid", "infinite"), M1, M1 * M2 / (M1 + M2))
+    reduced_mass = np.where(of_kind(*M1_ALONE_TARGETS), M1, M1 * M2 / (M1 + M2))
     indentation = np.array(list(map(indentation_of, alpha.tolist(), reduced_mass.tolist(), v.tolist(), K.tolist())))
     contact_time = hertz_contact_time(alpha, indentation, v)
     with np.errstate(divide="ignore"):  # Kb = 0: no period (Parameters.target_period)
