@@ -15,9 +15,14 @@ On a shared machine the speed of one core drifts by tens of per cent from minute
 ratio of two medians taken minutes apart measures the drift as much as the scaling. Each repeat
 therefore times every worker count of a workload back to back (their order alternating between
 repeats), and the efficiency is the median over the repeats of ``T(1) / (n T(n))`` within one
-repeat. The same pairing times a control: ``n`` threads of a compiled arithmetic loop that touches
-no memory and shares nothing, the efficiency this machine itself gives (its ceiling). "Cores busy"
-is the process's CPU time over ``n`` times the wall time: below 100 % by the idle and serial time of
+repeat. The same pairing times two controls: ``n`` threads of a compiled arithmetic loop that
+touches no memory and shares nothing, and the sweep's points dealt to ``n`` processes that share
+nothing (each started beforehand and sweeping its every ``n``-th kappa in one thread). The second
+runs the engine's own code with no in-process cost at all (no GIL, no threads to start and join,
+no Python between chunks), so whatever it loses, busy cores lose to each other on this machine (a
+shared cache, the host's other guests, a lower clock); its split is fixed, so a process that runs
+slower also leaves the others idle at the end, where threads take the rest from a counter. "Cores
+busy" is the CPU time over ``n`` times the wall time: below 100 % by the idle and serial time of
 the run, whatever the speed of a core at that minute.
 
     python benchmarks/scale.py [--quick] [--n 8000]
@@ -26,8 +31,11 @@ the run, whatever the speed of a core at that minute.
 from __future__ import annotations
 
 import argparse
+import functools
+import json
 import os
 import statistics
+import subprocess
 import sys
 import time
 from concurrent.futures import ThreadPoolExecutor
@@ -47,6 +55,10 @@ from phaseimpact.model import as_law  # noqa: E402
 RTOL = 1e-10
 #: simulate_many's runs alone: its cases packed beforehand and run in one call (no packing, no chunks).
 ENGINE_ONLY = "simulate_many's runs, packed beforehand"
+#: The sweep's points dealt to processes that share nothing: the machine's ceiling for this code.
+PROCESS_CEILING = "control: the sweep in processes that share nothing"
+#: Threads of arithmetic alone: the machine's scaling of compiled threads that touch no memory.
+ARITHMETIC_CONTROL = "control: arithmetic only"
 
 
 def worker_counts() -> list[int]:
@@ -68,12 +80,15 @@ def main(argv=None) -> int:
     ap.add_argument("--n", type=int, default=8000, help="points of the sweep and of simulate_many")
     ap.add_argument("--section", default="scale",
                     help="results/<section>.md and .json (default scale; a GPU machine's run: scale_gpu_machine)")
+    ap.add_argument("--worker", nargs=2, type=int, metavar=("I", "OF"), help=argparse.SUPPRESS)
     args = ap.parse_args(argv)
+    if args.worker:
+        return _sweep_worker(*args.worker, args.n // 4 if args.quick else args.n)
     n_points = args.n // 4 if args.quick else args.n
     repeats = 3 if args.quick else 9
     side = int(round(n_points ** 0.5))
     params = seed_parameters(v=1.0)
-    kappas = np.geomspace(1e8, 1e13, n_points)
+    kappas = _sweep_kappas(n_points)
     plist = [params.replace(kappa=float(k)) for k in np.geomspace(1e8, 1e11, n_points)]
     axes = [Axis("kappa", np.geomspace(1e10, 1e14, side), log=True), Axis("v", np.linspace(0.5, 13.0, side))]
     counts = worker_counts()
@@ -94,7 +109,9 @@ def main(argv=None) -> int:
         }
 
     contenders = {(what, how, n): fn for n in counts for (what, how), fn in workloads(n).items()}
-    contenders.update({("control: arithmetic only", "threads", n): (lambda n=n: _spin_threads(n)) for n in counts})
+    contenders.update({(ARITHMETIC_CONTROL, "threads", n): (lambda n=n: _spin_threads(n)) for n in counts})
+    ceilings = {n: _Processes(n, args.quick, args.n) for n in counts}
+    contenders.update({(PROCESS_CEILING, "processes", n): ceilings[n].sweep for n in counts})
     results = {key: fn() for key, fn in contenders.items()}  # warm-up: compiles, starts loky's workers
     times = {key: [] for key in contenders}
     busy = {key: [] for key in contenders}  # CPU time of the process over n times the wall time
@@ -107,10 +124,14 @@ def main(argv=None) -> int:
                     # engine): a call untimed first, or the 16-core run measured their start (0.14-0.18x)
                     contenders[(what, how, n)]()
                 start, cpu = time.perf_counter(), time.process_time()
-                contenders[(what, how, n)]()
+                result = contenders[(what, how, n)]()
                 wall = time.perf_counter() - start
                 times[(what, how, n)].append(wall)
-                busy[(what, how, n)].append((time.process_time() - cpu) / (n * wall))
+                # the ceiling's workers report their own CPU time; loky's cannot be read from here
+                used = result.cpu if how == "processes" else time.process_time() - cpu
+                busy[(what, how, n)].append(used / (n * wall))
+    for ceiling in ceilings.values():
+        ceiling.close()
     section = "" if args.section == "scale" else f" --section {args.section}"
     where = "" if args.section == "scale" else f", {os.cpu_count()} cores ({args.section})"
     rows, targets = [], []
@@ -121,9 +142,9 @@ def main(argv=None) -> int:
             t = statistics.median(times[(what, how, n)])
             speed_up = statistics.median(a / b for a, b in zip(one, times[(what, how, n)], strict=True))
             efficiency = speed_up / n
-            same = "-" if what.startswith("control") else (
+            same = "-" if what == ARITHMETIC_CONTROL else (
                 "identical" if _same(reference, results[(what, how, n)]) else "DIFFERENT")
-            used = "-" if how != "threads" else f"{100 * statistics.median(busy[(what, how, n)]):.0f} %"
+            used = "-" if how == "loky processes" else f"{100 * statistics.median(busy[(what, how, n)]):.0f} %"
             rows.append((what, how, n, f"{t:.3g}", f"{speed_up:.2f}", f"{100 * efficiency:.0f} %", used,
                          f"{karp_flatt(speed_up, n):.3f}" if n > 1 else "-", same))
             emit(f"{what}, {how}, {n}: {t:.3g} s, speed-up {speed_up:.2f}, efficiency {100 * efficiency:.0f} %")
@@ -144,10 +165,14 @@ def main(argv=None) -> int:
             f"{n_points} points each (the atlas {side} x {side}), {repeats} repeats; paper for the sweep and the "
             "atlas, hunt-crossley for simulate_many. Times are medians; speed-up and efficiency the medians over "
             "the repeats of T(1)/T(n) timed back to back (the machine's speed drifts between repeats); the "
-            "control is n threads of arithmetic alone (this machine's own ceiling); simulate_many's runs, packed "
+            "controls are n threads of arithmetic alone, and the sweep's points dealt to n processes that share "
+            "nothing, each started beforehand and sweeping every n-th kappa in one thread (the engine's code without "
+            "any in-process cost: no GIL, no threads to start and join, no Python between chunks; what it loses, "
+            "busy cores lose to each other on this machine, and, its split being fixed, a slower process leaves the "
+            "others idle at the end); simulate_many's runs, packed "
             "beforehand, are its cases in one run_batch call, without its packing and chunks (the engine's "
             "threads by themselves); cores busy is the process's CPU "
-            "time over n times the wall time (threads: what is left is idle or serial time, whatever the core's "
+            "time over n times the wall time (what is left is idle or serial time, whatever the core's "
             "speed). CPU backends only: the GPU's "
             "(backend=\"cuda\") is timed by "
             "benchmarks/gpu.py on a machine with one; no GPU "
@@ -179,6 +204,82 @@ def _spin_threads(n: int) -> float:
     """``n`` threads, each spinning the same work: the machine's own scaling of compiled threads."""
     with ThreadPoolExecutor(n) as pool:
         return sum(pool.map(_spin, [SPIN_ITERATIONS // n] * n))
+
+
+#: The columns the process ceiling's workers send back (to check them against one worker's).
+_CEILING_COLUMNS = ("max_force", "n_stick", "outcome", "t_run")
+
+
+def _sweep_kappas(n_points: int) -> np.ndarray:
+    return np.geomspace(1e8, 1e13, n_points)
+
+
+def _sweep_worker(i: int, of: int, n_points: int) -> int:
+    """A process of the ceiling: on each line ``go``, the sweep of every ``of``-th kappa from the
+    ``i``-th in this process's one thread; replies with its CPU time and the columns (raw bytes as
+    hex: no formatting of numbers inside the timed turn)."""
+    params, kappas = seed_parameters(v=1.0), _sweep_kappas(n_points)[i::of]
+    sweep(params, "paper", kappas, n_jobs=1)  # compiled (or read from the cache) before the first turn
+    print("ready", flush=True)
+    for _ in sys.stdin:
+        cpu = time.process_time()
+        result = sweep(params, "paper", kappas, n_jobs=1)
+        reply = {"cpu": time.process_time() - cpu}
+        for name in _CEILING_COLUMNS:
+            column = np.asarray(getattr(result, name))
+            reply[name] = [str(column.dtype), column.tobytes().hex()]
+        print(json.dumps(reply), flush=True)
+    return 0
+
+
+class _CeilingResult:
+    """The columns of the ceiling's workers in point order, and their CPU time together; read from
+    their replies when first asked for (not within the timed turn)."""
+
+    def __init__(self, lines: list[str]):
+        self._lines = lines
+
+    @functools.cached_property
+    def _replies(self) -> list[dict]:
+        return [json.loads(line) for line in self._lines]
+
+    @property
+    def cpu(self) -> float:
+        return sum(reply["cpu"] for reply in self._replies)
+
+    def __getattr__(self, name: str) -> np.ndarray:
+        if name not in _CEILING_COLUMNS:
+            raise AttributeError(name)
+        parts = [np.frombuffer(bytes.fromhex(reply[name][1]), reply[name][0]) for reply in self._replies]
+        column = np.empty(sum(part.size for part in parts), parts[0].dtype)
+        for i, part in enumerate(parts):
+            column[i::len(parts)] = part
+        return column
+
+
+class _Processes:
+    """``n`` worker processes (``scale.py --worker i n``), started once before any timing; each
+    sweeps its every ``n``-th kappa when told, all at once."""
+
+    def __init__(self, n: int, quick: bool, n_arg: int):
+        command = [sys.executable, str(Path(__file__).resolve()), "--n", str(n_arg), *(["--quick"] if quick else [])]
+        self.workers = [subprocess.Popen([*command, "--worker", str(i), str(n)], stdin=subprocess.PIPE,
+                                         stdout=subprocess.PIPE, text=True) for i in range(n)]
+        for worker in self.workers:
+            line = worker.stdout.readline().strip()
+            if line != "ready":
+                raise RuntimeError(f"a worker of the process ceiling did not start (said {line!r})")
+
+    def sweep(self) -> _CeilingResult:
+        for worker in self.workers:
+            worker.stdin.write("go\n")
+            worker.stdin.flush()
+        return _CeilingResult([worker.stdout.readline() for worker in self.workers])
+
+    def close(self) -> None:
+        for worker in self.workers:
+            worker.stdin.close()
+            worker.wait()
 
 
 def _packing_us(plist: list, repeats: int) -> float:
