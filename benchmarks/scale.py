@@ -37,6 +37,7 @@ import os
 import statistics
 import subprocess
 import sys
+import threading
 import time
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
@@ -49,7 +50,10 @@ from _common import emit, load, machine, save_section, save_targets, table, targ
 
 from phaseimpact import seed_parameters, simulate_many  # noqa: E402
 from phaseimpact.continuation import Axis, atlas, sweep  # noqa: E402
-from phaseimpact.integrate.batch import PACK_CHUNK, pack_batch, run_batch  # noqa: E402
+from phaseimpact.integrate import driver as d  # noqa: E402
+from phaseimpact.integrate.api import MAX_EVENTS, MAX_STEPS, _stiff_after, radau_marker  # noqa: E402
+from phaseimpact.integrate.batch import PACK_CHUNK, _run_block, pack_batch, run_batch, thread_tasks  # noqa: E402
+from phaseimpact.integrate.record import workspace_size  # noqa: E402
 from phaseimpact.model import as_law  # noqa: E402
 
 RTOL = 1e-10
@@ -155,6 +159,7 @@ def main(argv=None) -> int:
     pack_us = _packing_us(plist, repeats)
     run_us = 1e6 * statistics.median(times[("simulate_many", "threads", 1)]) / n_points
     emit(f"simulate_many's packing: {pack_us:.2g} us a case, a run {run_us:.3g} us a case on one worker")
+    chunk_rows = _chunk_cost(3 * repeats)
     end_load = load()
     header = ("workload", "workers", "n", "time [s]", "speed-up", "efficiency", "cores busy",
               "serial fraction (Karp-Flatt)",
@@ -179,7 +184,13 @@ def main(argv=None) -> int:
             "rows. simulate_many's packing (Python, in the caller while the other workers run the chunk before): "
             f"{pack_us:.2g} us a case "
             f"(process CPU time, median of {3 * repeats}), its runs {run_us:.3g} us a case on one worker.\n\n"
-            + table(header, rows))
+            + table(header, rows)
+            + "\n\nThe fixed cost of a threaded chunk: one chunk of "
+            f"{CHUNK_COST_RUNS} Hunt-Crossley runs (about a millisecond of work) in n threads, its helpers kept "
+            "from the chunk before (run_batch's, phaseimpact.integrate.helper_threads) or started and joined for the "
+            f"chunk, as before (medians of {3 * repeats}, taking turns; the results the same bit for bit).\n\n"
+            + table(("threads", "helpers kept [ms]", "helpers started for the chunk [ms]", "started / kept"),
+                    chunk_rows))
     emit()
     emit(text)
     suffix = "_quick" if args.quick else ""
@@ -280,6 +291,60 @@ class _Processes:
         for worker in self.workers:
             worker.stdin.close()
             worker.wait()
+
+
+#: Runs of the chunk whose fixed cost is timed (:func:`_chunk_cost`).
+CHUNK_COST_RUNS = 32
+
+
+def _chunk_cost(repeats: int) -> list[tuple]:
+    """Wall time of one small chunk in 2, 4, ... 16 threads: helpers kept from the chunk before
+    (``batch._run_block``) against helpers started and joined for the chunk (run_batch before
+    helper_threads). Each result is checked against the one-thread run's."""
+    cases = [seed_parameters(v=1.0, kappa=float(k)) for k in np.geomspace(1e9, 1e11, CHUNK_COST_RUNS)]
+    packed = pack_batch(cases, as_law("hunt-crossley"), None, RTOL)
+    args = (packed.law.code, (packed.C, packed.Y0, packed.t_end, packed.atol, packed.max_step),
+            (RTOL, True, -1, 0, MAX_STEPS, MAX_EVENTS, _stiff_after(True)))
+    radau = radau_marker(_stiff_after(True))
+
+    def outputs():
+        st = np.empty((3, CHUNK_COST_RUNS, 32))
+        return (np.empty((CHUNK_COST_RUNS, d.N_SUMMARY)), st[0], st[1], st[2], np.empty(CHUNK_COST_RUNS, np.int64))
+
+    def kept(n):
+        out = outputs()
+        _run_block(args, out, np.zeros((n, workspace_size(packed.C.shape[1], 32))), radau)
+        return out[0]
+
+    def started(n):
+        out, work = outputs(), np.zeros((n, workspace_size(packed.C.shape[1], 32)))
+        tasks, claimed = np.array(thread_tasks(CHUNK_COST_RUNS, n), np.int64), np.zeros(1, np.int64)
+        helpers = [threading.Thread(target=d.run_block, args=(*args, tasks, claimed, out, ws, radau))
+                   for ws in work[1:]]
+        for helper in helpers:
+            helper.start()
+        d.run_block(*args, tasks, claimed, out, work[0], radau)
+        for helper in helpers:
+            helper.join()
+        return out[0]
+
+    reference = kept(1)
+    counts = sorted({n for n in (2, 4, 16, os.cpu_count() or 1) if n > 1})
+    times = {(how, n): [] for how in (kept, started) for n in counts}
+    for r in range(repeats + 1):
+        for how in ((kept, started) if r % 2 == 0 else (started, kept)):
+            for n in counts:
+                start = time.perf_counter()
+                summary = how(n)
+                if r > 0:  # the first turn starts the helpers kept later
+                    times[(how, n)].append(time.perf_counter() - start)
+                assert np.array_equal(summary, reference, equal_nan=True), f"{how.__name__}({n}) differs"
+    rows = []
+    for n in counts:
+        a, b = (1e3 * statistics.median(times[(how, n)]) for how in (kept, started))
+        rows.append((n, f"{a:.3g}", f"{b:.3g}", f"{b / a:.2f}"))
+        emit(f"a chunk of {CHUNK_COST_RUNS} runs in {n} threads: helpers kept {a:.3g} ms, started {b:.3g} ms")
+    return rows
 
 
 def _packing_us(plist: list, repeats: int) -> float:

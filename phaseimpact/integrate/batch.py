@@ -9,11 +9,12 @@ threads or how the cases were cut into chunks; the checks, scales and tolerances
 
 from __future__ import annotations
 
+import functools
 import itertools
 import math
 import numbers
 import operator
-import threading
+import queue
 import time
 from dataclasses import dataclass
 
@@ -25,7 +26,7 @@ from ..model.laws import ContactLaw, as_law
 from ..model.rhs import N_COEF, initial_state
 from ..parameters import M1_ALONE_TARGETS, Parameters, indentation_of
 from . import driver as d
-from . import logs
+from . import helper_threads, logs
 from .api import (
     _NO_TIMES,
     HORIZON_CAP_PERIODS,
@@ -242,42 +243,41 @@ def run_batch(batch: Batch, *, rtol: float, settle: bool = True, stop_on=None, n
     return Columns.from_summary(summary, count, *points)
 
 
-#: Seconds between two looks of :func:`_run_block` at the helpers' first claims (a thread starts in
-#: about 0.1 ms).
+#: Seconds between two looks of :func:`_run_block` at the helpers' first claims (a waiting helper
+#: wakes within tens of microseconds; a new one starts in about 0.1 ms).
 _HAND_OVER = 2e-5
 
 
 def _run_block(args: tuple, outputs: tuple, work: np.ndarray, radau, meanwhile=None) -> None:
     """Every run of the batch in ``args`` (:func:`~.driver.run_block`'s first arguments) in
     ``len(work)`` threads at once (the driver releases the GIL): this one and ``len(work) - 1``
-    helpers, each in a workspace of its own, claiming the tasks of :func:`thread_tasks` from one
-    counter in compiled code; ``radau``: :func:`~.api.radau_marker`. No Python between two tasks: a
-    thread pool's hand-offs (a queue, a future, the caller woken) left each of two threads idle
-    3-5 % of a sweep's chunk. ``meanwhile``: Python this thread runs while the helpers run, before it
-    joins them (:func:`simulate_many` packs its next chunk); it starts once each helper has claimed a
-    task, inside compiled code, where the helpers need the GIL no more until their end."""
+    helpers (:mod:`.helper_threads`: started by an earlier chunk where one has), each in a workspace
+    of its own, claiming the tasks of :func:`thread_tasks` from one counter in compiled code;
+    ``radau``: :func:`~.api.radau_marker`. No Python between two tasks: a thread pool's hand-offs
+    (a queue, a future, the caller woken) left each of two threads idle 3-5 % of a sweep's chunk.
+    ``meanwhile``: Python this thread runs while the helpers run, before it waits for them
+    (:func:`simulate_many` packs its next chunk); it starts once each helper has claimed a task,
+    inside compiled code, where the helpers need the GIL no more until their end. A helper's
+    exception is raised here once every helper has ended."""
     tasks = np.array(thread_tasks(len(outputs[d.O_SUMMARY]), len(work)), np.int64)
     claimed = np.zeros(1, np.int64)
+    helpers = helper_threads.take(len(work) - 1)
+    done = queue.SimpleQueue()  # each helper's end: None, or what it raised
+    for helper, ws in zip(helpers, work[1:], strict=True):
+        helper.run(functools.partial(d.run_block, *args, tasks, claimed, outputs, ws, radau), done)
     failures = []
-
-    def helper(ws: np.ndarray) -> None:
-        try:
-            d.run_block(*args, tasks, claimed, outputs, ws, radau)
-        except BaseException as failure:  # raised in the caller's thread once every helper has ended
-            failures.append(failure)
-
-    helpers = [threading.Thread(target=helper, args=(ws,), name="phaseimpact-run") for ws in work[1:]]
-    for thread in helpers:
-        thread.start()
     try:
         if meanwhile is not None:
-            while claimed[0] < len(helpers) and any(thread.is_alive() for thread in helpers):
+            while claimed[0] < len(helpers) and done.empty():  # a helper that failed first claims nothing
                 time.sleep(_HAND_OVER)
             meanwhile()
         d.run_block(*args, tasks, claimed, outputs, work[0], radau)
     finally:
-        for thread in helpers:
-            thread.join()
+        for _ in helpers:
+            failure = done.get()
+            if failure is not None:
+                failures.append(failure)
+        helper_threads.give_back(helpers)  # all ended: ready for the next chunk
     if failures:
         raise failures[0]
 
