@@ -242,6 +242,22 @@ def test_none_and_misshapen_arguments_are_named(call, error, name):
     assert name in str(raised.value) and type(raised.value) is error
 
 
+@pytest.mark.parametrize("n_threads", [1, 2])
+def test_simulate_many_reads_each_case_s_own_coefficients_once(monkeypatch, n_threads):
+    """The up-front check of what the law needs hands its values to the packing (chunks packed as
+    they run): thornton's coefficients are read once a case, not twice."""
+    real, calls = ContactLaw.coefficients, []
+
+    def counted(self, params):
+        calls.append(params)
+        return real(self, params)
+
+    monkeypatch.setattr(ContactLaw, "coefficients", counted)
+    cases = [SEED.replace(limiting_pressure=2e9, kappa=k) for k in np.geomspace(1e9, 1e11, 1500)]
+    columns = simulate_many(cases, "thornton", n_threads=n_threads)
+    assert len(calls) == len(cases) and np.all(columns.status == 0)  # 0: success
+
+
 def test_a_case_the_law_cannot_run_is_refused_before_any_chunk_runs(monkeypatch):
     """simulate_many packs its chunks as they run (in threads the first has 1024 cases): a case
     without what the law needs, past the first chunk, is refused before any run, named by its index."""

@@ -82,5 +82,5 @@ def test_a_horizon_too_short_names_the_first_case_it_is_too_short_for():
 
 def test_a_case_the_law_cannot_pack_is_refused_by_the_law():
     cases = [seed_parameters(limiting_pressure=2e9), seed_parameters()]  # thornton needs p_y
-    with pytest.raises(ValueError, match="limiting contact pressure"):
+    with pytest.raises(ValueError, match=r"params_seq\[1\]: law 'thornton' needs the limiting contact pressure"):
         pack_batch(cases, "thornton", None, 1e-10)

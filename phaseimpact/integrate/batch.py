@@ -118,11 +118,26 @@ def _checked_sequence(params_seq) -> list:
 _NUMBER_FIELDS = operator.attrgetter("M1", "M2", "K", "Kb", "Km", "alpha", "kappa", "v")
 
 
-def _pack(params_seq: list, law: ContactLaw, t_end, rtol: float, initial) -> Batch:
+def _law_coefficients(law: ContactLaw, params_seq: list) -> list[tuple] | None:
+    """Each case's own coefficients of ``law`` (:meth:`~phaseimpact.model.ContactLaw.coefficients`),
+    None for a law without them; ``ValueError`` naming the first case that lacks what the law needs."""
+    if law.entry.coefficients is None:
+        return None
+    rows = []
+    for i, p in enumerate(params_seq):
+        try:
+            rows.append(law.coefficients(p))
+        except ValueError as error:
+            raise ValueError(f"params_seq[{i}]: {error}") from None
+    return rows
+
+
+def _pack(params_seq: list, law: ContactLaw, t_end, rtol: float, initial, coefficients=None) -> Batch:
     """The rows of :func:`~phaseimpact.model.rhs.pack`, :func:`~.api.scales` and the initial states,
-    on columns: per case only the fields are read (and what the law computes per case). The same
-    IEEE operations in the same order as the per-case code (``hertz_indentation``'s powers stay per
-    case), hence the same bits."""
+    on columns: per case only the fields are read (and what the law computes per case, unless
+    ``coefficients`` brings it: :func:`_law_coefficients` of these cases). The same IEEE operations
+    in the same order as the per-case code (``hertz_indentation``'s powers stay per case), hence
+    the same bits."""
     y0 = initial_state(0.0) if initial is None else np.concatenate([_checked_initial(initial), [0.0]])
     n = len(params_seq)
     fields = itertools.chain.from_iterable(map(_NUMBER_FIELDS, params_seq))  # fromiter: no list of tuples
@@ -141,10 +156,10 @@ def _pack(params_seq: list, law: ContactLaw, t_end, rtol: float, initial) -> Bat
     C[:, KB_], C[:, KM_] = np.where(springs, Kb, 0.0), np.where(springs, Km, 0.0)
     C[:, DAMP_] = _damping_column(law, params_seq, K, v, kappa)
     C[:, SPRINGS_], C[:, RIGID_], C[:, GUARD_] = springs, rigid, law.runaway_factor
-    if law.entry.coefficients is not None:
-        for i, p in enumerate(params_seq):
-            own = law.coefficients(p)
-            C[i, LAW_:LAW_ + len(own)] = own
+    if coefficients is None:
+        coefficients = _law_coefficients(law, params_seq)
+    for i, own in enumerate(coefficients or ()):  # None: the law has none of its own
+        C[i, LAW_:LAW_ + len(own)] = own
     if "infinite" in kinds:
         C[:, IMPEDANCE_] = [p.impedance if t == "infinite" else 0.0 for p, t in zip(params_seq, targets, strict=True)]
     # Parameters.reduced_mass (IEEE operations, numpy's bits too) and .hertz_indentation (its power
@@ -464,30 +479,28 @@ def simulate_many(params_seq, law: ContactLaw | str = "paper", t_end: float | No
 
         cuda.check(law)
     params_seq = _checked_sequence(params_seq)  # every case, before any run
-    if law.entry.coefficients is not None:  # what the law needs of each case (chunks are packed as they run)
-        for i, p in enumerate(params_seq):
-            try:
-                law.coefficients(p)
-            except ValueError as error:
-                raise ValueError(f"params_seq[{i}]: {error}") from None
+    # what the law needs of each case, read once: chunks are packed as they run, with these
+    own = _law_coefficients(law, params_seq)
     if t_end is not None:  # long enough for the case of the longest contact
         check_t_end(t_end, max(hertz_contact_time(p.alpha, p.hertz_indentation, p.v) for p in params_seq))
     threaded = n_threads > 1 and backend == "threads"
-    chunks = [params_seq[part] for part in pack_chunks(len(params_seq), threaded)]
+    chunks = [(params_seq[part], None if own is None else own[part]) for part in pack_chunks(len(params_seq), threaded)]
     options = {"rtol": rtol, "settle": stop_when_settled, "stop_on": stop_on, "n_threads": n_threads, "stiff": stiff,
                "backend": backend}
     if not threaded:
-        return _joined([run_batch(_pack(chunk, law, t_end, rtol, initial), **options) for chunk in chunks])
+        return _joined([run_batch(_pack(cases, law, t_end, rtol, initial, rows), **options) for cases, rows in chunks])
     # Packing is Python (~1.2 us a case on columns, 4 % of a run on two threads): this thread packs
     # the next chunk while the other threads run the chunk before, in compiled code that needs no GIL,
     # and then runs the rest of it beside them (run_batch's meanwhile). Only the first, small chunk is
     # packed before any run starts.
-    batch, parts = _pack(chunks[0], law, t_end, rtol, initial), []
+    first_cases, first_coefficients = chunks[0]
+    batch, parts = _pack(first_cases, law, t_end, rtol, initial, first_coefficients), []
     for following in [*chunks[1:], None]:
         packed = []
 
-        def pack_following(cases=following, into=packed) -> None:
-            into.append(_pack(cases, law, t_end, rtol, initial))
+        def pack_following(chunk=following, into=packed) -> None:
+            cases, coefficients = chunk
+            into.append(_pack(cases, law, t_end, rtol, initial, coefficients))
 
         parts.append(run_batch(batch, **options, meanwhile=None if following is None else pack_following))
         batch = packed[0] if packed else None
