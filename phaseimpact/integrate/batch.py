@@ -288,7 +288,7 @@ def _run_block(args: tuple, outputs: tuple, work: np.ndarray, radau, meanwhile=N
             meanwhile()
         d.run_block(*args, tasks, claimed, outputs, work[0], radau)
     finally:
-        for _ in helpers:
+        for _ in helpers:  # a second Ctrl-C in this wait leaves them out of the pool, to end their block alone
             failure = done.get()
             if failure is not None:
                 failures.append(failure)
