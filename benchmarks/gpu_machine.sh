@@ -64,7 +64,7 @@ print("Python", sys.version.split()[0], *(f"{p} {version(p)}" for p in ("numpy",
 
     if [ "$only" != gpu ]; then
         stamp "scale.py --section scale_gpu_machine $quick (the kernel compiling on one core beside it)"
-        timeout 240 "$PY" benchmarks/scale.py --section scale_gpu_machine $quick
+        timeout 300 "$PY" benchmarks/scale.py --section scale_gpu_machine $quick
         echo "scale.py exit $?"
         save scale_gpu_machine
         save scale_gpu_machine_quick

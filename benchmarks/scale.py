@@ -115,6 +115,8 @@ def main(argv=None) -> int:
     contenders = {(what, how, n): fn for n in counts for (what, how), fn in workloads(n).items()}
     contenders.update({(ARITHMETIC_CONTROL, "threads", n): (lambda n=n: _spin_threads(n)) for n in counts})
     ceilings = {n: _Processes(n, args.quick, args.n) for n in counts}
+    for ceiling in ceilings.values():
+        ceiling.wait_ready()
     contenders.update({(PROCESS_CEILING, "processes", n): ceilings[n].sweep for n in counts})
     results = {key: fn() for key, fn in contenders.items()}  # warm-up: compiles, starts loky's workers
     times = {key: [] for key in contenders}
@@ -276,6 +278,10 @@ class _Processes:
         command = [sys.executable, str(Path(__file__).resolve()), "--n", str(n_arg), *(["--quick"] if quick else [])]
         self.workers = [subprocess.Popen([*command, "--worker", str(i), str(n)], stdin=subprocess.PIPE,
                                          stdout=subprocess.PIPE, text=True) for i in range(n)]
+
+    def wait_ready(self) -> None:
+        """Each worker has compiled (or loaded) the engine and swept once (every group starts at once:
+        31 processes for 1-16 workers, within a GPU lease's limit for scale.py)."""
         for worker in self.workers:
             line = worker.stdout.readline().strip()
             if line != "ready":
