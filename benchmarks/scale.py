@@ -59,7 +59,7 @@ from phaseimpact.model import as_law  # noqa: E402
 RTOL = 1e-10
 #: simulate_many's runs alone: its cases packed beforehand and run in one call (no packing, no chunks).
 ENGINE_ONLY = "simulate_many's runs, packed beforehand"
-#: The sweep's points dealt to processes that share nothing: the machine's ceiling for this code.
+#: The sweep's points dealt to processes that share nothing: the engine's code without in-process costs.
 PROCESS_CEILING = "control: the sweep in processes that share nothing"
 #: Threads of arithmetic alone: the machine's scaling of compiled threads that touch no memory.
 ARITHMETIC_CONTROL = "control: arithmetic only"

@@ -24,14 +24,13 @@ def _chunk(n: int = 64):
 
 def _threads_running_blocks(monkeypatch) -> set:
     """The threads (other than this one) that run driver.run_block from now on."""
-    real, seen = batches.d.run_block, set()
+    real, seen, caller = batches.d.run_block, set(), threading.get_ident()
 
     def recording(*args):
         if threading.get_ident() != caller:
             seen.add(threading.get_ident())
         real(*args)
 
-    caller = threading.get_ident()
     monkeypatch.setattr(batches.d, "run_block", recording)
     return seen
 

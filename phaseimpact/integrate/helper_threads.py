@@ -4,8 +4,9 @@ A threaded chunk runs in its caller and ``n - 1`` helper threads. Starting and j
 threads for every chunk cost the caller a tenth of a millisecond or so a helper, one after the
 other, where a sweep's chunk at 16 threads is some 8 ms of work (4096 runs of about 30 us shared
 by 16 threads). One chunk of 32 runs in 16 threads took 3.29 ms with helpers started for it and
-1.29 ms with helpers kept (``benchmarks/scale.py``'s second table, on 2 cores). A helper taken
-from here was started by an earlier chunk and only waits to be handed the next block.
+1.29 ms with helpers kept (``benchmarks/scale.py``'s second table, on 2 cores). So a helper does
+not end with its chunk: it waits to be handed the next block, and a new one is started only when
+no idle helper is left.
 
 Helpers are taken for one chunk and given back at its end, so callers in several threads of a
 process never share one. They are daemon threads: one that waits for work holds nothing, and a
